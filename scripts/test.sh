@@ -1,0 +1,8 @@
+#!/usr/bin/env bash
+# Every test, the paper reproductions included: creates .venv if needed (with the test
+# extra: pytest, ruff, Pinocchio as an oracle), lints, then runs pytest.
+set -euo pipefail
+source "$(dirname "$0")/_venv.sh" "test"
+export MPLBACKEND=Agg
+.venv/bin/ruff check src tests benchmarks examples
+exec .venv/bin/python -m pytest -q "$@"

@@ -1,0 +1,85 @@
+"""jointlock: keep a space manipulator useful and safe after one of its joints locks.
+
+Quick start::
+
+    import numpy as np
+    import jointlock as jl
+
+    arm = jl.load_robot("halt7")                 # built-in, DH file or URDF
+    crippled = jl.lock(arm, joint=4, angle=0.0)  # joints numbered from 1, as in the papers
+    q = np.zeros((1000, crippled.dof))           # any leading batch shape
+    J = jl.jacobian(crippled, q)                 # (1000, 6, 6), twist order (v, omega)
+"""
+
+from __future__ import annotations
+
+from .dh import from_dh
+from .dynamics import generalized_inertia, mass_matrix, system_mass_matrix
+from .errors import (
+    ConfigurationError,
+    InfeasibleError,
+    JointlockError,
+    ModelError,
+    ScenarioError,
+    SingularityWarning,
+)
+from .kinematics import (
+    ChainState,
+    VirtualManipulator,
+    base_jacobian,
+    chain_state,
+    com_jacobians,
+    com_positions,
+    ee_pose,
+    generalized_jacobian,
+    jacobian,
+    link_poses,
+    momentum,
+    momentum_matrix,
+    system_com,
+    virtual_link_vectors,
+    virtual_manipulator,
+)
+from .locking import lock, lock_joints
+from .model import ArmModel, Body, Joint, LockedJoint, as_joint_array
+from .robots import BUILTIN_ROBOTS, load_robot
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "ArmModel",
+    "BUILTIN_ROBOTS",
+    "Body",
+    "ChainState",
+    "ConfigurationError",
+    "InfeasibleError",
+    "Joint",
+    "JointlockError",
+    "LockedJoint",
+    "ModelError",
+    "ScenarioError",
+    "SingularityWarning",
+    "VirtualManipulator",
+    "__version__",
+    "as_joint_array",
+    "base_jacobian",
+    "chain_state",
+    "com_jacobians",
+    "com_positions",
+    "ee_pose",
+    "from_dh",
+    "generalized_inertia",
+    "generalized_jacobian",
+    "jacobian",
+    "link_poses",
+    "load_robot",
+    "lock",
+    "lock_joints",
+    "mass_matrix",
+    "momentum",
+    "momentum_matrix",
+    "system_com",
+    "system_mass_matrix",
+    "virtual_link_vectors",
+    "virtual_manipulator",
+]

@@ -1,0 +1,133 @@
+"""Denavit-Hartenberg readers: standard (distal) and modified (Craig, proximal) tables into
+the one internal chain form of :mod:`jointlock.model`.
+
+Standard DH, joint ``i``:  ``T_{i-1,i} = Rz(theta_i + q_i) Tz(d_i) Tx(a_i) Rx(alpha_i)``; the
+body of link ``i`` (its centre of mass, its inertia) is given in DH frame ``i`` (at the distal
+end of the link).
+
+Modified DH, joint ``i``:  ``T_{i-1,i} = Rx(alpha_{i-1}) Tx(a_{i-1}) Rz(theta_i + q_i) Tz(d_i)``;
+row ``i`` of the arrays passed here holds ``(a_{i-1}, alpha_{i-1}, d_i, theta_i)``, and the
+body of link ``i`` is given in DH frame ``i`` (at joint ``i``).
+
+In the internal form frame ``i`` is the frame that rotates with joint ``i``.  For modified DH
+it *is* DH frame ``i``.  For standard DH it is DH frame ``i-1`` rotated by ``theta_i + q_i``,
+and DH frame ``i`` is frame ``i`` times the fixed ``Tz(d_i) Tx(a_i) Rx(alpha_i)``: the reader
+moves each body into frame ``i`` so that dynamics are unchanged.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .errors import ModelError
+from .model import ArmModel, Body, Joint
+from .spatial import rot_x, rot_z, translation
+
+DHConvention = Literal["standard", "modified"]
+
+
+def _column(values: ArrayLike | None, n: int, name: str, default: float = 0.0) -> np.ndarray:
+    if values is None:
+        return np.full(n, default)
+    arr = np.asarray(values, dtype=float)
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ModelError(f"DH column {name} must hold {n} finite numbers; got {np.asarray(values).tolist()!r}")
+    return arr
+
+
+def from_dh(
+    name: str,
+    *,
+    a: ArrayLike,
+    alpha: ArrayLike,
+    d: ArrayLike,
+    theta: ArrayLike | None = None,
+    convention: DHConvention,
+    bodies: Sequence[Body] | None = None,
+    tool: ArrayLike | None = None,
+    lower: ArrayLike | None = None,
+    upper: ArrayLike | None = None,
+    velocity_limit: ArrayLike | None = None,
+    spacecraft: Body | None = None,
+    description: str = "",
+) -> ArmModel:
+    """Build an arm from a DH table.
+
+    Parameters
+    ----------
+    name
+        Model name.
+    a, alpha, d, theta
+        (n,) DH columns: link lengths [m], twists [rad], offsets along z [m], joint-angle
+        offsets [rad] added to ``q`` (``theta=None`` means zero).  For ``"modified"``, entry
+        ``i`` of ``a`` and ``alpha`` is ``a_{i-1}`` and ``alpha_{i-1}`` (Craig's row layout).
+    convention
+        ``"standard"`` or ``"modified"`` (see the module docstring).
+    bodies
+        (n,) bodies, each expressed in its DH frame ``i``; massless points when omitted.
+    tool
+        (4, 4) pose of the end-effector frame in DH frame ``n`` [m]; identity when omitted.
+    lower, upper, velocity_limit
+        (n,) joint limits [rad], [rad/s]; +-pi and unlimited speed when omitted.
+    spacecraft
+        Spacecraft body (centre of mass and inertia in the root frame = DH frame 0); the arm
+        is free-floating when given, fixed-base otherwise.
+    description
+        Provenance and readings, kept with the model.
+    """
+    if convention not in ("standard", "modified"):
+        raise ModelError(f"convention must be 'standard' or 'modified'; got {convention!r}")
+    a_arr = np.asarray(a, dtype=float)
+    n = a_arr.size
+    if n == 0:
+        raise ModelError("a DH table needs at least one row")
+    a_arr = _column(a, n, "a")
+    alpha_arr = _column(alpha, n, "alpha")
+    d_arr = _column(d, n, "d")
+    theta_arr = _column(theta, n, "theta")
+    lo = _column(lower, n, "lower", -math.pi)
+    hi = _column(upper, n, "upper", math.pi)
+    vmax = _column(velocity_limit, n, "velocity_limit", math.inf) if velocity_limit is not None else np.full(n, math.inf)
+    if bodies is None:
+        bodies = [Body(0.0, name=f"link{i + 1}") for i in range(n)]
+    if len(bodies) != n:
+        raise ModelError(f"bodies must hold one body per DH row ({n}); got {len(bodies)}")
+    tool_arr = np.eye(4) if tool is None else np.asarray(tool, dtype=float)
+
+    if convention == "modified":
+        placements = [
+            rot_x(alpha_arr[i]) @ translation([a_arr[i], 0.0, 0.0]) @ rot_z(theta_arr[i])
+            @ translation([0.0, 0.0, d_arr[i]])
+            for i in range(n)
+        ]
+        frame_bodies = list(bodies)
+        model_tool = tool_arr
+    else:
+        # fixed part after the joint rotation: F_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)
+        fixed = [
+            rot_z(theta_arr[i]) @ translation([0.0, 0.0, d_arr[i]])
+            @ translation([a_arr[i], 0.0, 0.0]) @ rot_x(alpha_arr[i])
+            for i in range(n)
+        ]
+        placements = [np.eye(4)] + fixed[:-1]
+        frame_bodies = [bodies[i].transformed(fixed[i]) for i in range(n)]
+        model_tool = fixed[-1] @ tool_arr
+
+    joints = tuple(
+        Joint(placements[i], (0.0, 0.0, 1.0), lo[i], hi[i], vmax[i], number=i + 1, name=f"joint{i + 1}")
+        for i in range(n)
+    )
+    return ArmModel(
+        name=name,
+        joints=joints,
+        bodies=tuple(frame_bodies),
+        tool=model_tool,
+        root_body=spacecraft if spacecraft is not None else Body(0.0, name="root"),
+        floating=spacecraft is not None,
+        description=description,
+    )

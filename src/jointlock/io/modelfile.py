@@ -1,0 +1,184 @@
+"""jointlock's TOML model format: a DH table users can write by hand.
+
+Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``)::
+
+    name = "my-arm"
+    convention = "dh_modified"          # or "dh_standard"
+    description = "where the numbers come from"
+
+    [[joint]]                           # one table per joint, base outwards
+    a_m = 0.0                           # modified: a_{i-1};  standard: a_i
+    alpha_deg = 0.0                     # modified: alpha_{i-1};  standard: alpha_i
+    d_m = 0.6
+    theta_deg = 0.0                     # offset added to the joint angle (optional)
+    lower_deg = -180.0                  # optional, default -180
+    upper_deg = 180.0                   # optional, default 180
+    velocity_limit_deg_s = 4.0          # optional, default unlimited
+    mass_kg = 42.5                      # optional body of the link, in its DH frame
+    com_m = [0.0, 0.25, 0.0]
+    inertia_kgm2 = [0.89, 0.05, 0.89]   # [Ixx, Iyy, Izz], 6 values or 3x3
+
+    [tool]                              # optional: end effector in the last DH frame
+    xyz_m = [0.0, 0.0, 0.1]
+    rpy_deg = [0.0, 0.0, 0.0]           # URDF roll-pitch-yaw
+
+    [base]                              # optional: a free-floating spacecraft
+    mass_kg = 1000.0
+    com_m = [0.0, 0.0, -1.0]            # in the root frame (DH frame 0)
+    inertia_kgm2 = [667.0, 667.0, 667.0]
+"""
+
+from __future__ import annotations
+
+import difflib
+import math
+import sys
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..dh import from_dh
+from ..errors import ModelError
+from ..model import ArmModel, Body
+from ..spatial import pose, rpy_matrix
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover
+    import tomli as tomllib
+
+_TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base"}
+_JOINT_KEYS = {
+    "a_m", "alpha_deg", "d_m", "theta_deg", "lower_deg", "upper_deg", "velocity_limit_deg_s",
+    "mass_kg", "com_m", "inertia_kgm2", "name",
+}
+_TOOL_KEYS = {"xyz_m", "rpy_deg"}
+_BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2"}
+_CONVENTIONS = {"dh_modified": "modified", "dh_standard": "standard"}
+
+
+def _check_keys(table: dict[str, Any], allowed: set[str], where: str) -> None:
+    for key in table:
+        if key not in allowed:
+            close = difflib.get_close_matches(key, sorted(allowed), n=1)
+            hint = f" (did you mean {close[0]!r}?)" if close else ""
+            raise ModelError(f"{where}: unknown field {key!r}{hint}; allowed: {', '.join(sorted(allowed))}")
+
+
+def _num(table: dict[str, Any], key: str, where: str, default: float | None = None) -> float:
+    if key not in table:
+        if default is None:
+            raise ModelError(f"{where}: missing field {key!r}")
+        return default
+    value = table[key]
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
+        raise ModelError(f"{where}: field {key!r} must be a finite number; got {value!r}")
+    return float(value)
+
+
+def _array(table: dict[str, Any], key: str, where: str, default: Any) -> np.ndarray:
+    value = table.get(key, default)
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ModelError(f"{where}: field {key!r} must be numbers; got {value!r}") from None
+    if not np.all(np.isfinite(arr)):
+        raise ModelError(f"{where}: field {key!r} must be finite; got {value!r}")
+    return arr
+
+
+def _body(table: dict[str, Any], where: str, name: str) -> Body:
+    try:
+        return Body(
+            _num(table, "mass_kg", where, 0.0),
+            _array(table, "com_m", where, [0.0, 0.0, 0.0]),
+            _array(table, "inertia_kgm2", where, [0.0, 0.0, 0.0]),
+            name=name,
+        )
+    except ModelError as exc:
+        raise ModelError(f"{where}: {exc}") from None
+
+
+def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
+    """Build a model from the parsed TOML structure (see the module docstring)."""
+    _check_keys(data, _TOP_KEYS, where)
+    convention = data.get("convention")
+    if convention not in _CONVENTIONS:
+        raise ModelError(
+            f"{where}: field 'convention' must be one of {sorted(_CONVENTIONS)}; got {convention!r}"
+        )
+    rows = data.get("joint")
+    if not isinstance(rows, list) or not rows:
+        raise ModelError(f"{where}: needs at least one [[joint]] table")
+    cols: dict[str, list[float]] = {k: [] for k in ("a", "alpha", "d", "theta", "lower", "upper", "vmax")}
+    bodies = []
+    for i, row in enumerate(rows, start=1):
+        jw = f"{where}: joint {i}"
+        if not isinstance(row, dict):
+            raise ModelError(f"{jw}: must be a table")
+        _check_keys(row, _JOINT_KEYS, jw)
+        cols["a"].append(_num(row, "a_m", jw, 0.0))
+        cols["alpha"].append(math.radians(_num(row, "alpha_deg", jw, 0.0)))
+        cols["d"].append(_num(row, "d_m", jw, 0.0))
+        cols["theta"].append(math.radians(_num(row, "theta_deg", jw, 0.0)))
+        cols["lower"].append(math.radians(_num(row, "lower_deg", jw, -180.0)))
+        cols["upper"].append(math.radians(_num(row, "upper_deg", jw, 180.0)))
+        vmax = _num(row, "velocity_limit_deg_s", jw, math.inf)
+        if vmax <= 0:
+            raise ModelError(f"{jw}: field 'velocity_limit_deg_s' must be > 0; got {vmax}")
+        cols["vmax"].append(math.radians(vmax))
+        if cols["lower"][-1] > cols["upper"][-1]:
+            raise ModelError(f"{jw}: lower_deg must be <= upper_deg; got {row.get('lower_deg')} > {row.get('upper_deg')}")
+        bodies.append(_body(row, jw, str(row.get("name", f"link{i}"))))
+    tool = np.eye(4)
+    if "tool" in data:
+        tw = f"{where}: [tool]"
+        if not isinstance(data["tool"], dict):
+            raise ModelError(f"{tw}: must be a table")
+        _check_keys(data["tool"], _TOOL_KEYS, tw)
+        xyz = _array(data["tool"], "xyz_m", tw, [0.0, 0.0, 0.0])
+        rpy = np.radians(_array(data["tool"], "rpy_deg", tw, [0.0, 0.0, 0.0]))
+        if xyz.shape != (3,) or rpy.shape != (3,):
+            raise ModelError(f"{tw}: xyz_m and rpy_deg must hold 3 numbers each")
+        tool = pose(rpy_matrix(rpy), xyz)
+    spacecraft = None
+    if "base" in data:
+        bw = f"{where}: [base]"
+        if not isinstance(data["base"], dict):
+            raise ModelError(f"{bw}: must be a table")
+        _check_keys(data["base"], _BASE_KEYS, bw)
+        spacecraft = _body(data["base"], bw, "spacecraft")
+        if spacecraft.mass <= 0:
+            raise ModelError(f"{bw}: field 'mass_kg' must be > 0 for a free-floating base; got {spacecraft.mass}")
+    name = data.get("name", "toml-arm")
+    if not isinstance(name, str):
+        raise ModelError(f"{where}: field 'name' must be a string; got {name!r}")
+    return from_dh(
+        name,
+        a=cols["a"],
+        alpha=cols["alpha"],
+        d=cols["d"],
+        theta=cols["theta"],
+        convention=_CONVENTIONS[convention],  # type: ignore[arg-type]
+        bodies=bodies,
+        tool=tool,
+        lower=cols["lower"],
+        upper=cols["upper"],
+        velocity_limit=cols["vmax"],
+        spacecraft=spacecraft,
+        description=str(data.get("description", f"read from {where}")),
+    )
+
+
+def read_model_toml(path: str | Path) -> ArmModel:
+    """Read a TOML model file (format in the module docstring)."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except OSError as exc:
+        raise ModelError(f"cannot read model file {str(path)!r}: {exc.strerror}") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise ModelError(f"{path}: malformed TOML: {exc}") from None
+    return model_from_dict(data, str(path))

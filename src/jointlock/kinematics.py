@@ -1,0 +1,369 @@
+"""Batched kinematics: forward kinematics, geometric Jacobians, free-floating generalized
+Jacobian, momentum, and the virtual manipulator.
+
+Every function takes joint arrays of shape ``(..., n)`` (any leading batch shape) and loops
+only over the ``n`` joints, never over samples.  Results are expressed in the root (base)
+frame.  For a fixed base that is the inertial frame.  For a free-floating base it is the
+spacecraft frame at the instant considered: with the spacecraft at attitude ``R_b`` rotate
+both 3-blocks of a twist by ``R_b`` to get inertial components (the matrices themselves do
+not depend on the base pose).
+
+Twists are ordered ``(v, omega)``: linear velocity of the stated reference point [m/s], then
+angular velocity [rad/s].
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .model import ArmModel, FloatArray, as_joint_array
+from .spatial import axis_angle_rotation, pose, skew
+
+
+@dataclass(frozen=True)
+class ChainState:
+    """Frames of a chain for a batch of configurations (all in the root frame).
+
+    Attributes
+    ----------
+    rotations
+        (..., n, 3, 3) orientation of every link frame.
+    positions
+        (..., n, 3) origin of every link frame [m]; it lies on the joint axis.
+    axes
+        (..., n, 3) unit joint axes.
+    ee_rotation, ee_position
+        (..., 3, 3) and (..., 3) [m]: the end-effector frame.
+    """
+
+    rotations: FloatArray
+    positions: FloatArray
+    axes: FloatArray
+    ee_rotation: FloatArray
+    ee_position: FloatArray
+
+
+def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
+    """Forward kinematics of every frame.
+
+    Parameters
+    ----------
+    model
+        The arm.
+    q
+        (..., n) joint angles [rad].
+    """
+    q = as_joint_array(model, q)
+    n = model.dof
+    axes_local = np.array([j.axis for j in model.joints])  # (n, 3)
+    placements = np.array([j.placement for j in model.joints])  # (n, 4, 4)
+    joint_rot = axis_angle_rotation(axes_local, q)  # (..., n, 3, 3)
+    local_rot = placements[:, :3, :3] @ joint_rot
+    batch = q.shape[:-1]
+    rotations = np.empty(batch + (n, 3, 3))
+    positions = np.empty(batch + (n, 3))
+    rot = np.broadcast_to(np.eye(3), batch + (3, 3))
+    pos = np.zeros(batch + (3,))
+    for i in range(n):
+        pos = pos + rot @ placements[i, :3, 3]
+        rot = rot @ local_rot[..., i, :, :]
+        rotations[..., i, :, :] = rot
+        positions[..., i, :] = pos
+    axes = np.einsum("...ij,...j->...i", rotations, axes_local)
+    tool = model.tool
+    ee_rot = rotations[..., n - 1, :, :] @ tool[:3, :3]
+    ee_pos = positions[..., n - 1, :] + rotations[..., n - 1, :, :] @ tool[:3, 3]
+    return ChainState(rotations, positions, axes, ee_rot, ee_pos)
+
+
+def link_poses(model: ArmModel, q: ArrayLike) -> FloatArray:
+    """(..., n, 4, 4) pose of every link frame in the root frame [m]."""
+    s = chain_state(model, q)
+    return pose(s.rotations, s.positions)
+
+
+def ee_pose(model: ArmModel, q: ArrayLike) -> FloatArray:
+    """(..., 4, 4) end-effector pose in the root frame [m]."""
+    s = chain_state(model, q)
+    return pose(s.ee_rotation, s.ee_position)
+
+
+def com_positions(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+    """(..., n, 3) centre of mass of every link in the root frame [m]."""
+    s = chain_state(model, q) if state is None else state
+    coms = np.array([b.com for b in model.bodies])  # (n, 3)
+    return s.positions + np.einsum("...nij,nj->...ni", s.rotations, coms)
+
+
+def _point_jacobian(state: ChainState, point: FloatArray, upto: int | None = None) -> FloatArray:
+    """(..., 6, n) twist Jacobian of a point (..., 3) moving with link ``upto`` (all links by default)."""
+    lin = np.cross(state.axes, point[..., None, :] - state.positions)  # (..., n, 3)
+    ang = state.axes.copy()
+    if upto is not None:
+        lin[..., upto + 1 :, :] = 0.0
+        ang[..., upto + 1 :, :] = 0.0
+    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(ang, -1, -2)], axis=-2)
+
+
+def jacobian(
+    model: ArmModel,
+    q: ArrayLike,
+    *,
+    frame: Literal["base", "ee"] = "base",
+    state: ChainState | None = None,
+) -> FloatArray:
+    """Geometric Jacobian of the end effector, fixed base.
+
+    Parameters
+    ----------
+    model
+        The arm.
+    q
+        (..., n) joint angles [rad].
+    frame
+        ``"base"``: components in the root frame (the inertial frame for a fixed base);
+        ``"ee"``: components in the end-effector frame.
+    state
+        Precomputed :func:`chain_state` for ``q`` (optional, saves the forward kinematics).
+
+    Returns
+    -------
+    (..., 6, n) mapping joint rates [rad/s] to the end-effector twist ``(v, omega)``, ``v``
+    being the velocity of the end-effector frame's origin [m/s].  Column ``i`` is
+    ``(z_i x (p_e - p_i), z_i)``.
+    """
+    s = chain_state(model, q) if state is None else state
+    jac = _point_jacobian(s, s.ee_position)
+    if frame == "ee":
+        jac = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jac)
+    elif frame != "base":
+        raise ValueError(f"frame must be 'base' or 'ee'; got {frame!r}")
+    return jac
+
+
+def _rotate_twist(rot: FloatArray, jac: FloatArray) -> FloatArray:
+    return np.concatenate([rot @ jac[..., :3, :], rot @ jac[..., 3:, :]], axis=-2)
+
+
+def com_jacobians(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+    """(..., n, 6, n): Jacobian of every link's centre-of-mass velocity and angular velocity
+    (root frame), fixed base."""
+    s = chain_state(model, q) if state is None else state
+    coms = com_positions(model, q, s)
+    n = model.dof
+    lin = np.cross(s.axes[..., None, :, :], coms[..., :, None, :] - s.positions[..., None, :, :])
+    ang = np.broadcast_to(s.axes[..., None, :, :], lin.shape).copy()
+    mask = np.tril(np.ones((n, n), dtype=bool))  # body i moves with joints j <= i
+    lin = np.where(mask[:, :, None], lin, 0.0)
+    ang = np.where(mask[:, :, None], ang, 0.0)
+    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(ang, -1, -2)], axis=-2)
+
+
+def _world_inertias(model: ArmModel, state: ChainState) -> FloatArray:
+    inertias = np.array([b.inertia for b in model.bodies])  # (n, 3, 3)
+    rot = state.rotations
+    return rot @ inertias @ np.swapaxes(rot, -1, -2)
+
+
+def momentum_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+    """Momentum map of the free-floating system.
+
+    Returns
+    -------
+    (..., 6, 6 + n) matrix ``H = [H_b | H_bm]`` such that
+    ``[P; L] = H @ [v_0; omega_0; dq]``, where ``v_0`` is the velocity of the spacecraft's
+    centre of mass [m/s], ``omega_0`` its angular velocity [rad/s], ``P`` the total linear
+    momentum [kg m/s] and ``L`` the total angular momentum about the root-frame origin
+    [kg m^2/s], all in the root frame.
+    """
+    s = chain_state(model, q) if state is None else state
+    n = model.dof
+    batch = s.positions.shape[:-2]
+    masses = np.array([b.mass for b in model.bodies])
+    coms = com_positions(model, q, s)  # (..., n, 3)
+    r0 = model.root_body.com
+    jcom = com_jacobians(model, q, s)  # (..., n, 6, n)
+    # Velocity map of each link: [v_i; w_i] = A_i [v0; w0; dq]
+    a_lin = np.zeros(batch + (n, 3, 6 + n))
+    a_lin[..., :, :, 0:3] = np.eye(3)
+    a_lin[..., :, :, 3:6] = -skew(coms - r0)
+    a_lin[..., :, :, 6:] = jcom[..., :3, :]
+    a_ang = np.zeros(batch + (n, 3, 6 + n))
+    a_ang[..., :, :, 3:6] = np.eye(3)
+    a_ang[..., :, :, 6:] = jcom[..., 3:, :]
+    inertia_w = _world_inertias(model, s)
+    lin_mom = np.einsum("n,...nij->...ij", masses, a_lin)
+    ang_mom = np.einsum("...nij,...njk->...ik", inertia_w, a_ang) + np.einsum(
+        "n,...nij,...njk->...ik", masses, skew(coms), a_lin
+    )
+    # spacecraft (root body): v = v0, w = w0
+    m0 = model.root_body.mass
+    lin_mom[..., :, 0:3] += m0 * np.eye(3)
+    ang_mom[..., :, 3:6] += model.root_body.inertia
+    ang_mom[..., :, 0:3] += m0 * skew(r0)
+    return np.concatenate([lin_mom, ang_mom], axis=-2)
+
+
+def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+    """Spacecraft motion caused by the joints with zero total momentum (000 eq. 4, ``J_btheta``).
+
+    Returns
+    -------
+    (..., 6, n) mapping joint rates [rad/s] to the spacecraft twist ``(v_0, omega_0)``:
+    velocity of its centre of mass [m/s] and angular velocity [rad/s], root frame;
+    ``-H_b^{-1} H_bm`` with the blocks of :func:`momentum_matrix`.
+    """
+    h = momentum_matrix(model, q, state)
+    return -np.linalg.solve(h[..., :, :6], h[..., :, 6:])
+
+
+def generalized_jacobian(
+    model: ArmModel,
+    q: ArrayLike,
+    *,
+    frame: Literal["base", "ee"] = "base",
+    state: ChainState | None = None,
+) -> FloatArray:
+    """Generalized Jacobian of a free-floating arm with zero momentum (Umetani-Yoshida;
+    000 eq. 5, ``J_F = J_theta + J_b J_btheta``).
+
+    Parameters
+    ----------
+    model
+        A free-floating arm (``model.floating``); a fixed-base model gives the ordinary
+        Jacobian.
+    q
+        (..., n) joint angles [rad].
+    frame
+        ``"base"`` (root/spacecraft frame) or ``"ee"`` (end-effector frame) components.
+
+    Returns
+    -------
+    (..., 6, n) mapping joint rates to the end-effector twist ``(v, omega)`` in the inertial
+    frame (components in the current spacecraft frame), the spacecraft moving so that
+    linear and angular momentum stay zero.
+    """
+    s = chain_state(model, q) if state is None else state
+    jm = jacobian(model, q, state=s)
+    if model.floating:
+        jb_theta = base_jacobian(model, q, s)
+        arm = s.ee_position - model.root_body.com
+        lin = jb_theta[..., :3, :] - np.cross(arm[..., None, :], np.swapaxes(jb_theta[..., 3:, :], -1, -2)).swapaxes(-1, -2)
+        jm = jm + np.concatenate([lin, jb_theta[..., 3:, :]], axis=-2)
+    if frame == "ee":
+        jm = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jm)
+    elif frame != "base":
+        raise ValueError(f"frame must be 'base' or 'ee'; got {frame!r}")
+    return jm
+
+
+def momentum(
+    model: ArmModel, q: ArrayLike, dq: ArrayLike, base_twist: ArrayLike | None = None
+) -> FloatArray:
+    """Total momentum ``[P; L]`` (..., 6) [kg m/s, kg m^2/s] (``L`` about the root-frame
+    origin, root frame) for joint rates ``dq`` (..., n) [rad/s] and spacecraft twist
+    ``base_twist`` (..., 6) (centre-of-mass velocity, angular velocity); zero when omitted."""
+    dq = as_joint_array(model, dq, "dq")
+    h = momentum_matrix(model, q)
+    nu = np.zeros(dq.shape[:-1] + (6,)) if base_twist is None else np.asarray(base_twist, dtype=float)
+    full = np.concatenate([np.broadcast_to(nu, dq.shape[:-1] + (6,)), dq], axis=-1)
+    return np.einsum("...ij,...j->...i", h, full)
+
+
+def system_com(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+    """(..., 3) centre of mass of links plus root body, root frame [m]."""
+    s = chain_state(model, q) if state is None else state
+    masses = np.array([b.mass for b in model.bodies])
+    coms = com_positions(model, q, s)
+    total = masses.sum() + model.root_body.mass
+    return (np.einsum("n,...ni->...i", masses, coms) + model.root_body.mass * model.root_body.com) / total
+
+
+# -- virtual manipulator (Vafa & Dubowsky; 004 §2-3) ----------------------------------------
+
+
+def virtual_link_vectors(model: ArmModel) -> FloatArray:
+    """Virtual link vectors of the virtual manipulator, each in its own body frame.
+
+    With ``mu_k = (m_0 + ... + m_k) / M`` (``m_0`` the spacecraft), ``a_k`` the vector from
+    joint ``k`` to the centre of mass of link ``k`` and ``b_k`` from that centre of mass to
+    joint ``k+1`` (``b_0``: spacecraft centre of mass to joint 1; ``b_n``: to the end
+    effector), the end effector is ``r_g + sum_k R_k V_k`` with
+
+    ``V_0 = mu_0 b_0``,  ``V_k = mu_{k-1} a_k + mu_k b_k``  (k = 1..n).
+
+    A fixed base is the limit ``m_0 -> inf``: every ``mu_k = 1`` and the virtual arm is the
+    real one.
+
+    Returns
+    -------
+    (n + 1, 3) [m]; row 0 in the root frame, row ``k`` in link frame ``k``.
+    """
+    n = model.dof
+    masses = np.array([model.root_body.mass] + [b.mass for b in model.bodies])
+    if model.floating:
+        mu = np.cumsum(masses) / masses.sum()
+    else:
+        mu = np.ones(n + 1)
+    joint_points = [j.placement[:3, 3] for j in model.joints] + [model.tool[:3, 3]]
+    vectors = np.empty((n + 1, 3))
+    vectors[0] = mu[0] * (joint_points[0] - model.root_body.com)
+    for k in range(1, n + 1):
+        com = model.bodies[k - 1].com
+        vectors[k] = mu[k - 1] * com + mu[k] * (joint_points[k] - com)
+    return vectors
+
+
+@dataclass(frozen=True)
+class VirtualManipulator:
+    """The virtual manipulator at a batch of configurations (root frame, spacecraft attitude
+    held at the root frame's).
+
+    Attributes
+    ----------
+    ground
+        (..., 3) virtual ground = system centre of mass [m].
+    joint_positions
+        (..., n, 3) virtual joint positions [m].
+    ee_position
+        (..., 3) virtual end effector [m]; equals the real one.
+    link_vectors
+        (..., n + 1, 3) virtual link vectors in the root frame [m].
+    jacobian
+        (..., 6, n) Jacobian of the virtual arm as a fixed-base chain grounded at the system
+        centre of mass: columns ``(z_i x (p_e - p^_i), z_i)``.
+    """
+
+    ground: FloatArray
+    joint_positions: FloatArray
+    ee_position: FloatArray
+    link_vectors: FloatArray
+    jacobian: FloatArray
+
+
+def virtual_manipulator(model: ArmModel, q: ArrayLike) -> VirtualManipulator:
+    """Virtual manipulator of a free-floating arm (Vafa-Dubowsky, as used in 004).
+
+    Parameters
+    ----------
+    model
+        The arm; a fixed base gives the real arm back.
+    q
+        (..., n) joint angles [rad].
+    """
+    s = chain_state(model, q)
+    local = virtual_link_vectors(model)
+    ground = system_com(model, q, s)
+    vec_links = np.einsum("...nij,nj->...ni", s.rotations, local[1:])
+    vec0 = np.broadcast_to(local[0], ground.shape)
+    vectors = np.concatenate([vec0[..., None, :], vec_links], axis=-2)
+    cumulative = ground[..., None, :] + np.cumsum(vectors, axis=-2)
+    joints = cumulative[..., :-1, :]
+    ee = cumulative[..., -1, :]
+    lin = np.cross(s.axes, ee[..., None, :] - joints)
+    jac = np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(s.axes, -1, -2)], axis=-2)
+    return VirtualManipulator(ground, joints, ee, vectors, jac)
