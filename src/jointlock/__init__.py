@@ -13,6 +13,7 @@ Quick start::
 
 from __future__ import annotations
 
+from . import io
 from .dh import from_dh
 from .dynamics import generalized_inertia, mass_matrix, system_mass_matrix
 from .errors import (
@@ -40,6 +41,7 @@ from .kinematics import (
     virtual_link_vectors,
     virtual_manipulator,
 )
+from .io import read_model_toml, read_urdf
 from .locking import lock, lock_joints
 from .model import ArmModel, Body, Joint, LockedJoint, as_joint_array
 from .robots import BUILTIN_ROBOTS, load_robot
@@ -67,6 +69,9 @@ __all__ = [
     "com_jacobians",
     "com_positions",
     "ee_pose",
+    "io",
+    "read_model_toml",
+    "read_urdf",
     "from_dh",
     "generalized_inertia",
     "generalized_jacobian",

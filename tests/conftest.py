@@ -1,0 +1,32 @@
+"""Shared fixtures and tolerances for the test suite."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+
+#: Central finite-difference step [rad]; truncation error ~ h^2 * |f'''| ~ 1e-10 for these arms.
+FD_STEP = 1e-6
+#: Agreement of an analytic derivative with central differences (absolute, in the units of the
+#: derivative; rounding error ~ eps * |f| / h ~ 1e-9 for 10 m arms).
+FD_ATOL = 1e-7
+#: Two exact computations of the same quantity (round-off only).
+EXACT_ATOL = 1e-10
+#: Pinocchio oracle agreement required by the foundation issue.
+ORACLE_ATOL = 1e-10
+
+ROBOT_NAMES = tuple(jl.BUILTIN_ROBOTS)
+
+
+@pytest.fixture
+def rng() -> np.random.Generator:
+    return np.random.default_rng(20261121)
+
+
+def random_q(model: jl.ArmModel, rng: np.random.Generator, shape: tuple[int, ...] = ()) -> np.ndarray:
+    """Uniform configurations within the joint limits (capped to +-pi)."""
+    lo = np.maximum(model.lower, -np.pi)
+    hi = np.minimum(model.upper, np.pi)
+    return rng.uniform(lo, hi, size=shape + (model.dof,))

@@ -1,0 +1,68 @@
+"""Test-only bridge to Pinocchio: the same arm as a ``pin.Model``, built from our model's
+placements and bodies (not from our kinematics)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+import jointlock as jl
+
+pin = __import__("pytest").importorskip("pinocchio")
+
+
+def to_pinocchio(model: jl.ArmModel, *, free_flyer: bool = False):
+    """(pin.Model, ee frame id).  With ``free_flyer`` the root body is the spacecraft on a
+    free-flyer joint; otherwise the chain hangs from the universe."""
+    pm = pin.Model()
+    parent = 0
+    if free_flyer:
+        parent = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "base")
+        rb = model.root_body
+        pm.appendBodyToJoint(parent, pin.Inertia(rb.mass, rb.com.copy(), rb.inertia.copy()), pin.SE3.Identity())
+    for joint, body in zip(model.joints, model.bodies):
+        placement = pin.SE3(joint.placement[:3, :3].copy(), joint.placement[:3, 3].copy())
+        jm = pin.JointModelRevoluteUnaligned(joint.axis.copy())
+        parent = pm.addJoint(parent, jm, placement, joint.name)
+        pm.appendBodyToJoint(parent, pin.Inertia(body.mass, body.com.copy(), body.inertia.copy()), pin.SE3.Identity())
+    tool = pin.SE3(model.tool[:3, :3].copy(), model.tool[:3, 3].copy())
+    fid = pm.addFrame(pin.Frame("ee", parent, tool, pin.FrameType.OP_FRAME))
+    return pm, fid
+
+
+def pin_q(pm, q: np.ndarray, free_flyer: bool) -> np.ndarray:
+    """Pinocchio configuration: free flyer at identity, continuous joints as (cos, sin)."""
+    out = pin.neutral(pm)
+    values = iter(np.asarray(q, dtype=float))
+    for joint in pm.joints[1:]:
+        if joint.nq == 7:
+            continue  # free flyer: neutral = identity pose
+        angle = next(values)
+        if joint.nq == 2:
+            out[joint.idx_q : joint.idx_q + 2] = [np.cos(angle), np.sin(angle)]
+        else:
+            out[joint.idx_q] = angle
+    return out
+
+
+def pin_kinematics(pm, fid, q: np.ndarray, free_flyer: bool = False):
+    """EE pose (4, 4), fixed-base Jacobian (6, n) LOCAL_WORLD_ALIGNED, joint poses (n, 4, 4),
+    mass matrix (n, n) [fixed base] or generalized Jacobian (6, n) [free flyer]."""
+    data = pm.createData()
+    qq = pin_q(pm, q, free_flyer)
+    pin.forwardKinematics(pm, data, qq)
+    pin.updateFramePlacements(pm, data)
+    ee = data.oMf[fid].homogeneous.copy()
+    jac = pin.computeFrameJacobian(pm, data, qq, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED).copy()
+    mass = pin.crba(pm, data, qq).copy()
+    mass = np.triu(mass) + np.triu(mass, 1).T
+    first = 2 if free_flyer else 1
+    poses = np.array([data.oMi[i].homogeneous for i in range(first, pm.njoints)])
+    out = {"ee": ee, "poses": poses}
+    if free_flyer:
+        hb, hbm = mass[:6, :6], mass[:6, 6:]
+        out["generalized_jacobian"] = jac[:, 6:] - jac[:, :6] @ np.linalg.solve(hb, hbm)
+        out["jacobian"] = jac[:, 6:]
+    else:
+        out["jacobian"] = jac
+        out["mass_matrix"] = mass
+    return out
