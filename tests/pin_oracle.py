@@ -18,12 +18,16 @@ def to_pinocchio(model: jl.ArmModel, *, free_flyer: bool = False):
     if free_flyer:
         parent = pm.addJoint(0, pin.JointModelFreeFlyer(), pin.SE3.Identity(), "base")
         rb = model.root_body
-        pm.appendBodyToJoint(parent, pin.Inertia(rb.mass, rb.com.copy(), rb.inertia.copy()), pin.SE3.Identity())
+        pm.appendBodyToJoint(
+            parent, pin.Inertia(rb.mass, rb.com.copy(), rb.inertia.copy()), pin.SE3.Identity()
+        )
     for joint, body in zip(model.joints, model.bodies):
         placement = pin.SE3(joint.placement[:3, :3].copy(), joint.placement[:3, 3].copy())
         jm = pin.JointModelRevoluteUnaligned(joint.axis.copy())
         parent = pm.addJoint(parent, jm, placement, joint.name)
-        pm.appendBodyToJoint(parent, pin.Inertia(body.mass, body.com.copy(), body.inertia.copy()), pin.SE3.Identity())
+        pm.appendBodyToJoint(
+            parent, pin.Inertia(body.mass, body.com.copy(), body.inertia.copy()), pin.SE3.Identity()
+        )
     tool = pin.SE3(model.tool[:3, :3].copy(), model.tool[:3, 3].copy())
     fid = pm.addFrame(pin.Frame("ee", parent, tool, pin.FrameType.OP_FRAME))
     return pm, fid

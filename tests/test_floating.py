@@ -72,10 +72,16 @@ def test_generalized_jacobian_predicts_the_free_floating_motion(name, rng):
         vel = (frames[1][0] - frames[0][0]) / (2 * h)
         # angular velocity of each body: body-frame log of R(t-h)^T R(t+h), rotated to inertial
         omega = np.array(
-            [rots[i] @ rotation_log(frames[0][1][i].T @ frames[1][1][i]) / (2 * h) for i in range(len(masses))]
+            [
+                rots[i] @ rotation_log(frames[0][1][i].T @ frames[1][1][i]) / (2 * h)
+                for i in range(len(masses))
+            ]
         )
         lin = masses @ vel
-        ang = sum(rots[i] @ inertias[i] @ rots[i].T @ omega[i] + masses[i] * np.cross(pos[i], vel[i]) for i in range(len(masses)))
+        ang = sum(
+            rots[i] @ inertias[i] @ rots[i].T @ omega[i] + masses[i] * np.cross(pos[i], vel[i])
+            for i in range(len(masses))
+        )
         scale = float(np.sum(masses * np.linalg.norm(vel, axis=1))) + 1.0
         assert np.linalg.norm(lin) < 1e-5 * scale
         assert np.linalg.norm(ang) < 1e-4 * scale

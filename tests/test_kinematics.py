@@ -87,7 +87,9 @@ def test_poses_are_rigid_transforms(rng):
     model = jl.load_robot("puma6")
     poses = jl.link_poses(model, random_q(model, rng, (50,)))
     rot = poses[..., :3, :3]
-    np.testing.assert_allclose(rot @ np.swapaxes(rot, -1, -2), np.broadcast_to(np.eye(3), rot.shape), atol=1e-12)
+    np.testing.assert_allclose(
+        rot @ np.swapaxes(rot, -1, -2), np.broadcast_to(np.eye(3), rot.shape), atol=1e-12
+    )
     np.testing.assert_allclose(np.linalg.det(rot), 1.0, atol=1e-12)
 
 

@@ -29,26 +29,36 @@ def test_lock_every_joint_equals_frozen_full_model(name, base, rng):
         q_full = locked.expand(q)
         assert np.allclose(q_full[:, number - 1], angle)
         keep = [i for i in range(full.dof) if i != number - 1]
-        np.testing.assert_allclose(jl.link_poses(locked, q), jl.link_poses(full, q_full)[:, keep], atol=EXACT_ATOL)
+        np.testing.assert_allclose(
+            jl.link_poses(locked, q), jl.link_poses(full, q_full)[:, keep], atol=EXACT_ATOL
+        )
         np.testing.assert_allclose(jl.ee_pose(locked, q), jl.ee_pose(full, q_full), atol=EXACT_ATOL)
-        np.testing.assert_allclose(jl.jacobian(locked, q), jl.jacobian(full, q_full)[..., keep], atol=EXACT_ATOL)
+        np.testing.assert_allclose(
+            jl.jacobian(locked, q), jl.jacobian(full, q_full)[..., keep], atol=EXACT_ATOL
+        )
         m_full = jl.mass_matrix(full, q_full)
         np.testing.assert_allclose(jl.mass_matrix(locked, q), m_full[:, keep][:, :, keep], atol=1e-9)
         assert locked.total_mass == pytest.approx(full.total_mass, rel=1e-14)
         np.testing.assert_allclose(jl.system_com(locked, q), jl.system_com(full, q_full), atol=EXACT_ATOL)
         if base == "floating":
             np.testing.assert_allclose(
-                jl.generalized_jacobian(locked, q), jl.generalized_jacobian(full, q_full)[..., keep], atol=1e-9
+                jl.generalized_jacobian(locked, q),
+                jl.generalized_jacobian(full, q_full)[..., keep],
+                atol=1e-9,
             )
             h_full = jl.generalized_inertia(full, q_full)
-            np.testing.assert_allclose(jl.generalized_inertia(locked, q), h_full[:, keep][:, :, keep], atol=1e-8)
+            np.testing.assert_allclose(
+                jl.generalized_inertia(locked, q), h_full[:, keep][:, :, keep], atol=1e-8
+            )
             if number != 1:
                 # Locking joint 1 merges link 1 into the spacecraft and moves the centre of
                 # mass whose velocity is the base coordinate: compare the coordinate-free H*
                 # above only.
                 sys_full = jl.system_mass_matrix(full, q_full)
                 idx = list(range(6)) + [6 + k for k in keep]
-                np.testing.assert_allclose(jl.system_mass_matrix(locked, q), sys_full[:, idx][:, :, idx], atol=1e-8)
+                np.testing.assert_allclose(
+                    jl.system_mass_matrix(locked, q), sys_full[:, idx][:, :, idx], atol=1e-8
+                )
 
 
 @pytest.mark.parametrize("locks", [{1: 0.4, 7: -1.0}, {4: 0.0, 2: 0.7, 6: -0.3}, {7: 0.1, 6: 0.2, 5: 0.3}])

@@ -35,7 +35,9 @@ def test_fixed_base_against_pinocchio(name, rng):
             np.testing.assert_allclose(jl.ee_pose(model, q), ref["ee"], atol=ORACLE_ATOL)
             np.testing.assert_allclose(jl.link_poses(model, q), ref["poses"], atol=ORACLE_ATOL)
             np.testing.assert_allclose(jl.jacobian(model, q), ref["jacobian"], atol=ORACLE_ATOL)
-            np.testing.assert_allclose(jl.mass_matrix(model, q), ref["mass_matrix"], atol=ORACLE_ATOL * 1e3, rtol=1e-12)
+            np.testing.assert_allclose(
+                jl.mass_matrix(model, q), ref["mass_matrix"], atol=ORACLE_ATOL * 1e3, rtol=1e-12
+            )
 
 
 @pytest.mark.parametrize("name", ROBOT_NAMES)
@@ -45,7 +47,9 @@ def test_generalized_jacobian_against_pinocchio_free_flyer(name, rng):
         pm, fid = to_pinocchio(floating, free_flyer=True)
         for q in random_q(floating, rng, (4,)):
             ref = pin_kinematics(pm, fid, q, free_flyer=True)
-            np.testing.assert_allclose(jl.generalized_jacobian(floating, q), ref["generalized_jacobian"], atol=ORACLE_ATOL)
+            np.testing.assert_allclose(
+                jl.generalized_jacobian(floating, q), ref["generalized_jacobian"], atol=ORACLE_ATOL
+            )
 
 
 def _pin_urdf(free_flyer: bool):
@@ -74,7 +78,9 @@ def test_urdf_floating_against_pinocchio_free_flyer(rng):
     fid = pm.getFrameId("tool_tip")
     for q in random_q(ours, rng, (6,)):
         ref = pin_kinematics(pm, fid, q, free_flyer=True)
-        np.testing.assert_allclose(jl.generalized_jacobian(ours, q), ref["generalized_jacobian"], atol=ORACLE_ATOL)
+        np.testing.assert_allclose(
+            jl.generalized_jacobian(ours, q), ref["generalized_jacobian"], atol=ORACLE_ATOL
+        )
         locked = jl.lock(ours, 3, q[2])
         keep = [0, 1, 3, 4]
         np.testing.assert_allclose(

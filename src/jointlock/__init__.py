@@ -24,6 +24,7 @@ from .errors import (
     ScenarioError,
     SingularityWarning,
 )
+from .io import read_model_toml, read_urdf
 from .kinematics import (
     ChainState,
     VirtualManipulator,
@@ -41,7 +42,6 @@ from .kinematics import (
     virtual_link_vectors,
     virtual_manipulator,
 )
-from .io import read_model_toml, read_urdf
 from .locking import lock, lock_joints
 from .model import ArmModel, Body, Joint, LockedJoint, as_joint_array
 from .robots import BUILTIN_ROBOTS, load_robot

@@ -36,7 +36,9 @@ def _column(values: ArrayLike | None, n: int, name: str, default: float = 0.0) -
         return np.full(n, default)
     arr = np.asarray(values, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
-        raise ModelError(f"DH column {name} must hold {n} finite numbers; got {np.asarray(values).tolist()!r}")
+        raise ModelError(
+            f"DH column {name} must hold {n} finite numbers; got {np.asarray(values).tolist()!r}"
+        )
     return arr
 
 
@@ -92,7 +94,11 @@ def from_dh(
     theta_arr = _column(theta, n, "theta")
     lo = _column(lower, n, "lower", -math.pi)
     hi = _column(upper, n, "upper", math.pi)
-    vmax = _column(velocity_limit, n, "velocity_limit", math.inf) if velocity_limit is not None else np.full(n, math.inf)
+    vmax = (
+        _column(velocity_limit, n, "velocity_limit", math.inf)
+        if velocity_limit is not None
+        else np.full(n, math.inf)
+    )
     if bodies is None:
         bodies = [Body(0.0, name=f"link{i + 1}") for i in range(n)]
     if len(bodies) != n:
@@ -101,7 +107,9 @@ def from_dh(
 
     if convention == "modified":
         placements = [
-            rot_x(alpha_arr[i]) @ translation([a_arr[i], 0.0, 0.0]) @ rot_z(theta_arr[i])
+            rot_x(alpha_arr[i])
+            @ translation([a_arr[i], 0.0, 0.0])
+            @ rot_z(theta_arr[i])
             @ translation([0.0, 0.0, d_arr[i]])
             for i in range(n)
         ]
@@ -110,8 +118,10 @@ def from_dh(
     else:
         # fixed part after the joint rotation: F_i = Rz(theta_i) Tz(d_i) Tx(a_i) Rx(alpha_i)
         fixed = [
-            rot_z(theta_arr[i]) @ translation([0.0, 0.0, d_arr[i]])
-            @ translation([a_arr[i], 0.0, 0.0]) @ rot_x(alpha_arr[i])
+            rot_z(theta_arr[i])
+            @ translation([0.0, 0.0, d_arr[i]])
+            @ translation([a_arr[i], 0.0, 0.0])
+            @ rot_x(alpha_arr[i])
             for i in range(n)
         ]
         placements = [np.eye(4)] + fixed[:-1]

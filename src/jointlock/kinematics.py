@@ -252,7 +252,9 @@ def generalized_jacobian(
     if model.floating:
         jb_theta = base_jacobian(model, q, s)
         arm = s.ee_position - model.root_body.com
-        lin = jb_theta[..., :3, :] - np.cross(arm[..., None, :], np.swapaxes(jb_theta[..., 3:, :], -1, -2)).swapaxes(-1, -2)
+        lin = jb_theta[..., :3, :] - np.cross(
+            arm[..., None, :], np.swapaxes(jb_theta[..., 3:, :], -1, -2)
+        ).swapaxes(-1, -2)
         jm = jm + np.concatenate([lin, jb_theta[..., 3:, :]], axis=-2)
     if frame == "ee":
         jm = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jm)
@@ -261,9 +263,7 @@ def generalized_jacobian(
     return jm
 
 
-def momentum(
-    model: ArmModel, q: ArrayLike, dq: ArrayLike, base_twist: ArrayLike | None = None
-) -> FloatArray:
+def momentum(model: ArmModel, q: ArrayLike, dq: ArrayLike, base_twist: ArrayLike | None = None) -> FloatArray:
     """Total momentum ``[P; L]`` (..., 6) [kg m/s, kg m^2/s] (``L`` about the root-frame
     origin, root frame) for joint rates ``dq`` (..., n) [rad/s] and spacecraft twist
     ``base_twist`` (..., 6) (centre-of-mass velocity, angular velocity); zero when omitted."""

@@ -124,9 +124,7 @@ class Body:
         """The same body expressed in another frame; ``pose`` (4, 4) is T_new_old."""
         pose = np.asarray(pose, dtype=float)
         rot = pose[:3, :3]
-        return Body(
-            self.mass, rot @ self.com + pose[:3, 3], rot @ self.inertia @ rot.T, self.name
-        )
+        return Body(self.mass, rot @ self.com + pose[:3, 3], rot @ self.inertia @ rot.T, self.name)
 
     def merged(self, other: Body, pose_other: ArrayLike | None = None, name: str = "") -> Body:
         """Merge ``other`` (expressed in a frame whose pose in this body's frame is
@@ -189,9 +187,7 @@ class Joint:
             raise ModelError(f"{label}: axis must be a non-zero 3-vector; got {axis.tolist()}")
         lower, upper = float(self.lower), float(self.upper)
         if math.isnan(lower) or math.isnan(upper) or lower > upper:
-            raise ModelError(
-                f"{label}: limits must satisfy lower <= upper [rad]; got [{lower}, {upper}]"
-            )
+            raise ModelError(f"{label}: limits must satisfy lower <= upper [rad]; got [{lower}, {upper}]")
         if not (self.velocity_limit > 0):
             raise ModelError(f"{label}: velocity_limit must be > 0 [rad/s]; got {self.velocity_limit}")
         object.__setattr__(self, "placement", _readonly(placement))
@@ -367,9 +363,7 @@ class ArmModel:
             "masses_kg": [b.mass for b in self.bodies],
             "total_link_mass_kg": float(sum(b.mass for b in self.bodies)),
             "base": (
-                {"type": "floating", "mass_kg": self.root_body.mass}
-                if self.floating
-                else {"type": "fixed"}
+                {"type": "floating", "mass_kg": self.root_body.mass} if self.floating else {"type": "fixed"}
             ),
         }
 
@@ -396,9 +390,7 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
         )
     if not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
-        raise ConfigurationError(
-            f"{name} must be finite; got {arr[bad]} at index {bad} [rad]"
-        )
+        raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad} [rad]")
     return arr
 
 

@@ -17,7 +17,7 @@ import numpy as np
 from .dh import from_dh
 from .errors import ModelError
 from .model import ArmModel, Body
-from .spatial import pose, rot_x, rot_z, translation
+from .spatial import rot_x, translation
 
 BaseMode = Literal["fixed", "floating"]
 
@@ -84,6 +84,7 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = True) -> ArmModel:
 
 
 # -- canadarm7 (seed 004) -------------------------------------------------------------------
+
 
 def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
     """PROVISIONAL placeholder, replaced once the frames are inferred from 004."""
@@ -202,6 +203,5 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ModelError(
-        f"robot must be a built-in name ({', '.join(factories)}) or a .urdf/.toml file; "
-        f"got {text!r}{hint}"
+        f"robot must be a built-in name ({', '.join(factories)}) or a .urdf/.toml file; got {text!r}{hint}"
     )

@@ -111,7 +111,9 @@ def rotation_log(rotation: ArrayLike) -> FloatArray:
     # Near pi the antisymmetric part vanishes: take the axis from the symmetric part.
     near_pi = small & (cos_angle < 0)
     if np.any(near_pi):
-        sym = (r[near_pi] + np.swapaxes(r[near_pi], -1, -2)) / 2.0 - np.eye(3) * cos_angle[near_pi][..., None, None]
+        sym = (r[near_pi] + np.swapaxes(r[near_pi], -1, -2)) / 2.0 - np.eye(3) * cos_angle[near_pi][
+            ..., None, None
+        ]
         col = np.argmax(np.linalg.norm(sym, axis=-2), axis=-1)
         axis = np.take_along_axis(sym, col[..., None, None], axis=-1)[..., 0]
         axis /= np.linalg.norm(axis, axis=-1, keepdims=True)

@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import importlib.util
 import logging
 import sys
 from collections.abc import Sequence
@@ -15,8 +16,23 @@ from collections.abc import Sequence
 from .. import __version__
 from ..errors import JointlockError
 
-#: Subcommand modules, in the order ``--help`` lists them.
-COMMAND_MODULES: tuple[str, ...] = ("robots", "kinematics", "demo")
+#: Subcommand modules, in the order ``--help`` lists them.  A module listed here that is not
+#: installed (a capability still being written) is left out of the parser.
+COMMAND_MODULES: tuple[str, ...] = (
+    "robots",
+    "kinematics",
+    "halt_config",
+    "halt",
+    "jump",
+    "ik",
+    "tolerance_angle",
+    "replan",
+    "workspace",
+    "singular",
+    "run",
+    "reproduce",
+    "demo",
+)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -29,6 +45,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
+        if importlib.util.find_spec(f"{__name__}.{name}") is None:
+            continue
         importlib.import_module(f"{__name__}.{name}").register(sub)
     return parser
 
@@ -37,7 +55,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (0 ok, 2 usage or input error)."""
     parser = build_parser()
     args = parser.parse_args(argv)
-    logging.basicConfig(level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s")
+    logging.basicConfig(
+        level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s"
+    )
     try:
         return int(args.func(args) or 0)
     except JointlockError as exc:

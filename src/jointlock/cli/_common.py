@@ -75,7 +75,11 @@ def joint_vector_deg(model: ArmModel, values: list[float] | None, option: str) -
     if arr.size == model.full_dof and model.locked:
         full_locked = model.expand(model.healthy(arr))
         if not np.allclose(full_locked, arr, atol=1e-9):
-            bad = [lj.number for lj in model.locked if not math.isclose(arr[lj.number - 1], lj.angle, abs_tol=1e-9)]
+            bad = [
+                lj.number
+                for lj in model.locked
+                if not math.isclose(arr[lj.number - 1], lj.angle, abs_tol=1e-9)
+            ]
             raise ScenarioError(
                 f"{option}: the entries of locked joints {bad} must equal their lock angles "
                 "(or give only the movable joints)"

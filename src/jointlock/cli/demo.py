@@ -18,7 +18,17 @@ from .. import __version__
 from ..dynamics import mass_matrix
 from ..kinematics import generalized_jacobian, jacobian, link_poses, virtual_link_vectors
 from ..locking import lock
-from ..report import Section, atomic_write_bytes, atomic_write_json, atomic_write_text, draw_arm, figure_png, render_html, set_equal_3d, arm_points
+from ..report import (
+    Section,
+    arm_points,
+    atomic_write_bytes,
+    atomic_write_json,
+    atomic_write_text,
+    draw_arm,
+    figure_png,
+    render_html,
+    set_equal_3d,
+)
 from ..robots import BUILTIN_ROBOTS, load_robot
 
 #: Reference configurations [deg]: 000 §5 start (joint 4 at its lock angle 0), NOTES-001's
@@ -55,7 +65,9 @@ def lock_equivalence(name: str, q_deg: list[float]) -> list[dict]:
                 "joint": number,
                 "pose_error_m": float(np.abs(link_poses(locked, qh) - t_full[keep]).max()),
                 "jacobian_error": float(np.abs(jacobian(locked, qh) - j_full[:, keep]).max()),
-                "mass_matrix_error": float(np.abs(mass_matrix(locked, qh) - m_full[np.ix_(keep, keep)]).max()),
+                "mass_matrix_error": float(
+                    np.abs(mass_matrix(locked, qh) - m_full[np.ix_(keep, keep)]).max()
+                ),
             }
         )
     return rows
@@ -113,20 +125,40 @@ def run(args: argparse.Namespace) -> int:
                     (
                         ["Jacobian", "sigma_min", "sigma_max", "condition number", "manipulability"],
                         [
-                            ["fixed base", sv_fixed[-1], sv_fixed[0], sv_fixed[0] / sv_fixed[-1], float(np.prod(sv_fixed))],
-                            ["free-floating (generalized)", sv_float[-1], sv_float[0], sv_float[0] / sv_float[-1], float(np.prod(sv_float))],
+                            [
+                                "fixed base",
+                                sv_fixed[-1],
+                                sv_fixed[0],
+                                sv_fixed[0] / sv_fixed[-1],
+                                float(np.prod(sv_fixed)),
+                            ],
+                            [
+                                "free-floating (generalized)",
+                                sv_float[-1],
+                                sv_float[0],
+                                sv_float[0] / sv_float[-1],
+                                float(np.prod(sv_float)),
+                            ],
                         ],
                     ),
                     (
                         ["locked joint", "pose error [m]", "Jacobian error", "mass-matrix error"],
-                        [[r["joint"], r["pose_error_m"], r["jacobian_error"], r["mass_matrix_error"]] for r in equivalence],
+                        [
+                            [r["joint"], r["pose_error_m"], r["jacobian_error"], r["mass_matrix_error"]]
+                            for r in equivalence
+                        ],
                     ),
                     (
                         ["virtual link"] + [str(k) for k in range(len(vm))],
                         [["length [m]"] + [float(v) for v in vm]],
                     ),
                 ],
-                images=[(f"{name}: reference configuration (colour) and q = 0 (grey); x = link centres of mass", png)],
+                images=[
+                    (
+                        f"{name}: reference configuration (colour) and q = 0 (grey); x = link centres of mass",
+                        png,
+                    )
+                ],
             )
         )
     atomic_write_json(out / "results.json", results)

@@ -23,7 +23,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     add_robot_arguments(p)
-    p.add_argument("--q-deg", type=float, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)")
+    p.add_argument(
+        "--q-deg", type=float, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
@@ -53,12 +55,16 @@ def run(args: argparse.Namespace) -> int:
         print_json(result)
         return 0
     locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in result["locked"].items()) or "none"
-    print(f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: {locked}, base: {result['base']}")
+    print(
+        f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: {locked}, base: {result['base']}"
+    )
     print("q [deg]: " + ", ".join(f"{v:.4f}" for v in result["q_deg"]))
     print("\nend-effector pose T_base_ee [m]:")
     print(format_matrix(ee, "{:>11.6f}"))
     print(f"\n{result['jacobian_kind']} Jacobian (rows vx vy vz [m/s], wx wy wz [rad/s]):")
     print(format_matrix(jac, "{:>11.5f}", [f"joint {n}" for n in model.joint_numbers]))
     print("\nsingular values: " + ", ".join(f"{v:.6g}" for v in sv))
-    print(f"condition number: {result['condition_number']:.6g}   manipulability: {result['manipulability']:.6g}")
+    print(
+        f"condition number: {result['condition_number']:.6g}   manipulability: {result['manipulability']:.6g}"
+    )
     return 0

@@ -41,7 +41,9 @@ def run(args: argparse.Namespace) -> int:
     print(f"{'name':<10} {'DOF':>3} {'link masses [kg]':<42} {'reach [m]':>9} {'spacecraft [kg]':>15}")
     for r in rows:
         masses = ", ".join(f"{m:g}" for m in r["masses_kg"])
-        print(f"{r['name']:<10} {r['dof']:>3} {masses:<42} {r['reach_m']:>9.3f} {r['spacecraft_mass_kg']:>15g}")
+        print(
+            f"{r['name']:<10} {r['dof']:>3} {masses:<42} {r['reach_m']:>9.3f} {r['spacecraft_mass_kg']:>15g}"
+        )
     print("\njoint-to-joint distances [m] (last: to the end effector):")
     for r in rows:
         print(f"  {r['name']:<10} " + ", ".join(f"{v:.3f}" for v in r["link_lengths_m"]))

@@ -50,8 +50,17 @@ else:  # pragma: no cover
 
 _TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base"}
 _JOINT_KEYS = {
-    "a_m", "alpha_deg", "d_m", "theta_deg", "lower_deg", "upper_deg", "velocity_limit_deg_s",
-    "mass_kg", "com_m", "inertia_kgm2", "name",
+    "a_m",
+    "alpha_deg",
+    "d_m",
+    "theta_deg",
+    "lower_deg",
+    "upper_deg",
+    "velocity_limit_deg_s",
+    "mass_kg",
+    "com_m",
+    "inertia_kgm2",
+    "name",
 }
 _TOOL_KEYS = {"xyz_m", "rpy_deg"}
 _BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2"}
@@ -129,7 +138,9 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
             raise ModelError(f"{jw}: field 'velocity_limit_deg_s' must be > 0; got {vmax}")
         cols["vmax"].append(math.radians(vmax))
         if cols["lower"][-1] > cols["upper"][-1]:
-            raise ModelError(f"{jw}: lower_deg must be <= upper_deg; got {row.get('lower_deg')} > {row.get('upper_deg')}")
+            raise ModelError(
+                f"{jw}: lower_deg must be <= upper_deg; got {row.get('lower_deg')} > {row.get('upper_deg')}"
+            )
         bodies.append(_body(row, jw, str(row.get("name", f"link{i}"))))
     tool = np.eye(4)
     if "tool" in data:
@@ -150,7 +161,9 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
         _check_keys(data["base"], _BASE_KEYS, bw)
         spacecraft = _body(data["base"], bw, "spacecraft")
         if spacecraft.mass <= 0:
-            raise ModelError(f"{bw}: field 'mass_kg' must be > 0 for a free-floating base; got {spacecraft.mass}")
+            raise ModelError(
+                f"{bw}: field 'mass_kg' must be > 0 for a free-floating base; got {spacecraft.mass}"
+            )
     name = data.get("name", "toml-arm")
     if not isinstance(name, str):
         raise ModelError(f"{where}: field 'name' must be a string; got {name!r}")

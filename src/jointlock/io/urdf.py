@@ -83,7 +83,10 @@ def _inertial(link: ET.Element) -> Body:
     if inertia_el is None:
         inertia = np.zeros((3, 3))
     else:
-        vals = {k: _number(inertia_el, k, f"{where} <inertia>", 0.0) for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")}
+        vals = {
+            k: _number(inertia_el, k, f"{where} <inertia>", 0.0)
+            for k in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+        }
         inertia = np.array(
             [
                 [vals["ixx"], vals["ixy"], vals["ixz"]],
@@ -164,7 +167,12 @@ def read_urdf(
         for role, lname in (("parent", parent), ("child", child)):
             if lname not in links:
                 raise ModelError(f"{where}: {role} link {lname!r} is not defined")
-        axis = _floats(jel.find("axis").get("xyz") if jel.find("axis") is not None else None, 3, f"{where} <axis>", [1, 0, 0])
+        axis = _floats(
+            jel.find("axis").get("xyz") if jel.find("axis") is not None else None,
+            3,
+            f"{where} <axis>",
+            [1, 0, 0],
+        )
         lower, upper, velocity = -math.inf, math.inf, math.inf
         limit = jel.find("limit")
         if kind == "revolute":
@@ -179,7 +187,9 @@ def read_urdf(
         if kind != "fixed" and np.linalg.norm(axis) < 1e-12:
             raise ModelError(f"{where}: <axis xyz> must be non-zero")
         joints.append(
-            _UrdfJoint(jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity)
+            _UrdfJoint(
+                jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity
+            )
         )
 
     children: dict[str, list[_UrdfJoint]] = {k: [] for k in links}

@@ -1,0 +1,1 @@
+"""Analysis of an arm's state: kinematic ability indices, singularities, workspace."""
