@@ -94,11 +94,12 @@ def from_dh(
     theta_arr = _column(theta, n, "theta")
     lo = _column(lower, n, "lower", -math.pi)
     hi = _column(upper, n, "upper", math.pi)
-    vmax = (
-        _column(velocity_limit, n, "velocity_limit", math.inf)
-        if velocity_limit is not None
-        else np.full(n, math.inf)
-    )
+    vmax = np.full(n, math.inf) if velocity_limit is None else np.asarray(velocity_limit, dtype=float)
+    if vmax.shape != (n,) or not np.all(vmax > 0):
+        raise ModelError(
+            f"velocity_limit must hold {n} numbers > 0 [rad/s] (inf for unlimited); "
+            f"got {np.asarray(velocity_limit).tolist()!r}"
+        )
     if bodies is None:
         bodies = [Body(0.0, name=f"link{i + 1}") for i in range(n)]
     if len(bodies) != n:
