@@ -21,7 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .model import ArmModel, FloatArray, as_joint_array
-from .spatial import axis_angle_rotation, pose, skew
+from .spatial import pose, skew
 
 
 @dataclass(frozen=True)
@@ -56,28 +56,45 @@ def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
         The arm.
     q
         (..., n) joint angles [rad].
+
+    Notes
+    -----
+    With ``K`` the cross-product matrix of the joint axis, Rodrigues' formula gives the local
+    rotation ``P (I + sin q K + (1 - cos q) K^2)``.  The three constant products ``P``, ``P K``,
+    ``P K^2`` are multiplied into the parent rotation in one matrix product per joint, and
+    the joint angle only scales the results: the batch is never looped over.
     """
     q = as_joint_array(model, q)
     n = model.dof
-    axes_local = np.array([j.axis for j in model.joints])  # (n, 3)
-    placements = np.array([j.placement for j in model.joints])  # (n, 4, 4)
-    joint_rot = axis_angle_rotation(axes_local, q)  # (..., n, 3, 3)
-    local_rot = placements[:, :3, :3] @ joint_rot
     batch = q.shape[:-1]
-    rotations = np.empty(batch + (n, 3, 3))
-    positions = np.empty(batch + (n, 3))
-    rot = np.broadcast_to(np.eye(3), batch + (3, 3))
-    pos = np.zeros(batch + (3,))
-    for i in range(n):
-        pos = pos + rot @ placements[i, :3, 3]
-        rot = rot @ local_rot[..., i, :, :]
-        rotations[..., i, :, :] = rot
-        positions[..., i, :] = pos
-    axes = np.einsum("...ij,...j->...i", rotations, axes_local)
+    flat = q.reshape(-1, n)
+    count = flat.shape[0]
+    sin, one_minus_cos = np.sin(flat), 1.0 - np.cos(flat)
+    rotations = np.empty((count, n, 3, 3))
+    positions = np.empty((count, n, 3))
+    axes = np.empty((count, n, 3))
+    rot = np.broadcast_to(np.eye(3), (count, 3, 3))
+    pos = np.zeros((count, 3))
+    for i, joint in enumerate(model.joints):
+        place_rot, place_pos = joint.placement[:3, :3], joint.placement[:3, 3]
+        k = skew(joint.axis)
+        stacked = np.concatenate([place_rot, place_rot @ k, place_rot @ k @ k], axis=1)  # (3, 9)
+        pos = pos + rot @ place_pos
+        prod = (rot.reshape(-1, 3) @ stacked).reshape(count, 3, 3, 3)  # [R P, R P K, R P K^2]
+        rot = prod[:, :, 0] + sin[:, i, None, None] * prod[:, :, 1] + one_minus_cos[:, i, None, None] * prod[:, :, 2]
+        rotations[:, i] = rot
+        positions[:, i] = pos
+        axes[:, i] = rot @ joint.axis
     tool = model.tool
-    ee_rot = rotations[..., n - 1, :, :] @ tool[:3, :3]
-    ee_pos = positions[..., n - 1, :] + rotations[..., n - 1, :, :] @ tool[:3, 3]
-    return ChainState(rotations, positions, axes, ee_rot, ee_pos)
+    ee_rot = rot @ tool[:3, :3]
+    ee_pos = pos + rot @ tool[:3, 3]
+    return ChainState(
+        rotations.reshape(batch + (n, 3, 3)),
+        positions.reshape(batch + (n, 3)),
+        axes.reshape(batch + (n, 3)),
+        ee_rot.reshape(batch + (3, 3)),
+        ee_pos.reshape(batch + (3,)),
+    )
 
 
 def link_poses(model: ArmModel, q: ArrayLike) -> FloatArray:
