@@ -81,7 +81,11 @@ def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
         stacked = np.concatenate([place_rot, place_rot @ k, place_rot @ k @ k], axis=1)  # (3, 9)
         pos = pos + rot @ place_pos
         prod = (rot.reshape(-1, 3) @ stacked).reshape(count, 3, 3, 3)  # [R P, R P K, R P K^2]
-        rot = prod[:, :, 0] + sin[:, i, None, None] * prod[:, :, 1] + one_minus_cos[:, i, None, None] * prod[:, :, 2]
+        rot = (
+            prod[:, :, 0]
+            + sin[:, i, None, None] * prod[:, :, 1]
+            + one_minus_cos[:, i, None, None] * prod[:, :, 2]
+        )
         rotations[:, i] = rot
         positions[:, i] = pos
         axes[:, i] = rot @ joint.axis
@@ -303,15 +307,25 @@ def system_com(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -
 # -- virtual manipulator (Vafa & Dubowsky; 004 §2-3) ----------------------------------------
 
 
-def virtual_link_vectors(model: ArmModel) -> FloatArray:
+VMWeighting = Literal["vafa-dubowsky", "segment"]
+
+
+def virtual_link_vectors(model: ArmModel, *, weighting: VMWeighting = "vafa-dubowsky") -> FloatArray:
     """Virtual link vectors of the virtual manipulator, each in its own body frame.
 
     With ``mu_k = (m_0 + ... + m_k) / M`` (``m_0`` the spacecraft), ``a_k`` the vector from
-    joint ``k`` to the centre of mass of link ``k`` and ``b_k`` from that centre of mass to
-    joint ``k+1`` (``b_0``: spacecraft centre of mass to joint 1; ``b_n``: to the end
-    effector), the end effector is ``r_g + sum_k R_k V_k`` with
+    the origin of link frame ``k`` (on joint ``k``'s axis) to the centre of mass of link
+    ``k`` and ``b_k`` from that centre of mass to the origin of frame ``k+1`` (``b_0``:
+    spacecraft centre of mass to frame 1; ``b_n``: to the end effector):
 
-    ``V_0 = mu_0 b_0``,  ``V_k = mu_{k-1} a_k + mu_k b_k``  (k = 1..n).
+    * ``"vafa-dubowsky"`` (default, exact): ``V_0 = mu_0 b_0``,
+      ``V_k = mu_{k-1} a_k + mu_k b_k``.  Then ``p_e = r_g + sum_k R_k V_k`` holds exactly for
+      any placement of the frame origins along the joint axes.
+    * ``"segment"``: 004's formula (text under its eq. 3, Table 2): the whole segment of link
+      ``k`` scaled by ``mu_k``, ``V_k = mu_k (a_k + b_k)``.  It reproduces 004's printed
+      virtual lengths on ``canadarm7`` but is not the exact virtual manipulator (it moves the
+      virtual end point by up to 0.13 m there) and depends on where the frame origins sit
+      on the joint axes.
 
     A fixed base is the limit ``m_0 -> inf``: every ``mu_k = 1`` and the virtual arm is the
     real one.
@@ -320,6 +334,8 @@ def virtual_link_vectors(model: ArmModel) -> FloatArray:
     -------
     (n + 1, 3) [m]; row 0 in the root frame, row ``k`` in link frame ``k``.
     """
+    if weighting not in ("vafa-dubowsky", "segment"):
+        raise ValueError(f"weighting must be 'vafa-dubowsky' or 'segment'; got {weighting!r}")
     n = model.dof
     masses = np.array([model.root_body.mass] + [b.mass for b in model.bodies])
     if model.floating:
@@ -331,7 +347,10 @@ def virtual_link_vectors(model: ArmModel) -> FloatArray:
     vectors[0] = mu[0] * (joint_points[0] - model.root_body.com)
     for k in range(1, n + 1):
         com = model.bodies[k - 1].com
-        vectors[k] = mu[k - 1] * com + mu[k] * (joint_points[k] - com)
+        if weighting == "segment":
+            vectors[k] = mu[k] * joint_points[k]
+        else:
+            vectors[k] = mu[k - 1] * com + mu[k] * (joint_points[k] - com)
     return vectors
 
 
@@ -362,7 +381,9 @@ class VirtualManipulator:
     jacobian: FloatArray
 
 
-def virtual_manipulator(model: ArmModel, q: ArrayLike) -> VirtualManipulator:
+def virtual_manipulator(
+    model: ArmModel, q: ArrayLike, *, weighting: VMWeighting = "vafa-dubowsky"
+) -> VirtualManipulator:
     """Virtual manipulator of a free-floating arm (Vafa-Dubowsky, as used in 004).
 
     Parameters
@@ -371,9 +392,11 @@ def virtual_manipulator(model: ArmModel, q: ArrayLike) -> VirtualManipulator:
         The arm; a fixed base gives the real arm back.
     q
         (..., n) joint angles [rad].
+    weighting
+        See :func:`virtual_link_vectors`; ``"segment"`` is 004's reading.
     """
     s = chain_state(model, q)
-    local = virtual_link_vectors(model)
+    local = virtual_link_vectors(model, weighting=weighting)
     ground = system_com(model, q, s)
     vec_links = np.einsum("...nij,nj->...ni", s.rotations, local[1:])
     vec0 = np.broadcast_to(local[0], ground.shape)

@@ -16,7 +16,7 @@ import numpy as np
 
 from .dh import from_dh
 from .errors import ModelError
-from .model import ArmModel, Body
+from .model import ArmModel, Body, Joint
 from .spatial import rot_x, translation
 
 BaseMode = Literal["fixed", "floating"]
@@ -83,20 +83,87 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = True) -> ArmModel:
     )
 
 
-# -- canadarm7 (seed 004) -------------------------------------------------------------------
+# -- canadarm7 (seed 004, §5) -------------------------------------------------------------
+
+#: 004 §5 lengths [m]: a = c = f = h = k = l = 0.5, d = e = 2.5.
+CANADARM7_LENGTHS = {"l": 0.5, "a": 0.5, "c": 0.5, "d": 2.5, "e": 2.5, "f": 0.5, "h": 0.5, "k": 0.5}
+#: 004 §5 masses [kg]: spacecraft m0 = 1000, m1 = m2 = m5 = m6 = m7 = 30, m3 = m4 = 100.
+CANADARM7_MASSES = (1000.0, 30.0, 30.0, 100.0, 100.0, 30.0, 30.0, 30.0)
 
 
 def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
-    """PROVISIONAL placeholder, replaced once the frames are inferred from 004."""
+    """The Canadarm2/SSRMS-structure 7-DOF arm of seed 004 with its §5 numbers (also the
+    SSRMS-type arm of 001, whose own table was lost).
+
+    004 prints no DH table.  The frames are inferred from its text and its simplified
+    Jacobian eq. (15) (derivation in ``docs/readings/canadarm7-004.md``):
+
+    * Modified DH (Craig), all theta offsets 0:
+      ``alpha_{i-1} = [0, 90, -90, 0, 0, 90, -90] deg``, ``a_{i-1} = [0, 0, 0, d, e, 0, 0]``,
+      ``d_i = [l, a, c, 0, f, h, 0]``, tool ``Tz(k)``.  The paper's frame Sigma_{i-1} is Craig
+      frame {i}.  With these frames the geometric Jacobian, referred to the origin of Craig
+      frame {5} (where axes 5 and 6 meet) and expressed in that frame, equals eq. (15)
+      symbolically (tested numerically to 1e-12).
+    * Eq. (15) leaves free: d_1 (taken = l, base centre of mass to joint 1 along z_1), the
+      tool length k, the offsets of joints 1 and 7, and the split of c + f between d_3 and
+      d_5; the choice gives every physical segment its §5 length.
+    * Link frames sit at 004's joint points J_1..J_7 (frames 5 and 6 are slid along their
+      own axes from the Craig origins, which changes nothing kinematically), so that the
+      vector from frame k to frame k+1 is 004's physical segment of link k
+      (a, c, d, e, f, h, then k to the tool).  Each link is a 0.1 m-radius solid cylinder
+      along its segment, centre of mass at the midpoint (004 Table 1: a_i = b_i = L_i / 2;
+      the cylinders are ours: 004 gives no inertias).  Spacecraft: 1000 kg, a 2 m cube
+      (ours), centre of mass at the root-frame origin, joint 1 at l = 0.5 m along z.
+    * Virtual manipulator: ``virtual_link_vectors(model, weighting="segment")`` is 004's
+      formula (each segment of link i scaled by (m_0 + ... + m_i) / M) and reproduces its
+      printed virtual lengths; the default ``"vafa-dubowsky"`` weighting is the exact one.
+    """
+    L = CANADARM7_LENGTHS
     deg = math.radians
-    return from_dh(
-        "canadarm7",
-        a=[0, 0, 0, 2.5, 2.5, 0, 0],
-        alpha=[0, deg(90), deg(-90), 0, 0, deg(90), deg(-90)],
-        d=[0.5, 0.5, 0.5, 0.5, 0.5, 0.5, 0.5],
-        convention="modified",
-        bodies=[Body(m, (0, 0, 0), (1, 1, 1)) for m in (30, 30, 100, 100, 30, 30, 30)],
-        spacecraft=Body(1000.0, (0, 0, -1.0), (500, 500, 500)) if base == "floating" else None,
+    placements = [
+        translation([0.0, 0.0, L["l"]]),
+        rot_x(deg(90.0)) @ translation([0.0, 0.0, L["a"]]),
+        rot_x(deg(-90.0)) @ translation([0.0, 0.0, L["c"]]),
+        translation([L["d"], 0.0, 0.0]),
+        translation([L["e"], 0.0, 0.0]),
+        translation([0.0, 0.0, L["f"]]) @ rot_x(deg(90.0)),
+        translation([0.0, 0.0, L["h"]]) @ rot_x(deg(-90.0)),
+    ]
+    tool = translation([0.0, 0.0, L["k"]])
+    radius = 0.1
+    # (segment direction in the link frame, length) for links 1..7
+    segments = [
+        ((0, -1, 0), L["a"]),
+        ((0, 1, 0), L["c"]),
+        ((1, 0, 0), L["d"]),
+        ((1, 0, 0), L["e"]),
+        ((0, 0, 1), L["f"]),
+        ((0, 0, 1), L["h"]),
+        ((0, 0, 1), L["k"]),
+    ]
+    bodies = []
+    for i, (direction, length) in enumerate(segments):
+        mass = CANADARM7_MASSES[i + 1]
+        u = np.array(direction, dtype=float)
+        axial = mass * radius**2 / 2.0
+        transverse = mass * (3.0 * radius**2 + length**2) / 12.0
+        inertia = transverse * np.eye(3) + (axial - transverse) * np.outer(u, u)
+        bodies.append(Body(mass, 0.5 * length * u, inertia, name=f"link{i + 1}"))
+    joints = tuple(Joint(placements[i], number=i + 1, name=f"joint{i + 1}") for i in range(7))
+    spacecraft = Body(
+        CANADARM7_MASSES[0], np.zeros(3), np.diag([CANADARM7_MASSES[0] * 4.0 / 6.0] * 3), name="spacecraft"
+    )
+    return ArmModel(
+        name="canadarm7",
+        joints=joints,
+        bodies=tuple(bodies),
+        tool=tool,
+        root_body=spacecraft if base == "floating" else Body(0.0, name="root"),
+        floating=base == "floating",
+        description=(
+            "Seed 004 Canadarm2 structure with its §5 lengths and masses; frames inferred from eq. (15) "
+            "(modified DH, zero offsets, frames at 004's joint points); link inertias and spacecraft shape ours."
+        ),
     )
 
 
