@@ -4,5 +4,5 @@
 set -euo pipefail
 source "$(dirname "$0")/_venv.sh" "test"
 export MPLBACKEND=Agg
-.venv/bin/ruff check src tests benchmarks examples
+.venv/bin/ruff check .
 exec .venv/bin/python -m pytest -q "$@"
