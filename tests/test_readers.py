@@ -18,11 +18,11 @@ def _halt7_toml(tmp_path: Path, extra_base: bool = True) -> Path:
     model = jl.load_robot("halt7")
     rows = [
         (0, 0, 0.6, 0),
-        (0, 90, 0.5, 90),
+        (0, 90, 0.5, 0),
         (0, -90, 0.5, 0),
         (5, 0, 0.5, 0),
         (5, 0, 0.5, 0),
-        (0, 90, 0.5, -90),
+        (0, 90, 0.5, 0),
         (0, -90, 0.6, 0),
     ]
     lines = ['name = "halt7-from-file"', 'convention = "dh_modified"']
@@ -174,8 +174,24 @@ def test_urdf_branching_movable_joints_are_refused():
 
 
 def test_halt7_readings_are_selectable(rng):
-    with_offsets = jl.load_robot("halt7")
-    without = __import__("jointlock.robots", fromlist=["halt7"]).halt7(theta_offsets=False)
+    from jointlock.robots import halt7
+
+    with_offsets = halt7(theta_offsets=True)
+    without = halt7()
     q = random_q(with_offsets, rng)
     shifted = q + np.radians([0, 90, 0, 0, 0, -90, 0])
     np.testing.assert_allclose(jl.ee_pose(with_offsets, q), jl.ee_pose(without, shifted), atol=EXACT_ATOL)
+
+
+def test_halt7_default_reading_keeps_000s_halt_configurations_regular():
+    """000 §5.1's q_best and q_sub (joint 4 locked at 0): exactly singular if the theta column
+    is added, regular under the default reading (the test that chose the default)."""
+    from jointlock.robots import halt7
+
+    q_best = np.radians([-167, -90, 40, -158, 90, -62])
+    q_sub = np.radians([-52, 90, 84, 148, -90, 157])
+    for offsets, singular in ((True, True), (False, False)):
+        model = jl.lock(halt7(theta_offsets=offsets), 4, 0.0)
+        for q in (q_best, q_sub):
+            sigma_min = np.linalg.svd(jl.jacobian(model, q), compute_uv=False)[-1]
+            assert (sigma_min < 1e-9) == singular

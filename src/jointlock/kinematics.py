@@ -200,33 +200,44 @@ def momentum_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = No
     centre of mass [m/s], ``omega_0`` its angular velocity [rad/s], ``P`` the total linear
     momentum [kg m/s] and ``L`` the total angular momentum about the root-frame origin
     [kg m^2/s], all in the root frame.
+
+    Notes
+    -----
+    Built from composite quantities of the links outboard of each joint ``j`` (suffix sums,
+    as in the composite-rigid-body algorithm): mass ``M_j``, first moment ``S_j = sum m_i c_i``
+    and inertia about the root origin ``K_j = sum I_i + m_i (|c_i|^2 E - c_i c_i^T)``.  Joint
+    ``j`` contributes ``z_j x (S_j - M_j p_j)`` to ``P`` and ``K_j z_j - S_j x (z_j x p_j)`` to
+    ``L``.
     """
     s = chain_state(model, q) if state is None else state
     n = model.dof
     batch = s.positions.shape[:-2]
     masses = np.array([b.mass for b in model.bodies])
     coms = com_positions(model, q, s)  # (..., n, 3)
-    r0 = model.root_body.com
-    jcom = com_jacobians(model, q, s)  # (..., n, 6, n)
-    # Velocity map of each link: [v_i; w_i] = A_i [v0; w0; dq]
-    a_lin = np.zeros(batch + (n, 3, 6 + n))
-    a_lin[..., :, :, 0:3] = np.eye(3)
-    a_lin[..., :, :, 3:6] = -skew(coms - r0)
-    a_lin[..., :, :, 6:] = jcom[..., :3, :]
-    a_ang = np.zeros(batch + (n, 3, 6 + n))
-    a_ang[..., :, :, 3:6] = np.eye(3)
-    a_ang[..., :, :, 6:] = jcom[..., 3:, :]
-    inertia_w = _world_inertias(model, s)
-    lin_mom = np.einsum("n,...nij->...ij", masses, a_lin)
-    ang_mom = np.einsum("...nij,...njk->...ik", inertia_w, a_ang) + np.einsum(
-        "n,...nij,...njk->...ik", masses, skew(coms), a_lin
+    first = masses[:, None] * coms  # (..., n, 3)
+    about_origin = _world_inertias(model, s) + masses[:, None, None] * (
+        np.einsum("...i,...i->...", coms, coms)[..., None, None] * np.eye(3)
+        - coms[..., :, None] * coms[..., None, :]
     )
-    # spacecraft (root body): v = v0, w = w0
-    m0 = model.root_body.mass
-    lin_mom[..., :, 0:3] += m0 * np.eye(3)
-    ang_mom[..., :, 3:6] += model.root_body.inertia
-    ang_mom[..., :, 0:3] += m0 * skew(r0)
-    return np.concatenate([lin_mom, ang_mom], axis=-2)
+    # suffix sums over the links: composite body outboard of joint j
+    mass_out = np.cumsum(masses[::-1])[::-1]  # (n,)
+    first_out = np.flip(np.cumsum(np.flip(first, -2), axis=-2), -2)  # (..., n, 3)
+    inertia_out = np.flip(np.cumsum(np.flip(about_origin, -3), axis=-3), -3)  # (..., n, 3, 3)
+    z, p = s.axes, s.positions
+    lin_cols = np.cross(z, first_out - mass_out[:, None] * p)
+    ang_cols = np.einsum("...ij,...j->...i", inertia_out, z) - np.cross(first_out, np.cross(z, p))
+
+    m0, r0, i0 = model.root_body.mass, model.root_body.com, model.root_body.inertia
+    total = m0 + masses.sum()
+    first_links = first_out[..., 0, :]
+    out = np.zeros(batch + (6, 6 + n))
+    out[..., 0:3, 0:3] = total * np.eye(3)
+    out[..., 0:3, 3:6] = -skew(first_links - masses.sum() * r0)
+    out[..., 3:6, 0:3] = skew(first_links + m0 * r0)
+    out[..., 3:6, 3:6] = inertia_out[..., 0, :, :] + i0 + skew(first_links) @ skew(r0)
+    out[..., 0:3, 6:] = np.swapaxes(lin_cols, -1, -2)
+    out[..., 3:6, 6:] = np.swapaxes(ang_cols, -1, -2)
+    return out
 
 
 def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:

@@ -29,7 +29,7 @@ BaseMode = Literal["fixed", "floating"]
 HALT7_SPACECRAFT = Body(2000.0, [0.0, 0.0, -1.0], np.diag([2000.0 * 4 / 6] * 3), name="spacecraft")
 
 
-def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = True) -> ArmModel:
+def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
     """The 7-DOF space manipulator of seed 000 (Tables 6 and 7).
 
     Readings chosen (SPEC "Built-in robots"):
@@ -41,9 +41,13 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = True) -> ArmModel:
       5 m booms that run along ``x_3`` and ``x_4`` from joints 3 and 4 to joints 4 and 5.  In
       the standard reading the booms end at frames 3 and 4 and those centres of mass would
       lie outside them.  The tip pose is the same in both readings.
-    * **theta column = offsets** added to the joint angles (``theta_offsets=True``, the usual
-      meaning of "initial DH parameters"): joint 2 carries +90 deg, joint 6 -90 deg.  Pass
-      ``theta_offsets=False`` for the other reading.
+    * **theta column = the initial configuration, not an offset** (``theta_offsets=False``,
+      default).  Adding it (+90 deg on joint 2, -90 deg on joint 6) puts 000's own optimal
+      and sub-optimal halt configurations (§5.1: q_best has q2 = -90, q6 = 90; q_sub has
+      q2 = 90, q6 = -90) at q2, q6 in {0, 180} deg, where the shoulder and wrist axes
+      align: both become exactly singular (sigma_min ~ 1e-16), which a halt-configuration
+      optimum cannot be.  So 000's printed joint angles are full DH angles.  Pass
+      ``theta_offsets=True`` for the other reading.
     * Limits: [-180, 180] deg on every joint (000 §5.1); speed limit 40 deg/s (000 §5.2).
     * Masses, centres of mass and principal inertias from Table 7, as printed, in each link's
       DH frame.  The end effector is DH frame 7 (row 7's ``d_7 = 0.6`` m places it).
