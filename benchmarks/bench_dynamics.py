@@ -1,0 +1,105 @@
+"""Benchmark: batched Newton-Euler base wrench vs a Pinocchio ``rnea`` loop, and a whole GA
+run of the halt motion (000 §4.2).  Run on one core:
+
+    OMP_NUM_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_dynamics.py
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
+
+import jointlock as jl  # noqa: E402
+from jointlock.dynamics import rnea  # noqa: E402
+from jointlock.planning.ga import GASettings  # noqa: E402
+from jointlock.planning.halt_motion import HaltProblem, optimal_halt_motion  # noqa: E402
+
+
+def best_of(fn, repeat=5):
+    times = []
+    for _ in range(repeat):
+        t = time.perf_counter()
+        fn()
+        times.append(time.perf_counter() - t)
+    return min(times)
+
+
+def main() -> None:
+    print(
+        f"python {platform.python_version()}, numpy {np.__version__}, CPU {platform.processor() or platform.machine()}"
+    )
+    print(
+        f"os.cpu_count={os.cpu_count()}, OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}, "
+        f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}"
+    )
+    model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
+    d = np.radians
+    p = HaltProblem(
+        model,
+        d([-180, -180, -100, -10, 20, 20]),
+        d([20, 30, 15, 25, 40, 35]),
+        d([8, 10, 12, 10, -8, 6]),
+        d([-167, -90, 40, -158, 90, -62]),
+        12.0,
+        d(40),
+        d(20),
+        n_samples=1001,
+    )
+    q, dq, ddq = p.trajectory(3e-4 * np.pi / 180, p.times(1001))
+    for base in ("fixed", "floating"):
+        t_ours = best_of(lambda b=base: rnea(model, q, dq, ddq, base=b))
+        print(f"ours  rnea+base wrench, 1001 samples, {base:8s}: {1e3 * t_ours:8.2f} ms")
+    t_pin = None
+    try:
+        from pin_oracle import pin, pin_q, to_pinocchio
+
+        pm, _ = to_pinocchio(model)
+        pm.gravity.linear[:] = 0.0
+        data = pm.createData()
+        qs = np.array([pin_q(pm, x, False) for x in q])
+
+        def loop():
+            out = np.empty((len(q), 6))
+            for i in range(len(q)):
+                pin.rnea(pm, data, qs[i], dq[i], ddq[i])
+                pin.forwardKinematics(pm, data, qs[i])  # only rnea; placement of joint 1 below
+                f = data.f[1]
+                rot = data.oMi[1].rotation
+                out[i, :3] = rot @ f.linear
+                out[i, 3:] = rot @ f.angular
+            return out
+
+        t_pin = best_of(loop)
+        t_fixed = best_of(lambda: rnea(model, q, dq, ddq))
+        print(
+            f"pinocchio rnea loop, 1001 samples (fixed):   {1e3 * t_pin:8.2f} ms  -> ratio {t_pin / t_fixed:.1f}x"
+        )
+    except ImportError:
+        print("pinocchio not installed: no ratio")
+    for n in (1, 10, 50):
+        kk = np.linspace(0, 5e-4, n) * np.pi / 180
+        qb, dqb, ddqb = p.trajectory(kk, p.times(1001))
+        t = best_of(lambda a=qb, b=dqb, c=ddqb: rnea(model, a, b, c), 3)
+        print(
+            f"ours fixed, {n:3d} trajectories x 1001 samples: {1e3 * t:8.1f} ms, {n * 1001 / t / 1e6:.2f} M samples/s"
+        )
+    st = GASettings(n_pop=50, n_gen=100)
+    for base in ("fixed", "floating"):
+        pb = HaltProblem(**{**p.__dict__, "base": base})
+        t = time.perf_counter()
+        res = optimal_halt_motion(pb, solver="ga", rng=0, ga_settings=st)
+        t = time.perf_counter() - t
+        print(
+            f"GA {st.n_pop} x {st.n_gen} generations, {base:8s} base, 1001 samples: {t:6.2f} s "
+            f"({res.ga.n_evaluations} distinct trajectories scored), k* = {res.k * 180 / np.pi:.6g} deg/s^6"
+        )
+
+
+if __name__ == "__main__":
+    main()

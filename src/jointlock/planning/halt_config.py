@@ -1,0 +1,625 @@
+"""Optimal halt configuration (seed 000 §3.2 and §5.1): HCOM by Monte Carlo, then a bounded
+local refinement, with an optional reachability bound and the section plots of 000 Fig. 7.
+
+The search (000 eqs. 20-24): sample ``K`` configurations of the healthy joints uniformly within
+their limits (eq. 21), evaluate the combined kinematic-ability index CP of every sample in
+batched calls (eq. 19, :mod:`jointlock.analysis.ability`), keep the best.  The normalisation of
+CP (min-max bounds of ``s`` and ``w``) and its weights (AHP + entropy) depend on the sample
+set; they are fitted once and then *frozen*, so that the refinement and any later evaluation
+score configurations on the same scale.
+
+Beyond the paper: the best ``refine_starts`` samples are polished by a bounded quasi-Newton
+search (``scipy.optimize.minimize``, L-BFGS-B, central-difference gradients evaluated in one
+batched call).  The result is never worse than the best sample, and the gain is reported.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import secrets
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..analysis.ability import (
+    DEFAULT_BATCH,
+    INDEX_NAMES,
+    PAPER_JUDGMENT,
+    AbilityModel,
+    Assignment,
+    JacobianKind,
+    KinematicIndices,
+    RITable,
+    configuration_indices,
+    fit_ability_model,
+)
+from ..errors import ConfigurationError, InfeasibleError
+from ..model import ArmModel, FloatArray, as_joint_array
+from ..progress import Progress
+
+logger = logging.getLogger(__name__)
+
+#: Central-difference step of the refinement's gradient [rad]; CP is smooth away from
+#: singular-value crossings, truncation error ~ h^2 (1e-12), round-off ~ eps / h (1e-10).
+REFINE_FD_STEP = 1e-6
+#: Default minimum separation of the runner-up from the best configuration (largest joint
+#: difference) [rad]: 10 deg, so that the runner-up is another configuration, not the best
+#: one nudged.
+RUNNER_UP_SEPARATION = math.radians(10.0)
+
+
+#: Two configurations whose CP differ by less than this (relative) are equivalents of one
+#: another, not a runner-up [-] (refined starts agree to ~1e-10 at a common optimum).
+EQUIVALENT_CP_RTOL = 1e-6
+
+
+def _readonly(a: ArrayLike) -> FloatArray:
+    out = np.array(a, dtype=float)
+    out.setflags(write=False)
+    return out
+
+
+# -- reachability bound -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ReachabilityBound:
+    """Where each healthy joint can come to rest within a halt time under speed and
+    acceleration limits: a necessary condition for a halt configuration.
+
+    For one joint starting at ``q0`` with rate ``dq0``, the positions at which it can be at
+    rest by time ``T`` with ``|dq| <= v_max`` and ``|ddq| <= a_max`` form an interval
+    ``[q0 + d_-, q0 + d_+]``.  ``d_+`` is reached by the bang-bang profile (accelerate at
+    ``a_max`` to a peak speed, cruise at ``v_max`` if reached, brake at ``a_max`` to rest at
+    ``T``); ``d_- = -d_+(-dq0)``.  The feasible velocity profiles form a convex set, so every
+    point between is reachable too.  The bound ignores the initial acceleration ``ddq0`` and
+    jerk, so it is an *outer* bound for smooth profiles such as 000's 6th-order polynomial
+    (issue 4 checks a specific motion); ``ddq0`` is recorded only.
+
+    Attributes
+    ----------
+    q0, dq0
+        (n,) healthy-joint angles [rad] and rates [rad/s] at the start of the halt.
+    halt_time
+        ``T = t_f - t_0`` [s].
+    velocity_limit, acceleration_limit
+        (n,) ``v_max`` [rad/s] and ``a_max`` [rad/s^2] (symmetric limits).
+    ddq0
+        (n,) accelerations [rad/s^2] at the start (recorded, not used by the bound).
+    """
+
+    q0: FloatArray
+    dq0: FloatArray
+    halt_time: float
+    velocity_limit: FloatArray
+    acceleration_limit: FloatArray
+    ddq0: FloatArray | None = None
+
+    def __post_init__(self) -> None:
+        q0 = np.asarray(self.q0, dtype=float)
+        n = q0.shape[-1] if q0.ndim == 1 else -1
+        if q0.ndim != 1 or not np.all(np.isfinite(q0)):
+            raise ConfigurationError(f"q0 must be a finite vector (n,) [rad]; got shape {q0.shape}")
+
+        def vec(name: str, value: Any, positive: bool) -> FloatArray:
+            arr = np.broadcast_to(np.asarray(value, dtype=float), (n,)).copy()
+            if not np.all(np.isfinite(arr) | (positive & np.isposinf(arr))):
+                raise ConfigurationError(f"{name} must be finite; got {arr.tolist()}")
+            if positive and np.any(arr <= 0):
+                raise ConfigurationError(f"{name} must be > 0; got {arr.tolist()}")
+            return _readonly(arr)
+
+        try:
+            dq0 = vec("dq0 [rad/s]", self.dq0, False)
+            vmax = vec("velocity_limit [rad/s]", self.velocity_limit, True)
+            amax = vec("acceleration_limit [rad/s^2]", self.acceleration_limit, True)
+            ddq0 = None if self.ddq0 is None else vec("ddq0 [rad/s^2]", self.ddq0, False)
+        except ValueError as exc:
+            raise ConfigurationError(f"reachability: vectors must have {n} entries like q0; {exc}") from None
+        if not np.all(np.isfinite(amax)):
+            raise ConfigurationError("acceleration_limit must be finite [rad/s^2]")
+        t = float(self.halt_time)
+        if not (math.isfinite(t) and t > 0):
+            raise ConfigurationError(f"halt_time must be a finite time > 0 [s]; got {self.halt_time!r}")
+        object.__setattr__(self, "q0", _readonly(q0))
+        object.__setattr__(self, "dq0", dq0)
+        object.__setattr__(self, "velocity_limit", vmax)
+        object.__setattr__(self, "acceleration_limit", amax)
+        object.__setattr__(self, "ddq0", ddq0)
+        object.__setattr__(self, "halt_time", t)
+
+    def interval(self, joint_numbers: tuple[int, ...] | None = None) -> tuple[FloatArray, FloatArray]:
+        """(n,) lowest and highest reachable rest angles [rad].
+
+        Raises
+        ------
+        InfeasibleError
+            A joint starts faster than its speed limit, or cannot stop within ``T``
+            (``|dq0| > a_max T``); the message names the joint, by how much, and the
+            smallest halt time that would do.
+        """
+        numbers = joint_numbers or tuple(range(1, self.q0.size + 1))
+        v0, vmax, amax, t = self.dq0, self.velocity_limit, self.acceleration_limit, self.halt_time
+        over = np.abs(v0) - vmax
+        if np.any(over > 0):
+            i = int(np.argmax(over))
+            raise InfeasibleError(
+                f"joint {numbers[i]} starts at {math.degrees(abs(v0[i])):.4g} deg/s, above its speed "
+                f"limit {math.degrees(vmax[i]):.4g} deg/s by {math.degrees(over[i]):.4g} deg/s"
+            )
+        t_stop = np.abs(v0) / amax
+        if np.any(t_stop > t):
+            i = int(np.argmax(t_stop - t))
+            raise InfeasibleError(
+                f"joint {numbers[i]} cannot stop within the halt time T = {t:.4g} s: braking from "
+                f"{math.degrees(abs(v0[i])):.4g} deg/s at {math.degrees(amax[i]):.4g} deg/s^2 takes "
+                f"{t_stop[i]:.4g} s ({t_stop[i] - t:.4g} s too long); the smallest feasible T is "
+                f"{float(t_stop.max()):.4g} s"
+            )
+        return self.q0 - _max_rest_displacement(-v0, vmax, amax, t), self.q0 + _max_rest_displacement(
+            v0, vmax, amax, t
+        )
+
+    def contains(self, q: ArrayLike) -> np.ndarray:
+        """(...) bool: configurations (..., n) [rad] inside the reachable box."""
+        lo, hi = self.interval()
+        q = np.asarray(q, dtype=float)
+        return np.all((q >= lo) & (q <= hi), axis=-1)
+
+
+def _max_rest_displacement(v0: FloatArray, vmax: FloatArray, amax: FloatArray, t: float) -> FloatArray:
+    """Largest displacement [rad] ending at rest by time ``t`` (bang-bang with cruise)."""
+    peak = 0.5 * (amax * t + v0)  # accelerate then brake, meeting at the peak at time t
+    no_cruise = (2.0 * peak**2 - v0**2) / (2.0 * amax)
+    vm = np.where(np.isfinite(vmax), vmax, 0.0)
+    t_cruise = t - (vm - v0) / amax - vm / amax
+    cruise = (vm**2 - v0**2) / (2.0 * amax) + vm**2 / (2.0 * amax) + vm * t_cruise
+    return np.where(peak <= vmax, no_cruise, cruise)
+
+
+# -- result -----------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class HaltCandidate:
+    """One configuration and its kinematic ability.
+
+    Attributes
+    ----------
+    q
+        (n,) healthy-joint angles [rad], chain order (``joint_numbers`` of the result).
+    cp
+        Combined index CP (000 eq. 19) on the frozen scale of the sample set.
+    sigma_min, condition_number, manipulability
+        The unilateral indices (000 Table 3) at ``q``, computed by SVD.
+    """
+
+    q: FloatArray
+    cp: float
+    sigma_min: float
+    condition_number: float
+    manipulability: float
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data, angles in degrees."""
+        return {
+            "q_deg": np.degrees(self.q).tolist(),
+            "cp": self.cp,
+            "sigma_min": self.sigma_min,
+            "condition_number": self.condition_number,
+            "manipulability": self.manipulability,
+        }
+
+
+@dataclass(frozen=True)
+class HaltConfiguration:
+    """Result of :func:`optimal_halt_configuration`.
+
+    Attributes
+    ----------
+    best
+        The optimal halt configuration (after refinement when enabled).
+    best_sample
+        The best of the ``samples`` Monte Carlo configurations (000's answer).
+    runner_up
+        The best configuration at least ``runner_up_separation`` away from ``best`` (largest
+        joint difference) and not equivalent to it (CP differing by more than
+        :data:`EQUIVALENT_CP_RTOL`), among refined candidates and samples; None if none.
+    refinement_gain
+        ``best.cp - best_sample.cp`` (>= 0; 0 without refinement).
+    ability
+        CP's frozen normalisation and weights (AHP, entropy, combined).
+    samples
+        ``K``.
+    seed
+        The seed of the generator (an int) or None when a ``Generator`` was passed.
+    jacobian, base
+        Jacobian used (``"generalized"`` / ``"fixed"``) and the model's base
+        (``"floating"`` / ``"fixed"``); the generalized Jacobian of a fixed base is the
+        fixed-base Jacobian.
+    joint_numbers
+        Numbers (1-based, full arm) of the healthy joints, the order of every ``q``.
+    locked
+        ``{joint number: angle [rad]}``.
+    lower, upper
+        (n,) the box that was sampled [rad] (limits, intersected with the reachable box).
+    characteristic_length
+        ``L`` [m] or None (raw Jacobian, as 000).
+    reachability
+        The reachability bound applied, or None.
+    q_samples, cp_samples
+        (K, n) [rad] and (K,): the sample set and its CP.
+    indices_samples
+        Indices of the sample set, arrays (K,).
+    refine_evaluations
+        Configurations evaluated by the refinement.
+    """
+
+    best: HaltCandidate
+    best_sample: HaltCandidate
+    runner_up: HaltCandidate | None
+    refinement_gain: float
+    ability: AbilityModel
+    samples: int
+    seed: int | None
+    jacobian: JacobianKind
+    base: Literal["fixed", "floating"]
+    joint_numbers: tuple[int, ...]
+    locked: dict[int, float]
+    lower: FloatArray
+    upper: FloatArray
+    characteristic_length: float | None
+    reachability: ReachabilityBound | None
+    q_samples: FloatArray = field(repr=False)
+    cp_samples: FloatArray = field(repr=False)
+    indices_samples: KinematicIndices = field(repr=False)
+    refine_evaluations: int = 0
+
+    @property
+    def q_best(self) -> FloatArray:
+        """(n,) the optimal halt configuration, healthy joints [rad]."""
+        return self.best.q
+
+    @property
+    def cp_best(self) -> float:
+        """CP at :attr:`q_best`."""
+        return self.best.cp
+
+    @property
+    def weights(self) -> dict[str, dict[str, float]]:
+        """``{"ahp" | "entropy" | "combined": {index name: weight}}``."""
+        return self.ability.weights_dict()
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data for JSON (degrees for angles; the samples themselves are left out)."""
+        ahp = self.ability.ahp
+        return {
+            "best": self.best.to_dict(),
+            "best_sample": self.best_sample.to_dict(),
+            "runner_up": None if self.runner_up is None else self.runner_up.to_dict(),
+            "refinement": {
+                "gain": self.refinement_gain,
+                "relative_gain": self.refinement_gain / abs(self.best_sample.cp)
+                if self.best_sample.cp
+                else None,
+                "evaluations": self.refine_evaluations,
+            },
+            "weights": self.weights,
+            "ahp": {
+                "matrix": ahp.matrix.tolist(),
+                "lambda_max": ahp.lambda_max,
+                "ci": ahp.ci,
+                "cr": ahp.cr,
+                "ri": ahp.ri,
+            },
+            "entropy": {
+                "entropy": dict(zip(INDEX_NAMES, self.ability.entropy.entropy.tolist())),
+                "divergence": dict(zip(INDEX_NAMES, self.ability.entropy.divergence.tolist())),
+            },
+            "normalization": {
+                "sigma_min": list(self.ability.normalization.sigma_min_range),
+                "manipulability": list(self.ability.normalization.manipulability_range),
+            },
+            "readings": {"assignment": self.ability.assignment, "renormalize": self.ability.renormalize},
+            "seed": self.seed,
+            "samples": self.samples,
+            "jacobian": self.jacobian,
+            "base": self.base,
+            "characteristic_length_m": self.characteristic_length,
+            "joint_numbers": list(self.joint_numbers),
+            "locked_deg": {str(k): math.degrees(v) for k, v in self.locked.items()},
+            "lower_deg": np.degrees(self.lower).tolist(),
+            "upper_deg": np.degrees(self.upper).tolist(),
+        }
+
+
+# -- the search -------------------------------------------------------------------------------
+
+
+def _resolve_rng(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, int | None]:
+    if isinstance(rng, np.random.Generator):
+        return rng, None
+    if rng is None:
+        seed = secrets.randbits(63)
+    elif isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and int(rng) >= 0:
+        seed = int(rng)
+    else:
+        raise ConfigurationError(
+            f"rng must be None, a non-negative int seed or a numpy Generator; got {rng!r}"
+        )
+    return np.random.default_rng(seed), seed
+
+
+def _sampling_box(
+    model: ArmModel,
+    lower: ArrayLike | None,
+    upper: ArrayLike | None,
+    reachability: ReachabilityBound | None,
+) -> tuple[FloatArray, FloatArray]:
+    n = model.dof
+    lo = np.maximum(model.lower, -math.pi) if lower is None else np.asarray(lower, dtype=float)
+    hi = np.minimum(model.upper, math.pi) if upper is None else np.asarray(upper, dtype=float)
+    for name, arr in (("lower", lo), ("upper", hi)):
+        if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+            raise ConfigurationError(
+                f"{name} must be {n} finite angles [rad] (joints {list(model.joint_numbers)}); "
+                f"got {np.asarray(arr).tolist()}"
+            )
+    if reachability is not None:
+        if reachability.q0.shape != (n,):
+            raise ConfigurationError(
+                f"reachability.q0 must have {n} entries (joints {list(model.joint_numbers)}); "
+                f"got {reachability.q0.shape}"
+            )
+        r_lo, r_hi = reachability.interval(model.joint_numbers)
+        lo, hi = np.maximum(lo, r_lo), np.minimum(hi, r_hi)
+    empty = hi < lo
+    if np.any(empty):
+        i = int(np.argmax(lo - hi))
+        raise InfeasibleError(
+            f"no admissible angle for joint {model.joint_numbers[i]}: the reachable range misses the "
+            f"joint limits by {math.degrees(lo[i] - hi[i]):.4g} deg (lower {math.degrees(lo[i]):.4g} "
+            f"deg > upper {math.degrees(hi[i]):.4g} deg)"
+        )
+    return _readonly(lo), _readonly(hi)
+
+
+def _candidate(q: FloatArray, cp: float, ind: KinematicIndices) -> HaltCandidate:
+    return HaltCandidate(
+        _readonly(q),
+        float(cp),
+        float(ind.sigma_min),
+        float(ind.condition_number),
+        float(ind.manipulability),
+    )
+
+
+def optimal_halt_configuration(
+    model_locked: ArmModel,
+    *,
+    samples: int = 36000,
+    rng: int | np.random.Generator | None = None,
+    jacobian: JacobianKind = "generalized",
+    refine: bool = True,
+    refine_starts: int = 8,
+    assignment: Assignment = "equation",
+    renormalize: bool = False,
+    judgment: ArrayLike = PAPER_JUDGMENT,
+    ri: RITable = "paper",
+    characteristic_length: float | None = None,
+    lower: ArrayLike | None = None,
+    upper: ArrayLike | None = None,
+    reachability: ReachabilityBound | None = None,
+    runner_up_separation: float = RUNNER_UP_SEPARATION,
+    batch_size: int = DEFAULT_BATCH,
+    progress: Progress | None = None,
+) -> HaltConfiguration:
+    """Optimal halt configuration of an arm with locked joints (000 HCOM, eqs. 19-24).
+
+    Parameters
+    ----------
+    model_locked
+        The arm after the lock (:func:`jointlock.lock`); its movable joints are the healthy
+        joints searched over.
+    samples
+        ``K``, Monte Carlo samples (000: 36000), K >= 2.
+    rng
+        Seed or ``numpy.random.Generator``; None draws a fresh seed, which is recorded.
+    jacobian
+        ``"generalized"`` (default): 000 §3.1.2 analyses the generalized Jacobian ``J~_F`` of
+        the free-floating arm (eq. 5), which is also what the crippled arm's operator sees in
+        orbit.  A fixed-base model has no spacecraft to react, and its generalized Jacobian is
+        the fixed-base one; load the robot with ``base="floating"`` for 000's ``J_F``.
+        ``"fixed"``: the geometric Jacobian with the base held, whatever the model.
+    refine
+        Polish the best ``refine_starts`` samples with L-BFGS-B inside the box, CP's
+        normalisation and weights frozen from the sample set; the best is never worse than
+        the best sample.
+    assignment, renormalize, judgment, ri
+        Readings of 000's ambiguities and the AHP inputs, see
+        :mod:`jointlock.analysis.ability`.  Defaults: eq. (19)'s index order
+        (``"equation"``: the condition number receives the AHP weight 1/2), weights summed as
+        printed in eq. (18) (not renormalised), 000's judgment matrix eq. (39) and RI table.
+    characteristic_length
+        ``L`` [m] to scale the Jacobian's linear rows; None (000) uses the raw matrix.
+    lower, upper
+        (n,) sampling box [rad]; default the joint limits capped to +-pi (000: [-180, 180] deg).
+    reachability
+        Keep only configurations where every joint can be at rest within the halt time
+        (:class:`ReachabilityBound`); the box is intersected with the reachable one.
+    runner_up_separation
+        Minimum largest-joint difference of the runner-up from the best [rad].
+    batch_size
+        Samples per batched evaluation.
+    progress
+        Optional progress bar (advanced per batch).
+
+    Returns
+    -------
+    HaltConfiguration
+
+    Raises
+    ------
+    InfeasibleError
+        When the reachability bound leaves no admissible angle for some joint.
+    """
+    from scipy.optimize import minimize
+
+    if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
+        raise ConfigurationError(f"samples must be an integer >= 2; got {samples!r}")
+    if jacobian not in ("generalized", "fixed"):
+        raise ConfigurationError(f"jacobian must be 'generalized' or 'fixed'; got {jacobian!r}")
+    if int(refine_starts) < 1:
+        raise ConfigurationError(f"refine_starts must be >= 1; got {refine_starts!r}")
+    generator, seed = _resolve_rng(rng)
+    lo, hi = _sampling_box(model_locked, lower, upper, reachability)
+    n = model_locked.dof
+    k = int(samples)
+
+    q = lo + (hi - lo) * generator.random((k, n))  # 000 eq. (21)-(22), one row per sample
+    opts = {"jacobian": jacobian, "characteristic_length": characteristic_length}
+    ind = configuration_indices(
+        model_locked, q, method="gram", batch_size=batch_size, progress=progress, **opts
+    )
+    ability = fit_ability_model(ind, judgment=judgment, assignment=assignment, renormalize=renormalize, ri=ri)
+    cp = ability(ind)
+    order = np.argsort(-cp, kind="stable")
+
+    def exact(qs: FloatArray) -> tuple[FloatArray, KinematicIndices]:
+        i = configuration_indices(model_locked, qs, method="svd", **opts)
+        return ability(i), i
+
+    cp0, ind0 = exact(q[order[0]])
+    best_sample = _candidate(q[order[0]], cp0, ind0)
+
+    refined_q: list[FloatArray] = []
+    refined_cp: list[float] = []
+    evaluations = 0
+    if refine:
+        steps = REFINE_FD_STEP * np.vstack([np.zeros(n), np.eye(n), -np.eye(n)])  # (2n+1, n)
+
+        def fun(x: FloatArray) -> tuple[float, FloatArray]:
+            nonlocal evaluations
+            pts = np.clip(x + steps, lo, hi)
+            val, _ = exact(pts)
+            evaluations += pts.shape[0]
+            h = np.diagonal(pts[1 : n + 1]) - np.diagonal(pts[n + 1 :])  # per-joint step
+            grad = np.divide(val[1 : n + 1] - val[n + 1 :], h, out=np.zeros(n), where=h > 0)
+            return -float(val[0]), -grad
+
+        for idx in order[: int(refine_starts)]:
+            res = minimize(fun, q[idx], jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)))
+            x = np.clip(res.x, lo, hi)
+            refined_q.append(x)
+            refined_cp.append(float(exact(x)[0]))
+    best = best_sample
+    if refined_cp and max(refined_cp) > best_sample.cp:
+        j = int(np.argmax(refined_cp))
+        c, i = exact(refined_q[j])
+        best = _candidate(refined_q[j], c, i)
+
+    pool_q = np.vstack([np.asarray(refined_q).reshape(-1, n), q])
+    pool_cp = np.concatenate([np.asarray(refined_cp, dtype=float), cp])
+    # Runner-up: far from the best, and not an equivalent of it (same CP: e.g. joint 1 of a
+    # fixed base, or a joint turning about the tool axis, leaves every index unchanged).
+    far = (np.max(np.abs(pool_q - best.q), axis=-1) > runner_up_separation) & (
+        np.abs(pool_cp - best.cp) > EQUIVALENT_CP_RTOL * max(1.0, abs(best.cp))
+    )
+    runner_up = None
+    if np.any(far):
+        j = int(np.argmax(np.where(far, pool_cp, -np.inf)))
+        c, i = exact(pool_q[j])
+        runner_up = _candidate(pool_q[j], c, i)
+
+    gain = best.cp - best_sample.cp
+    logger.info("HCOM: best sample CP %.6g, refined %.6g (gain %.3g)", best_sample.cp, best.cp, gain)
+    q.setflags(write=False)
+    cp.setflags(write=False)
+    return HaltConfiguration(
+        best=best,
+        best_sample=best_sample,
+        runner_up=runner_up,
+        refinement_gain=float(gain),
+        ability=ability,
+        samples=k,
+        seed=seed,
+        jacobian=jacobian,
+        base="floating" if model_locked.floating else "fixed",
+        joint_numbers=model_locked.joint_numbers,
+        locked={lj.number: lj.angle for lj in model_locked.locked},
+        lower=lo,
+        upper=hi,
+        characteristic_length=characteristic_length,
+        reachability=reachability,
+        q_samples=q,
+        cp_samples=cp,
+        indices_samples=ind,
+        refine_evaluations=evaluations,
+    )
+
+
+def evaluate_cp(result: HaltConfiguration, model_locked: ArmModel, q: ArrayLike) -> FloatArray:
+    """CP (...) of configurations (..., n) [rad] on the frozen scale of a search result
+    (same Jacobian, normalisation and weights), e.g. 000's printed ``q_best`` and ``q_sub``."""
+    q = as_joint_array(model_locked, q)
+    ind = configuration_indices(
+        model_locked, q, jacobian=result.jacobian, characteristic_length=result.characteristic_length
+    )
+    return result.ability(ind)
+
+
+# -- section plots (000 Fig. 7) ---------------------------------------------------------------
+
+
+def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
+    """One matplotlib figure per healthy joint: joint angle [deg] vs CP over the sample set,
+    with the upper envelope (max CP per angle bin), the best and the runner-up (000 Fig. 7).
+
+    Returns
+    -------
+    list of ``matplotlib.figure.Figure``, chain order.
+    """
+    from matplotlib.figure import Figure
+
+    figures = []
+    q_deg = np.degrees(result.q_samples)
+    edges = np.linspace(
+        math.degrees(float(result.lower.min())), math.degrees(float(result.upper.max())), bins + 1
+    )
+    for j, number in enumerate(result.joint_numbers):
+        fig = Figure(figsize=(5.0, 3.4))
+        ax = fig.add_subplot()
+        ax.scatter(q_deg[:, j], result.cp_samples, s=1.5, alpha=0.25, color="tab:blue", rasterized=True)
+        which = np.clip(np.digitize(q_deg[:, j], edges) - 1, 0, bins - 1)
+        envelope = np.full(bins, np.nan)
+        np.fmax.at(envelope, which, result.cp_samples)
+        centres = 0.5 * (edges[1:] + edges[:-1])
+        ax.plot(centres, envelope, color="tab:blue", lw=1.2, label="max CP per bin")
+        ax.plot(math.degrees(result.best.q[j]), result.best.cp, "r*", ms=12, label="best")
+        if result.runner_up is not None:
+            ax.plot(math.degrees(result.runner_up.q[j]), result.runner_up.cp, "ks", ms=6, label="runner-up")
+        ax.set_xlabel(f"angle of joint {number} [deg]")
+        ax.set_ylabel("CP")
+        ax.set_title(f"joint {number} - CP ({result.samples} samples)", fontsize=10)
+        ax.legend(fontsize=7, loc="lower right")
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        figures.append(fig)
+    return figures
+
+
+def write_section_plots(result: HaltConfiguration, folder: str | Path, *, dpi: int = 110) -> list[Path]:
+    """Write :func:`section_figures` as ``section_joint<N>.png`` in ``folder``; returns the paths."""
+    from ..report import atomic_write_bytes, figure_png
+
+    folder = Path(folder)
+    paths = []
+    for number, fig in zip(result.joint_numbers, section_figures(result)):
+        path = folder / f"section_joint{number}.png"
+        atomic_write_bytes(path, figure_png(fig, dpi=dpi))
+        paths.append(path)
+    return paths

@@ -1,0 +1,726 @@
+"""Optimal halt motion (seed 000 §4): the 6th-order halt polynomial with one free
+coefficient ``k``, the joint-limit check, the global base disturbance torque, and solvers.
+
+Method (000 eqs. 25-38)
+-----------------------
+Every healthy joint moves from the state at failure ``(q0, dq0, ddq0)`` to the halt
+configuration ``qf`` at rest (``dqf = ddqf = 0``) in the halt time ``T`` along
+
+    q(t) = a0 + a1 t + ... + a6 t^6,   a6 = k                       (eqs. 25-27)
+
+The ``k``-part of eq. 27 is ``k t^3 (t - T)^3``: a triple root at both ends, so it leaves
+all six boundary conditions untouched and ``q(t; k) = q_quintic(t) + k t^3 (t - T)^3``.
+Its peak, at ``t = T/2``, is ``k T^6 / 64``.
+
+The objective is the time average of the 2-norm of the base disturbance torque (eq. 32),
+``tau_bar(k) = 1/T int_0^T ||n_d(t; k)|| dt`` with ``n_d`` from :func:`jointlock.dynamics.rnea`
+(000 eqs. 28-31; base held fixed as in 000, or free-floating), integrated by Simpson's
+rule.  Constraints (eq. 33): angle, speed and acceleration limits per joint on a dense
+time grid.  Each constraint is affine in ``k``, so the feasible set of a shared ``k`` is an
+interval computed exactly on the grid (and a box for one ``k`` per joint).
+
+Units of ``k``
+--------------
+Inside the library ``k`` is in rad/s^6 (SI).  000 works in degrees: its ``k = 0.0018``
+reads as deg/s^6 (a 28 deg swing at mid-halt for ``T = 10`` s; in rad/s^6 it would be a
+28 rad swing, far outside every limit), so the paper's reading is **deg/s^6**:
+``k_si = k_paper * pi / 180`` (:data:`K_UNIT_SCALE`).  The CLI reports ``k`` in deg/s^6.
+
+Infeasible scenarios are reported, never optimised silently: :class:`HaltMotion` then
+has ``feasible=False``, the least-violating ``k``, the violations (joint, limit, excess)
+and the smallest halt time ``T`` for which a feasible ``k`` exists.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import minimize, minimize_scalar
+
+from ..dynamics import BaseMode, rnea
+from ..errors import InfeasibleError, ScenarioError
+from ..model import ArmModel, FloatArray
+from .ga import GAResult, GASettings, adaptive_ga, bits_for_precision
+
+log = logging.getLogger(__name__)
+
+#: Factor from the unit of ``k`` to rad/s^6: 000's reading is deg/s^6.
+K_UNIT_SCALE: dict[str, float] = {"deg/s^6": math.pi / 180.0, "rad/s^6": 1.0}
+#: Slack on every limit when checking feasibility (relative to the limit) [-]: round-off only.
+LIMIT_RTOL = 1e-9
+#: Samples below which Simpson's rule on the halt is refused.
+MIN_SAMPLES = 11
+#: Largest number of (candidate, time) samples passed to one :func:`rnea` call.
+CHUNK_SAMPLES = 60_000
+
+Solver = Literal["scan", "ga", "vector"]
+LimitKind = Literal["angle", "velocity", "acceleration"]
+
+
+# -- the halt polynomial (eqs. 25-27) -------------------------------------------------------
+
+
+def halt_coefficients(
+    q0: ArrayLike,
+    dq0: ArrayLike,
+    ddq0: ArrayLike,
+    qf: ArrayLike,
+    T: float,
+    k: ArrayLike,
+    dqf: ArrayLike = 0.0,
+    ddqf: ArrayLike = 0.0,
+) -> FloatArray:
+    """Coefficients ``a0..a6`` of 000 eq. 27 for every joint.
+
+    Parameters
+    ----------
+    q0, dq0, ddq0
+        (..., n) state at failure [rad, rad/s, rad/s^2].
+    qf, dqf, ddqf
+        (..., n) final state [rad, rad/s, rad/s^2] (000: at rest).
+    T
+        Halt time ``t_f - t_0`` [s], > 0.
+    k
+        (...) or (..., n) free coefficient ``a6`` [rad/s^6] (broadcast against the joints).
+
+    Returns
+    -------
+    (..., n, 7) coefficients ``a0 .. a6`` in SI units (``a_j`` in rad/s^j).
+    """
+    q0, dq0, ddq0, qf, dqf, ddqf, k = (np.asarray(x, dtype=float) for x in (q0, dq0, ddq0, qf, dqf, ddqf, k))
+    T = float(T)
+    if not T > 0:
+        raise ScenarioError(f"halt time T must be > 0 [s]; got {T}")
+    h = qf - q0
+    a3 = -(T**3) * k + (20 * h - T**2 * (3 * ddq0 - ddqf) - T * (8 * dqf + 12 * dq0)) / (2 * T**3)
+    a4 = 3 * T**2 * k + (T**2 * (3 * ddq0 - 2 * ddqf) + T * (14 * dqf + 16 * dq0) - 30 * h) / (2 * T**4)
+    a5 = -3 * T * k + ((ddqf - ddq0) * T**2 - 6 * (dq0 + dqf) * T + 12 * h) / (2 * T**5)
+    parts = np.broadcast_arrays(q0, dq0, ddq0 / 2, a3, a4, a5, k + 0 * h)
+    return np.stack(parts, axis=-1)
+
+
+def polynomial_profile(coefficients: ArrayLike, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """Angle, rate and acceleration of eq. 25 at times ``t``.
+
+    Parameters
+    ----------
+    coefficients
+        (..., n, 7) from :func:`halt_coefficients`.
+    t
+        (n_t,) times since the failure [s].
+
+    Returns
+    -------
+    q, dq, ddq
+        each (..., n_t, n) [rad, rad/s, rad/s^2].
+    """
+    c = np.asarray(coefficients, dtype=float)
+    t = np.asarray(t, dtype=float)
+    powers = t[:, None] ** np.arange(7)  # (n_t, 7)
+    j = np.arange(7)
+    d1 = np.zeros_like(powers)
+    d1[:, 1:] = j[1:] * powers[:, :-1]
+    d2 = np.zeros_like(powers)
+    d2[:, 2:] = j[2:] * (j[2:] - 1) * powers[:, :-2]
+    return tuple(np.einsum("...jc,tc->...tj", c, p) for p in (powers, d1, d2))  # type: ignore[return-value]
+
+
+# -- the problem --------------------------------------------------------------------------
+
+
+def _vec(value: ArrayLike, n: int, name: str, unit: str, *, positive: bool = False) -> FloatArray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ScenarioError(f"{name} must be one finite value or {n} values [{unit}]; got {arr.tolist()}")
+    if positive and not np.all(arr > 0):
+        raise ScenarioError(f"{name} must be > 0 [{unit}]; got {arr.tolist()}")
+    out = arr.copy()
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True)
+class HaltProblem:
+    """A halt-motion problem (000 eq. 34), in SI units and radians.
+
+    Attributes
+    ----------
+    model
+        The locked arm (healthy joints only); for ``base="floating"`` it must carry a spacecraft.
+    q0, dq0, ddq0
+        (n,) state at failure [rad, rad/s, rad/s^2].
+    qf
+        (n,) halt configuration [rad] (000: ``q_best``).
+    T
+        Halt time [s].
+    dq_max, ddq_max
+        (n,) speed and acceleration limits [rad/s, rad/s^2] (symmetric).
+    q_min, q_max
+        (n,) angle limits [rad]; default the model's.
+    base
+        ``"fixed"`` (000) or ``"floating"`` base for the disturbance torque.
+    n_samples
+        Time samples of the objective (odd; Simpson's rule).
+    n_check
+        Time samples of the constraint check.
+    """
+
+    model: ArmModel
+    q0: FloatArray
+    dq0: FloatArray
+    ddq0: FloatArray
+    qf: FloatArray
+    T: float
+    dq_max: FloatArray
+    ddq_max: FloatArray
+    q_min: FloatArray | None = None
+    q_max: FloatArray | None = None
+    base: BaseMode = "fixed"
+    n_samples: int = 501
+    n_check: int = 2001
+
+    def __post_init__(self) -> None:
+        n = self.model.dof
+        for name, unit in (("q0", "rad"), ("dq0", "rad/s"), ("ddq0", "rad/s^2"), ("qf", "rad")):
+            object.__setattr__(self, name, _vec(getattr(self, name), n, name, unit))
+        object.__setattr__(self, "dq_max", _vec(self.dq_max, n, "dq_max", "rad/s", positive=True))
+        object.__setattr__(self, "ddq_max", _vec(self.ddq_max, n, "ddq_max", "rad/s^2", positive=True))
+        lo = self.model.lower if self.q_min is None else self.q_min
+        hi = self.model.upper if self.q_max is None else self.q_max
+        object.__setattr__(self, "q_min", _vec(lo, n, "q_min", "rad"))
+        object.__setattr__(self, "q_max", _vec(hi, n, "q_max", "rad"))
+        T = float(self.T)
+        if not (math.isfinite(T) and T > 0):
+            raise ScenarioError(f"halt time T must be a finite number > 0 [s]; got {self.T}")
+        object.__setattr__(self, "T", T)
+        if self.base not in ("fixed", "floating"):
+            raise ScenarioError(f"base must be 'fixed' or 'floating'; got {self.base!r}")
+        if self.base == "floating" and not self.model.floating:
+            raise ScenarioError(
+                "base='floating' needs a model with a spacecraft (load it with base='floating')"
+            )
+        if self.n_samples < MIN_SAMPLES or self.n_samples % 2 == 0:
+            raise ScenarioError(f"n_samples must be odd and >= {MIN_SAMPLES}; got {self.n_samples}")
+        if self.n_check < 3:
+            raise ScenarioError(f"n_check must be >= 3; got {self.n_check}")
+
+    @property
+    def dof(self) -> int:
+        return self.model.dof
+
+    def with_time(self, T: float) -> HaltProblem:
+        """The same problem with another halt time [s]."""
+        return replace(self, T=T)
+
+    def times(self, n: int | None = None) -> FloatArray:
+        """(n,) uniform time grid on [0, T] [s] (``n_samples`` points by default)."""
+        return np.linspace(0.0, self.T, self.n_samples if n is None else n)
+
+    def base_profile(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The ``k = 0`` (quintic) part: q, dq, ddq each (n_t, n)."""
+        coef = halt_coefficients(self.q0, self.dq0, self.ddq0, self.qf, self.T, 0.0)
+        return polynomial_profile(coef, t)
+
+    def k_shape(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``phi(t) = t^3 (t - T)^3`` and its first two derivatives, each (n_t,) [s^6, s^5, s^4]."""
+        t = np.asarray(t, dtype=float)
+        u = t - self.T
+        phi = t**3 * u**3
+        dphi = 3 * t**2 * u**2 * (t + u)
+        ddphi = 6 * t * u * (t**2 + 3 * t * u + u**2)
+        return phi, dphi, ddphi
+
+    def trajectory(
+        self, k: ArrayLike, t: ArrayLike | None = None, *, per_joint: bool = False
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint angles, rates and accelerations of the halt for one or many ``k``.
+
+        Parameters
+        ----------
+        k
+            [rad/s^6]: shape (...) for one shared ``k`` per candidate (000), or (..., n) with
+            ``per_joint=True`` (one per joint).
+        t
+            (n_t,) times [s]; default :meth:`times`.
+
+        Returns
+        -------
+        q, dq, ddq
+            each (..., n_t, n) [rad, rad/s, rad/s^2].
+        """
+        t = self.times() if t is None else np.asarray(t, dtype=float)
+        k = _k_array(k, self.dof, per_joint)
+        base = self.base_profile(t)
+        shape = self.k_shape(t)
+        kk = k[..., None, :]
+        return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+
+
+def _k_array(k: ArrayLike, n: int, per_joint: bool) -> FloatArray:
+    k = np.asarray(k, dtype=float)
+    if per_joint:
+        if k.ndim == 0 or k.shape[-1] != n:
+            raise ScenarioError(f"per-joint k must have shape (..., {n}) [rad/s^6]; got {k.shape}")
+        return k
+    return np.broadcast_to(k[..., None], k.shape + (n,))
+
+
+# -- objective (eq. 32) --------------------------------------------------------------------
+
+
+def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
+    """Time average over the last axis of uniformly sampled values (odd count), Simpson's rule."""
+    n = values.shape[-1]
+    w = np.ones(n)
+    w[1:-1:2] = 4.0
+    w[2:-1:2] = 2.0
+    return values @ w / (3.0 * (n - 1))
+
+
+def base_torque_history(
+    problem: HaltProblem, k: ArrayLike, t: ArrayLike | None = None, *, per_joint: bool = False
+) -> FloatArray:
+    """Base disturbance torque ``tau_b(t; k)`` (000 eq. 31), (..., n_t, 3) [N m], root frame."""
+    q, dq, ddq = problem.trajectory(k, t, per_joint=per_joint)
+    return rnea(problem.model, q, dq, ddq, base=problem.base).base_moment
+
+
+def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
+    """Global base disturbance torque of 000 eq. 32 for a batch of ``k``.
+
+    ``tau_bar(k) = (1/T) int_0^T ||tau_b(t; k)||_2 dt``, Simpson's rule on
+    ``problem.n_samples`` points.  Candidates are processed in chunks of at most
+    :data:`CHUNK_SAMPLES` (candidate, time) samples, each chunk one batched :func:`rnea` call.
+
+    Parameters
+    ----------
+    k
+        (...) shared ``k`` [rad/s^6], or (..., n) with ``per_joint=True``.
+
+    Returns
+    -------
+    (...) [N m].
+    """
+    k = np.asarray(k, dtype=float)
+    batch = k.shape[:-1] if per_joint else k.shape
+    flat = k.reshape((-1, problem.dof) if per_joint else (-1,))
+    t = problem.times()
+    step = max(1, CHUNK_SAMPLES // t.size)
+    out = np.empty(flat.shape[0])
+    for start in range(0, flat.shape[0], step):  # chunks of candidates, not samples
+        torque = base_torque_history(problem, flat[start : start + step], t, per_joint=per_joint)
+        out[start : start + step] = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
+    return out.reshape(batch)
+
+
+# -- constraints (eq. 33) ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One violated limit: joint number (1-based), which limit, the limit, the worst value
+    reached, by how much it is exceeded (same unit, > 0), and when [s].  Values in SI
+    (rad, rad/s, rad/s^2)."""
+
+    joint: int
+    kind: LimitKind
+    limit: float
+    value: float
+    excess: float
+    time: float
+
+    def describe(self) -> str:
+        unit = {"angle": "deg", "velocity": "deg/s", "acceleration": "deg/s^2"}[self.kind]
+        return (
+            f"joint {self.joint} {self.kind} reaches {math.degrees(self.value):.3f} {unit} at "
+            f"t = {self.time:.3f} s: limit {math.degrees(self.limit):.3f} {unit} exceeded by "
+            f"{math.degrees(self.excess):.3f} {unit} ({100 * self.excess / abs(self.limit):.1f} %)"
+        )
+
+
+def _limits(problem: HaltProblem) -> tuple[FloatArray, FloatArray]:
+    """(3, n) lower and upper limits for angle, velocity, acceleration."""
+    lo = np.stack([problem.q_min, -problem.dq_max, -problem.ddq_max])
+    hi = np.stack([problem.q_max, problem.dq_max, problem.ddq_max])
+    return lo, hi
+
+
+def _slack(lo: FloatArray, hi: FloatArray) -> FloatArray:
+    return LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1.0)
+
+
+def feasible_k_intervals(problem: HaltProblem) -> FloatArray:
+    """Exact feasible interval of ``k`` for every joint on the check grid.
+
+    Each limit at each time is affine in ``k`` (``g0(t) + k phi(t)``), so every joint's
+    feasible set is an interval; for a shared ``k`` (000) intersect them
+    (:func:`shared_k_interval`).
+
+    Returns
+    -------
+    (n, 2) ``[k_min, k_max]`` per joint [rad/s^6]; ``k_min > k_max`` (or NaN-free
+    ``+inf/-inf``) when empty.
+    """
+    t = problem.times(problem.n_check)
+    base = np.stack(problem.base_profile(t))  # (3, n_t, n)
+    shape = np.stack(problem.k_shape(t))[:, :, None]  # (3, n_t, 1)
+    lo, hi = _limits(problem)
+    sl = _slack(lo, hi)
+    lo_s, hi_s = (lo - sl)[:, None, :], (hi + sl)[:, None, :]
+    nz = np.abs(shape) > 0
+    safe = np.where(nz, shape, 1.0)
+    b1 = (lo[:, None, :] - base) / safe  # exact limits, so that k on a bound is within the slack
+    b2 = (hi[:, None, :] - base) / safe
+    kmin = np.where(nz, np.minimum(b1, b2), -np.inf)
+    kmax = np.where(nz, np.maximum(b1, b2), np.inf)
+    # where phi^(j)(t) = 0 the value does not depend on k: it must already be within limits
+    fixed_bad = (~nz) & ((base < lo_s) | (base > hi_s))
+    kmin = np.where(fixed_bad, np.inf, kmin)
+    kmax = np.where(fixed_bad, -np.inf, kmax)
+    return np.stack([kmin.max(axis=(0, 1)), kmax.min(axis=(0, 1))], axis=-1)
+
+
+def shared_k_interval(problem: HaltProblem) -> tuple[float, float]:
+    """Feasible interval of one shared ``k`` [rad/s^6]; empty when ``lo > hi``."""
+    per = feasible_k_intervals(problem)
+    return float(per[:, 0].max()), float(per[:, 1].min())
+
+
+def relative_violation(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
+    """Largest limit excess relative to its limit (0 when feasible), for a batch of ``k``:
+    (...) [-]; a number per candidate, max over joints, limits and the check grid."""
+    t = problem.times(problem.n_check)
+    lo, hi = _limits(problem)
+    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint), axis=-3)  # (..., 3, n_t, n)
+    scale = np.maximum(np.abs(lo), np.abs(hi))[:, None, :]
+    excess = np.maximum(traj - hi[:, None, :], lo[:, None, :] - traj) / scale
+    return np.maximum(excess.max(axis=(-3, -2, -1)), 0.0)
+
+
+def constraint_violations(
+    problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False
+) -> tuple[Violation, ...]:
+    """Every violated (joint, limit) pair for one ``k`` (scalar, or (n,) with
+    ``per_joint=True``), worst first; empty when the halt is within all limits (eq. 33)."""
+    t = problem.times(problem.n_check)
+    lo, hi = _limits(problem)
+    sl = _slack(lo, hi)
+    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint))  # (3, n_t, n)
+    over = traj - hi[:, None, :]
+    under = lo[:, None, :] - traj
+    out = []
+    for kind_i, kind in enumerate(("angle", "velocity", "acceleration")):
+        for j in range(problem.dof):
+            for arr, lim in ((over, hi), (under, lo)):
+                i_t = int(np.argmax(arr[kind_i, :, j]))
+                excess = float(arr[kind_i, i_t, j])
+                if excess > sl[kind_i, j]:
+                    out.append(
+                        Violation(
+                            joint=problem.model.joint_numbers[j],
+                            kind=kind,  # type: ignore[arg-type]
+                            limit=float(lim[kind_i, j]),
+                            value=float(traj[kind_i, i_t, j]),
+                            excess=excess,
+                            time=float(t[i_t]),
+                        )
+                    )
+    return tuple(sorted(out, key=lambda v: -v.excess / max(abs(v.limit), 1e-300)))
+
+
+def least_violating_k(problem: HaltProblem) -> float:
+    """Shared ``k`` [rad/s^6] minimising the largest relative limit excess (a convex,
+    piecewise-linear function of ``k``): dense scan, then bounded refinement."""
+    per = feasible_k_intervals(problem)
+    ends = per[np.isfinite(per)]
+    span = max(float(np.abs(ends).max()) if ends.size else 0.0, 1e-12)
+    grid = np.linspace(-2 * span, 2 * span, 801)
+    viol = np.concatenate([relative_violation(problem, grid[i : i + 100]) for i in range(0, grid.size, 100)])
+    i = int(np.argmin(viol))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    res = minimize_scalar(
+        lambda x: float(relative_violation(problem, x)),
+        bounds=(a, b),
+        method="bounded",
+        options={"xatol": 1e-12 * span + 1e-15},
+    )
+    return float(res.x) if res.fun <= viol[i] else float(grid[i])
+
+
+def minimum_halt_time(
+    problem: HaltProblem, *, t_min: float = 0.5, t_max: float | None = None, tol: float = 1e-3
+) -> float | None:
+    """Smallest halt time ``T`` [s] for which a feasible shared ``k`` exists.
+
+    Scans ``T`` on a grid of 0.25 s steps from ``t_min`` to ``t_max`` (default
+    ``max(10 T, 120 s)``), then bisects the first infeasible-to-feasible bracket to
+    ``tol`` [s].  Returns None when no ``T`` in the range is feasible.
+    """
+    t_max = max(10 * problem.T, 120.0) if t_max is None else t_max
+    grid = np.arange(t_min, t_max + 1e-9, 0.25)
+
+    def ok(T: float) -> bool:
+        lo, hi = shared_k_interval(problem.with_time(T))
+        return lo <= hi
+
+    prev = None
+    for T in grid:
+        if ok(float(T)):
+            if prev is None:
+                return float(T)
+            a, b = prev, float(T)
+            while b - a > tol:
+                mid = 0.5 * (a + b)
+                a, b = (a, mid) if ok(mid) else (mid, b)
+            return b
+        prev = float(T)
+    return None
+
+
+# -- the result and the solvers ------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class HaltMotion:
+    """Optimal halt motion (000 eq. 34) and how it was found.
+
+    Attributes
+    ----------
+    k
+        Optimal coefficient [rad/s^6]: a float (shared, 000) or (n,) per joint.  When the
+        problem is infeasible: the least-violating shared ``k``.
+    global_torque
+        ``tau_bar(k)`` [N m] (eq. 32).
+    global_torque_k0
+        ``tau_bar(0)`` [N m] (the plain quintic halt).
+    feasible
+        True when the halt at ``k`` respects every limit.
+    violations
+        Limits broken at ``k`` (empty when feasible); ``violations_k0`` at ``k = 0``.
+    k_interval
+        (2,) feasible interval of a shared ``k`` [rad/s^6] (``lo > hi``: empty).
+    joint_intervals
+        (n, 2) feasible interval of each joint's own ``k`` [rad/s^6].
+    minimum_T
+        Smallest halt time [s] with a feasible shared ``k`` (computed when infeasible or asked).
+    solver
+        ``"scan"``, ``"ga"`` or ``"vector"``.
+    settings
+        The solver's settings (grid size, GA settings, ...).
+    seed
+        Seed of a stochastic solver (GA), else None.
+    problem
+        The :class:`HaltProblem` solved.
+    ga
+        The GA run (solver ``"ga"``).
+    """
+
+    k: Any
+    global_torque: float
+    global_torque_k0: float
+    feasible: bool
+    violations: tuple[Violation, ...]
+    violations_k0: tuple[Violation, ...]
+    k_interval: FloatArray
+    joint_intervals: FloatArray
+    minimum_T: float | None
+    solver: str
+    settings: dict
+    seed: Any
+    problem: HaltProblem = field(repr=False)
+    ga: GAResult | None = field(default=None, repr=False)
+
+    @property
+    def reduction(self) -> float:
+        """Relative reduction of the global torque against ``k = 0`` [-] (000: 30.1 %)."""
+        return 1.0 - self.global_torque / self.global_torque_k0
+
+    @property
+    def per_joint(self) -> bool:
+        return np.ndim(self.k) == 1
+
+    def trajectory(self, t: ArrayLike | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """q, dq, ddq (n_t, n) of the optimal halt."""
+        return self.problem.trajectory(self.k, t, per_joint=self.per_joint)
+
+
+def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[float, FloatArray, FloatArray]:
+    grid = np.linspace(lo, hi, n_scan)
+    values = global_base_torque(problem, grid)
+    i = int(np.argmin(values))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, n_scan - 1)]
+    best = float(grid[i])
+    if b > a:
+        res = minimize_scalar(
+            lambda x: float(global_base_torque(problem, x)),
+            bounds=(a, b),
+            method="bounded",
+            options={"xatol": 1e-9 * max(abs(hi - lo), 1e-30)},
+        )
+        if res.fun < values[i]:
+            best = float(res.x)
+    return best, grid, values
+
+
+def optimal_halt_motion(
+    problem: HaltProblem,
+    *,
+    solver: Solver = "scan",
+    k_bounds: Sequence[float] | None = None,
+    n_scan: int = 401,
+    ga_settings: GASettings | None = None,
+    ga_precision: float | None = None,
+    rng: int | np.random.Generator | None = None,
+    on_infeasible: Literal["report", "raise"] = "report",
+    find_minimum_T: bool = False,
+    progress: Any = None,
+) -> HaltMotion:
+    """Solve 000's halt-motion model (eq. 34): ``min tau_bar(k)`` s.t. the limits of eq. 33.
+
+    Parameters
+    ----------
+    problem
+        The halt problem.
+    solver
+        ``"scan"``: exact for a shared ``k`` -- ``n_scan`` points over the feasible interval,
+        then bounded 1-D refinement (scipy ``minimize_scalar``) around the best point.
+        ``"ga"``: 000's adaptive GA (:func:`jointlock.planning.ga.adaptive_ga`) on the
+        feasible interval, fitness ``1 / tau_bar`` (eq. 35).  ``"vector"``: one ``k`` per
+        joint (extension), scipy ``minimize`` (Powell, bounded by each joint's feasible
+        interval) started from the shared-``k`` optimum.
+    k_bounds
+        ``(lo, hi)`` [rad/s^6] to intersect with the feasible interval (e.g. 000's
+        Fig. 8 range ``[0, 0.1]`` deg/s^6).  Default: the feasible interval itself.
+    n_scan
+        Grid points of the scan.
+    ga_settings, ga_precision
+        GA settings; ``ga_precision`` [rad/s^6] sets the bits per gene (default: 1/1000 of
+        the interval, 10 bits).
+    rng
+        Seed or generator for the GA (recorded in the result).
+    on_infeasible
+        ``"report"``: return a result with ``feasible=False``, the least-violating ``k``, the
+        violations and the smallest feasible ``T``; ``"raise"``: raise
+        :class:`~jointlock.errors.InfeasibleError` with the same information.
+    find_minimum_T
+        Also compute the smallest feasible halt time when the problem is feasible.
+
+    Returns
+    -------
+    HaltMotion
+    """
+    if solver not in ("scan", "ga", "vector"):
+        raise ScenarioError(f"solver must be 'scan', 'ga' or 'vector'; got {solver!r}")
+    per = feasible_k_intervals(problem)
+    lo, hi = float(per[:, 0].max()), float(per[:, 1].min())
+    if k_bounds is not None:
+        lo, hi = max(lo, float(k_bounds[0])), min(hi, float(k_bounds[1]))
+    tau0 = float(global_base_torque(problem, 0.0))
+    viol0 = constraint_violations(problem, 0.0)
+    settings: dict[str, Any] = {"n_scan": n_scan, "n_samples": problem.n_samples, "n_check": problem.n_check}
+    if not lo <= hi:
+        k = least_violating_k(problem)
+        viol = constraint_violations(problem, k)
+        t_min = minimum_halt_time(problem)
+        result = HaltMotion(
+            k=k,
+            global_torque=float(global_base_torque(problem, k)),
+            global_torque_k0=tau0,
+            feasible=False,
+            violations=viol,
+            violations_k0=viol0,
+            k_interval=np.array([lo, hi]),
+            joint_intervals=per,
+            minimum_T=t_min,
+            solver=solver,
+            settings=settings,
+            seed=None,
+            problem=problem,
+        )
+        msg = infeasibility_message(result)
+        log.info("infeasible halt: %s", msg.splitlines()[0])
+        if on_infeasible == "raise":
+            raise InfeasibleError(msg)
+        return result
+
+    ga_result = None
+    seed = None
+    if solver == "ga":
+        st = ga_settings or GASettings()
+        if ga_precision is not None and hi > lo:
+            st = replace(st, n_bits=bits_for_precision(lo, hi, ga_precision))
+        ga_result = adaptive_ga(
+            lambda x: 1.0 / global_base_torque(problem, x[:, 0]),
+            lo,
+            hi,
+            settings=st,
+            rng=rng,
+            progress=progress,
+        )
+        k: Any = float(ga_result.x[0])
+        seed = ga_result.seed
+        settings["ga"] = st
+    else:
+        k, _, _ = _scan(problem, lo, hi, n_scan)
+        if solver == "vector":
+            bounds = [(float(a), float(b)) for a, b in per]
+            x0 = np.clip(np.full(problem.dof, k), per[:, 0], per[:, 1])
+            scale = max(hi - lo, 1e-12)
+            res = minimize(
+                lambda x: float(global_base_torque(problem, x * scale, per_joint=True)),
+                x0 / scale,
+                method="Powell",
+                bounds=[(a / scale, b / scale) for a, b in bounds],
+                options={"xtol": 1e-6, "ftol": 1e-10},
+            )
+            kv = np.clip(res.x * scale, per[:, 0], per[:, 1])
+            k = (
+                kv
+                if global_base_torque(problem, kv, per_joint=True) <= global_base_torque(problem, k)
+                else np.full(problem.dof, k)
+            )
+            settings["scipy"] = {"method": "Powell", "nfev": int(res.nfev), "message": str(res.message)}
+    per_joint = np.ndim(k) == 1
+    tau = float(global_base_torque(problem, k, per_joint=per_joint))
+    viol = constraint_violations(problem, k, per_joint=per_joint)
+    return HaltMotion(
+        k=k,
+        global_torque=tau,
+        global_torque_k0=tau0,
+        feasible=not viol,
+        violations=viol,
+        violations_k0=viol0,
+        k_interval=np.array([lo, hi]),
+        joint_intervals=per,
+        minimum_T=minimum_halt_time(problem) if find_minimum_T else None,
+        solver=solver,
+        settings=settings,
+        seed=seed,
+        problem=problem,
+        ga=ga_result,
+    )
+
+
+def infeasibility_message(result: HaltMotion, *, k_unit: str = "deg/s^6") -> str:
+    """Plain-language verdict for an infeasible halt: which joint, which limit, by how much,
+    and the smallest halt time with a feasible ``k``."""
+    scale = K_UNIT_SCALE[k_unit]
+    p = result.problem
+    lines = [
+        f"no k satisfies the limits for a {p.T:g} s halt: every value of k breaks at least one limit.",
+        f"least-violating k = {np.asarray(result.k) / scale} {k_unit}; there:",
+    ]
+    lines += ["  " + v.describe() for v in result.violations[:6]]
+    if result.minimum_T is not None:
+        lines.append(f"smallest halt time with a feasible k: T = {result.minimum_T:.3f} s")
+    else:
+        lines.append("no halt time up to the search limit has a feasible k")
+    return "\n".join(lines)
