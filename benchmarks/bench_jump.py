@@ -1,0 +1,66 @@
+"""Benchmark: the full seed-001 pipeline on NOTES-001's default scenario.
+
+40 failure times, kappa probe + grid + refinement, kappa(t) fit, verification with the failure
+injected at every 50 ms step (and the fixed kappa(t) when the fit breaks a limit).  Target:
+under 10 s on one core.  Run with one BLAS thread for the one-core figure::
+
+    OMP_NUMBER_THREADS=1 OPENBLAS_NUM_THREADS=1 python benchmarks/bench_jump.py [ROBOT]
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+import jointlock as jl
+from jointlock.planning.jump import JumpScenario, study_jump
+
+
+def main(argv: list[str]) -> int:
+    robot = argv[1] if len(argv) > 1 else "canadarm7"
+    threads = {
+        k: os.environ.get(k, "unset") for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+    }
+    print(
+        f"python {platform.python_version()}, numpy {np.__version__}, cpu: {platform.processor() or platform.machine()}"
+    )
+    print(f"cores visible: {os.cpu_count()}, affinity: {len(os.sched_getaffinity(0))}, threads: {threads}")
+    try:
+        from threadpoolctl import threadpool_info
+
+        for info in threadpool_info():
+            print(f"  {info.get('internal_api')} {info.get('version')} threads={info.get('num_threads')}")
+    except ImportError:
+        pass
+    model = jl.load_robot(robot)
+    sc = JumpScenario()
+    times = []
+    for _ in range(3):
+        t0 = time.perf_counter()
+        st = study_jump(model, sc, n_samples=40)
+        times.append(time.perf_counter() - t0)
+    v = st.verification
+    print(
+        f"{robot}: full pipeline best of 3: {min(times):.2f} s (runs {', '.join(f'{t:.2f}' for t in times)})"
+    )
+    print("  stages [s]: " + ", ".join(f"{k} {val:.2f}" for k, val in st.elapsed.items()))
+    print(
+        f"  mean jump reduction {100 * v.mean_reduction:.1f} %, improved {100 * v.share_improved:.1f} % of "
+        f"{v.t.size} steps, limits kept {v.limits_ok}; kappa(t) order {st.fit.order}, SSR {st.fit.ssr:.3g}, "
+        f"segment points {st.fit.segment_points.tolist()}"
+    )
+    if st.verification_fixed is not None:
+        f = st.verification_fixed
+        print(
+            f"  with fix {f.fix}: reduction {100 * f.mean_reduction:.1f} %, improved {100 * f.share_improved:.1f} %, "
+            f"limits kept {f.limits_ok}"
+        )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,240 @@
+"""Seed 001 / NOTES-001: global compensation, jump metrics, kappa search, kappa(t), verification."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.cli import main as cli_main
+from jointlock.derivatives import jacobian_derivatives
+from jointlock.planning.jump import (
+    JumpScenario,
+    cartesian_trapezoid,
+    compensated_rates,
+    fit_kappa,
+    jump_table,
+    load_scenario,
+    ramp_schedule,
+    scenario_from_mapping,
+    search_kappa,
+    simulate,
+    verify_kappa,
+)
+
+#: Round-off level of products of 10 m Jacobians with rad/s rates [m/s].
+EXACT = 1e-10
+#: A shorter task keeps the tests fast (same law, same checks).
+SHORT = JumpScenario(duration=3.0, blend=0.75, dx=(0.1, -0.125, 0.07))
+
+
+@pytest.fixture(scope="module")
+def arm():
+    return jl.load_robot("canadarm7")
+
+
+def test_trapezoid_endpoints_and_continuity():
+    T, tb = 12.0, 2.0
+    t = np.linspace(0, T, 24001)
+    p = cartesian_trapezoid([1.0, 2.0, 3.0], [1.2, -1.5, 0.8], t, duration=T, blend=tb)
+    np.testing.assert_allclose(p.x[0], [1, 2, 3], atol=1e-15)
+    np.testing.assert_allclose(p.x[-1], [2.2, 0.5, 3.8], atol=1e-12)
+    assert p.sd[0] == 0 and abs(p.sd[-1]) < 1e-12
+    dt = t[1] - t[0]
+    assert np.max(np.abs(np.diff(p.s))) < 1.01 * dt / (T - tb)  # position continuous
+    assert np.max(np.abs(np.diff(p.sd))) < 1.01 * dt / (tb * (T - tb))  # velocity continuous
+    np.testing.assert_allclose(np.gradient(p.s, dt)[1:-1], p.sd[1:-1], atol=1e-3)  # sd is ds/dt
+    for knot in (tb, T - tb):  # both sides of the blend knots agree
+        lo = cartesian_trapezoid(0, [1, 0, 0], knot - 1e-9, duration=T, blend=tb)
+        hi = cartesian_trapezoid(0, [1, 0, 0], knot + 1e-9, duration=T, blend=tb)
+        assert abs(lo.s - hi.s) < 1e-8 and abs(lo.sd - hi.sd) < 1e-8
+
+
+def test_property1_null_space_never_moves_end_effector(arm, rng):
+    q = rng.uniform(-2, 2, (20, 7))
+    jac = jl.jacobian(arm, q)[:, :3]
+    djac = jacobian_derivatives(arm, q)[:, :, :3]
+    xd = rng.normal(size=(20, 3))
+    mask = np.ones((20, 7), bool)
+    mask[10:, 1] = False
+    for kappa in (0.0, 0.3, -2.0):
+        qd, _ = compensated_rates(jac, djac, xd, np.full(20, kappa), mask)
+        np.testing.assert_allclose(np.einsum("brc,bc->br", jac, qd), xd, atol=EXACT)
+    # the null-space term alone gives zero end-effector velocity
+    null, _ = compensated_rates(jac, djac, np.zeros(3), np.ones(20), mask)
+    np.testing.assert_allclose(np.einsum("brc,bc->br", jac, null), 0, atol=EXACT)
+    assert np.abs(null).max() > 1e-3  # and is not trivially zero
+
+
+def test_property2_kappa_zero_is_pseudoinverse(arm, rng):
+    q = rng.uniform(-2, 2, (5, 7))
+    jac = jl.jacobian(arm, q)[:, :3]
+    xd = rng.normal(size=(5, 3))
+    qd, _ = compensated_rates(jac, jacobian_derivatives(arm, q)[:, :, :3], xd, np.zeros(5))
+    np.testing.assert_allclose(qd, np.einsum("bij,bj->bi", np.linalg.pinv(jac), xd), atol=1e-10)
+
+
+def test_property3_locked_joint_rate_is_exactly_zero(arm):
+    tr = simulate(arm, SHORT, 0.004, failures=[(2, 1.0)])
+    k = SHORT.step_of(1.0)
+    assert np.all(tr.qd[k:, 1] == 0.0)
+    assert np.all(tr.q[k:, 1] == tr.q[k, 1])
+    assert np.any(tr.qd[:k, 1] != 0.0)
+
+
+def test_several_joints_lock_in_sequence(arm):
+    tr = simulate(arm, SHORT, 0.002, failures=[(2, 0.8), (5, 1.7)])
+    k1, k2 = SHORT.step_of(0.8), SHORT.step_of(1.7)
+    assert np.all(tr.qd[k1:, 1] == 0.0) and np.all(tr.qd[k2:, 4] == 0.0)
+    assert np.any(tr.qd[k1:k2, 4] != 0.0)
+    assert tr.limits.max_deviation < 5e-3  # still follows the path with 5 joints
+
+
+def test_property4_motion_before_failure_independent_of_failure_time(arm):
+    base = simulate(arm, SHORT, 0.003)
+    for tf in (0.5, 1.5, 2.5):
+        k = SHORT.step_of(tf)
+        tr = simulate(arm, SHORT, 0.003, failures=[(2, tf)])
+        np.testing.assert_array_equal(tr.q[: k + 1], base.q[: k + 1])
+        np.testing.assert_array_equal(tr.qd[:k], base.qd[:k])
+        # and the jump table (from the healthy run only) predicts the realised jump
+        table = jump_table(arm, SHORT, 0.003)
+        np.testing.assert_allclose(tr.qd[k] - base.qd[k], table.joint_jump[0, k], atol=1e-14)
+
+
+def test_property5_jump_affine_in_kappa_at_fixed_configuration(arm, rng):
+    q = rng.uniform(-2, 2, (4, 7))
+    jac = jl.jacobian(arm, q)[:, :3]
+    djac = jacobian_derivatives(arm, q)[:, :, :3]
+    xd = rng.normal(size=(4, 3))
+    mask = np.ones(7, bool)
+    mask[1] = False
+
+    def dq(k):
+        kk = np.full(4, k)
+        return compensated_rates(jac, djac, xd, kk, mask)[0] - compensated_rates(jac, djac, xd, kk)[0]
+
+    d0, d1, d2 = dq(0.0), dq(1.0), dq(2.5)
+    np.testing.assert_allclose(d2, d0 + 2.5 * (d1 - d0), atol=1e-10)
+
+
+def test_replanning_zero_task_jump_and_noreplan_value(arm):
+    table = jump_table(arm, SHORT, [0.0, 0.004])
+    assert table.task_jump_replan.max() < EXACT  # J_r keeps full row rank along the path
+    assert table.task_jump_noreplan[:, 10:-10].min() > 1e-4  # without re-planning it is not 0
+    np.testing.assert_allclose(
+        table.joint_jump_noreplan[:, 5:], np.abs(table.joint_jump[:, 5:, 1]), rtol=1e-12
+    )
+
+
+def test_batched_equals_looped(arm):
+    kappas = [0.0, 0.002, 0.005]
+    table = jump_table(arm, SHORT, kappas)
+    for i, k in enumerate(kappas):
+        single = jump_table(arm, SHORT, k)
+        np.testing.assert_allclose(table.joint_jump[i], single.joint_jump[0], atol=1e-13)
+        tr = simulate(arm, SHORT, k)
+        np.testing.assert_allclose(table.q[i], tr.q, atol=1e-13)
+
+
+def test_search_fit_verify_short(arm):
+    s = search_kappa(arm, SHORT, n_samples=8, n_grid=9, n_probe=21)
+    ok = np.isfinite(s.kappa_opt)
+    assert ok.all()
+    assert np.all(s.objective_opt <= s.objective_zero + 1e-15)  # 0 is in the grid
+    assert np.all((s.kappa_opt >= s.interval[:, 0]) & (s.kappa_opt <= s.interval[:, 1]))
+    # the optimum found beats every feasible grid value at each failure time
+    best_grid = np.where(s.feasible, s.objective, np.inf).min(axis=0)
+    assert np.all(s.objective_opt <= best_grid + 1e-15)
+    fit = fit_kappa(arm, s, order=3)
+    assert fit.order >= 3 and np.isfinite(fit.ssr)
+    v = verify_kappa(arm, None, fit, search=s)
+    assert v.jump_before.shape == (SHORT.n_steps,)
+    assert 0.0 <= v.share_improved <= 1.0
+    assert v.mean_reduction == pytest.approx(1 - v.jump_after.mean() / v.jump_before.mean())
+    # constant kappa = 0 "after" equals "before"
+    v0 = verify_kappa(arm, SHORT, 0.0)
+    np.testing.assert_array_equal(v0.jump_after, v0.jump_before)
+    assert v0.limits_ok == (v0.healthy_ok and v0.limits_ok_per_step.all())
+
+
+def test_verification_detects_limit_break_and_ramp_fix(arm):
+    """A schedule that drops abruptly breaks the acceleration limit; the ramp fix removes it."""
+    sc = SHORT
+    s = search_kappa(arm, sc, n_samples=4, n_grid=5, n_probe=11, refine_iter=0)
+    step = np.where(sc.times[:-1] < 1.5, 0.6 * s.probe_range[1], 0.0)
+    bad = verify_kappa(arm, sc, lambda t: np.interp(t, sc.times[:-1], step), search=s)
+    assert not bad.limits_ok and any("acceleration" in m for m in bad.limits.broken())
+    fixed = verify_kappa(arm, sc, lambda t: np.interp(t, sc.times[:-1], step), search=s, fix="ramp")
+    assert np.abs(np.diff(fixed.kappa)).max() <= sc.amax * sc.dt / (2 * s.null_max) + 1e-15
+    assert fixed.limits.max_acceleration < bad.limits.max_acceleration
+
+
+def test_ramp_schedule():
+    k = np.array([0, 0, 1, 1, 1, 0, 0, -1, -1], float)
+    r = ramp_schedule(k, 0.5)
+    assert np.abs(np.diff(r)).max() <= 0.5 + 1e-15
+    assert np.all(np.abs(r) <= np.abs(k) + 1e-15)
+
+
+def test_deterministic(arm):
+    a = search_kappa(arm, SHORT, n_samples=3, n_grid=5, n_probe=9, refine_iter=1)
+    b = search_kappa(arm, SHORT, n_samples=3, n_grid=5, n_probe=9, refine_iter=1)
+    np.testing.assert_array_equal(a.kappa_opt, b.kappa_opt)
+    np.testing.assert_array_equal(a.objective, b.objective)
+
+
+def test_scenario_file_and_errors(tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text("q0_deg = [0, 30, -60, 90, -60, 30, 0]\ndx_m = [0.5, 0, 0]\nduration_s = 6.0\nkp = 1.5\n")
+    sc = load_scenario(f)
+    assert sc.duration == 6.0 and sc.kp == 1.5 and sc.q0[1] == pytest.approx(math.radians(30))
+    assert sc == load_scenario(f)
+    with pytest.raises(jl.ScenarioError, match="did you mean 'duration_s'"):
+        scenario_from_mapping({"duraton_s": 3.0})
+    with pytest.raises(jl.ScenarioError, match="'kp' must be a number"):
+        scenario_from_mapping({"kp": "fast"})
+    with pytest.raises(jl.ScenarioError, match="list of 3 numbers"):
+        scenario_from_mapping({"dx_m": [1, 2]})
+    with pytest.raises(jl.ScenarioError, match="whole number"):
+        JumpScenario(duration=6.01, dt=0.05)
+    with pytest.raises(jl.ScenarioError, match="failure time"):
+        SHORT.step_of(5.0)
+
+
+def test_floating_base_runs(arm):
+    model = jl.load_robot("canadarm7", base="floating")
+    sc = JumpScenario(duration=1.0, blend=0.25, dx=(0.05, -0.05, 0.03), base="floating")
+    tr = simulate(model, sc, 0.002, failures=[(2, 0.5)])
+    assert np.all(tr.qd[10:, 1] == 0.0)
+    assert tr.limits.max_deviation < 1e-3
+    with pytest.raises(jl.ModelError, match="free-floating"):
+        simulate(arm, sc)
+
+
+def test_cli_fail_at_json(capsys, tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text("duration_s = 3.0\nblend_s = 0.75\ndx_m = [0.1, -0.125, 0.07]\n")
+    rc = cli_main(["jump", "halt7", "--scenario", str(f), "--fail-at", "1.5", "--json", "--quiet"])
+    assert rc == 0
+    out = json.loads(capsys.readouterr().out)
+    for key in ("kappa", "jump_before", "jump_after", "mean_reduction", "share_improved", "limits_ok"):
+        assert key in out
+    assert out["jump_after"] <= out["jump_before"]
+
+
+def test_cli_sweep_and_errors(capsys, tmp_path):
+    f = tmp_path / "s.toml"
+    f.write_text("duration_s = 3.0\nblend_s = 0.75\ndx_m = [0.1, -0.125, 0.07]\n")
+    rc = cli_main(
+        ["jump", "canadarm7", "--scenario", str(f), "--sweep", "6", "--order", "2", "--json", "--quiet"]
+    )
+    out = json.loads(capsys.readouterr().out)
+    assert rc == 0 and len(out["jump_before"]) == 60 and 0 <= out["share_improved"] <= 1
+    bad = tmp_path / "bad.toml"
+    bad.write_text("vmax_deg = 10\n")
+    assert cli_main(["jump", "canadarm7", "--scenario", str(bad)]) == 2
+    assert "did you mean 'vmax_deg_s'" in capsys.readouterr().err
