@@ -1,0 +1,143 @@
+"""``jointlock workspace``: Monte Carlo workspace of the full and the locked arm (002 Figs. 2-3)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+import numpy as np
+
+from ..analysis.workspace import compare_workspaces, projection_extent, sample_workspace
+from ..errors import ScenarioError
+from ..progress import Progress
+from ..robots import load_robot
+from ._common import add_robot_arguments, print_json
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "workspace",
+        help="Monte Carlo workspace, full arm vs locked arm: clouds, projections, volume, share kept",
+    )
+    add_robot_arguments(p)
+    p.add_argument("--samples", type=int, default=200_000, help="configurations per arm (default 200000)")
+    p.add_argument(
+        "--voxel", type=float, default=None, metavar="M", help="voxel side [m] (default: automatic)"
+    )
+    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--json", action="store_true", help="print one JSON object")
+    p.add_argument("--out", type=Path, metavar="DIR", help="write projections, clouds (NPZ) and summary here")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.samples < 1:
+        raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
+    if args.voxel is not None and not (args.voxel > 0):
+        raise ScenarioError(f"--voxel must be > 0 [m]; got {args.voxel}")
+    if len(args.lock) > 1:
+        raise ScenarioError(f"--lock may be given at most once; got {len(args.lock)}")
+    model = load_robot(args.robot, base=args.base)
+    with Progress(1, "workspace", enabled=None if not args.json else False) as bar:
+        if args.lock:
+            joint, angle = args.lock[0]
+            cmp = compare_workspaces(
+                model, joint, angle, samples=args.samples, voxel=args.voxel, rng=args.seed
+            )
+            full, locked, voxel = cmp.full, cmp.locked, cmp.voxel
+            summary = {
+                "robot": model.name,
+                "samples": args.samples,
+                "seed": args.seed,
+                "lock": {"joint": joint, "angle_deg": math.degrees(angle)},
+                "voxel_m": voxel,
+                "volume_full_m3": cmp.volume_full,
+                "volume_locked_m3": cmp.volume_locked,
+                "share_kept": cmp.share_kept,
+                "locked_voxels_outside_full": cmp.outside,
+                "extent_full_m": projection_extent(full),
+                "extent_locked_m": projection_extent(locked),
+            }
+        else:
+            ws = sample_workspace(model, samples=args.samples, voxel=args.voxel, rng=args.seed)
+            full, locked, voxel = ws.points, None, ws.voxel
+            summary = {
+                "robot": model.name,
+                "samples": args.samples,
+                "seed": args.seed,
+                "lock": None,
+                "voxel_m": voxel,
+                "volume_full_m3": ws.volume,
+                "extent_full_m": projection_extent(full),
+            }
+        bar.update()
+    if args.out is not None:
+        summary["files"] = _write(args.out, full, locked, summary)
+    if args.json:
+        print_json(summary)
+        return 0
+    print(f"{model.name}: {args.samples} samples per arm (seed {args.seed}), voxel {voxel:.4g} m")
+    print(f"  full arm volume   : {summary['volume_full_m3']:.4f} m^3")
+    if locked is not None:
+        lk = summary["lock"]
+        print(
+            f"  locked arm volume : {summary['volume_locked_m3']:.4f} m^3 (joint {lk['joint']} at {lk['angle_deg']:g} deg)"
+        )
+        print(f"  share kept        : {100 * summary['share_kept']:.2f} %")
+        print(
+            f"  locked voxels outside the full cloud (sampling): {100 * summary['locked_voxels_outside_full']:.2f} %"
+        )
+    for f in summary.get("files", []):
+        print(f"wrote {f}")
+    return 0
+
+
+def _write(out_dir: Path, full: np.ndarray, locked: np.ndarray | None, summary: dict) -> list[str]:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from ..report import atomic_write_json
+
+    out_dir.mkdir(parents=True, exist_ok=True)
+    files = []
+    show = 20000
+    f_pts = full[:show]
+    l_pts = None if locked is None else locked[:show]
+    fig, axes = plt.subplots(1, 3, figsize=(14, 4.5))
+    for ax, (i, j, name) in zip(axes, ((0, 1, "xy"), (0, 2, "xz"), (1, 2, "yz"))):
+        ax.scatter(f_pts[:, i], f_pts[:, j], s=0.3, alpha=0.3, label="full arm", color="tab:blue")
+        if l_pts is not None:
+            ax.scatter(l_pts[:, i], l_pts[:, j], s=0.3, alpha=0.3, label="locked arm", color="tab:red")
+        ax.set_xlabel(f"{name[0]} [m]")
+        ax.set_ylabel(f"{name[1]} [m]")
+        ax.set_aspect("equal")
+        ax.set_title(f"{name} projection")
+    axes[0].legend(markerscale=20)
+    fig.tight_layout()
+    fig.savefig(out_dir / "projections.png", dpi=110)
+    plt.close(fig)
+    files.append(str(out_dir / "projections.png"))
+    fig = plt.figure(figsize=(11, 5))
+    clouds = [("full arm", f_pts, "tab:blue")] + (
+        [("locked arm", l_pts, "tab:red")] if l_pts is not None else []
+    )
+    for k, (title, pts, color) in enumerate(clouds):
+        ax = fig.add_subplot(1, len(clouds), k + 1, projection="3d")
+        ax.scatter(pts[:5000, 0], pts[:5000, 1], pts[:5000, 2], s=0.5, alpha=0.4, color=color)
+        ax.set_title(title)
+        ax.set_xlabel("x [m]")
+        ax.set_ylabel("y [m]")
+        ax.set_zlabel("z [m]")
+    fig.tight_layout()
+    fig.savefig(out_dir / "clouds.png", dpi=110)
+    plt.close(fig)
+    files.append(str(out_dir / "clouds.png"))
+    arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
+    np.savez_compressed(out_dir / "points.npz", **arrays)
+    files.append(str(out_dir / "points.npz"))
+    atomic_write_json(out_dir / "workspace.json", summary)
+    files.append(str(out_dir / "workspace.json"))
+    return files

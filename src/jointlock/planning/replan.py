@@ -1,0 +1,516 @@
+"""Fault-tolerant re-planning of a non-redundant arm with one locked joint (seed 002).
+
+* :func:`gamma_sweep` -- 002 §"Fault-tolerant planning based on the inverse solution of
+  6-DOF manipulator", steps 1-4: rotate the target about the **tool x axis** by ``gamma``
+  (eq. 18, ``T' = T Rx(gamma)``; the printed (1, 1) element 0 is a typo for 1), solve the
+  full-arm closed-form IK for every ``gamma`` at once and follow one branch (Figs. 5-8).
+* :func:`absorbable_range` -- the range of lock angles of a joint that some ``gamma`` within
+  a tolerance can absorb (002: joint 2 "48 deg to 123 deg" over +-180 deg, "59.2 to 60.8 deg"
+  over +-2 deg).
+* :func:`gammas_for_lock` -- step 5: every ``gamma`` at which the full-arm IK puts the
+  locked joint exactly at its locked angle (bracketing on a grid, then vectorised
+  bisection), with the joint solution at each.
+* :func:`replan_line` -- step 6 and eqs. (19)-(20): a straight Cartesian line, each
+  waypoint rotated by the smallest admissible ``gamma`` and solved with the locked-arm
+  closed form; joint trajectories, poses and tracking errors.
+
+Everything is batched over ``gamma`` and over waypoints; SI units and radians.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..errors import ConfigurationError, ModelError
+from ..ik import Puma6Geometry, _as_poses, ik_closed_form, puma6_branches, puma6_geometry, wrap_angle
+from ..kinematics import ee_pose
+from ..model import ArmModel, FloatArray
+from ..spatial import invert, pose_error, rot_x, rotation_log
+
+#: Bisection steps when refining a gamma root (bracket 0.1 deg -> 1e-17 rad).
+ROOT_BISECTIONS = 56
+#: Default gamma grid step for bracketing roots [rad].
+DEFAULT_GAMMA_STEP = math.radians(0.1)
+
+
+def tool_x_rotation(target: ArrayLike, gamma: ArrayLike) -> FloatArray:
+    """002 eq. (18), corrected: ``T Rx(gamma)``.
+
+    Parameters
+    ----------
+    target
+        (..., 4, 4) poses [m].
+    gamma
+        (...) rotation about the tool x axis [rad]; broadcast against ``target``'s batch.
+
+    Returns
+    -------
+    (..., 4, 4) poses.  The printed (1, 1) element of eq. (18) is 0; it must be 1 (a
+    rotation), and only then does E4 -> E5 of 002 (roll + gamma) hold.
+    """
+    return np.asarray(target, dtype=float) @ rot_x(gamma)
+
+
+def _full_geometry(model: ArmModel) -> Puma6Geometry:
+    geom = puma6_geometry(model)
+    return Puma6Geometry(geom.a2, geom.d4, geom.d6, geom.tool, None)
+
+
+def _full_branches(geom: Puma6Geometry, poses: FloatArray) -> tuple[FloatArray, FloatArray]:
+    return puma6_branches(geom, poses @ invert(geom.tool))
+
+
+def _pick_branch(
+    geom: Puma6Geometry, target: FloatArray, q_ref: FloatArray | None, branch: int | None
+) -> int:
+    if branch is not None:
+        if not 0 <= branch < 8:
+            raise ConfigurationError(f"branch must be 0..7; got {branch}")
+        return int(branch)
+    if q_ref is None:
+        raise ConfigurationError("give q_ref (full-arm joint angles [rad]) or branch to choose the IK branch")
+    q0, valid = _full_branches(geom, target)
+    dist = np.where(valid, np.max(np.abs(wrap_angle(q0 - q_ref)), axis=-1), np.inf)
+    if not np.any(np.isfinite(dist)):
+        raise ConfigurationError("the target is out of reach of the full arm: no IK branch exists")
+    return int(np.argmin(dist))
+
+
+@dataclass(frozen=True)
+class GammaSweep:
+    """Full-arm IK along the gamma sweep.
+
+    Attributes
+    ----------
+    gammas
+        (G,) rotation about the tool x axis [rad].
+    q
+        (G, 6) joint angles on the followed branch [rad], unwrapped along ``gammas`` so that
+        each curve is continuous (value at the gamma nearest 0 within [-pi, pi)).
+    q_branches
+        (G, 8, 6) every branch [rad] in [-pi, pi) (NaN where it does not exist).
+    valid
+        (G,) the followed branch exists.
+    branch
+        Index of the followed branch (:func:`jointlock.ik.puma6_branches` order).
+    target
+        (4, 4) pose at ``gamma = 0`` [m].
+    """
+
+    gammas: FloatArray
+    q: FloatArray
+    q_branches: FloatArray
+    valid: FloatArray
+    branch: int
+    target: FloatArray
+
+
+def gamma_sweep(
+    model: ArmModel,
+    target: ArrayLike,
+    gammas: ArrayLike | None = None,
+    *,
+    q_ref: ArrayLike | None = None,
+    branch: int | None = None,
+) -> GammaSweep:
+    """Full-arm closed-form IK of ``T Rx(gamma)`` for every ``gamma`` (002 steps 1-4, Figs. 5-8).
+
+    Parameters
+    ----------
+    model
+        A ``puma6``-family arm (a locked one is accepted; its full arm is used).
+    target
+        (4, 4) desired pose [m] (002: FK of the desired joint angles).
+    gammas
+        (G,) [rad]; default ``[-pi, pi]`` in 0.1 deg steps.
+    q_ref
+        (6,) full-arm angles [rad] selecting the branch nearest to them at ``gamma = 0``
+        (002 follows the branch of its desired configuration).
+    branch
+        Or the branch index directly.
+    """
+    geom = _full_geometry(model)
+    t = _as_poses(target)
+    g = np.linspace(-math.pi, math.pi, 3601) if gammas is None else np.asarray(gammas, dtype=float).ravel()
+    b = _pick_branch(geom, t, None if q_ref is None else np.asarray(q_ref, dtype=float), branch)
+    q_all, valid_all = _full_branches(geom, tool_x_rotation(t, g))
+    q = q_all[:, b, :]
+    valid = valid_all[:, b]
+    q = _continuous(q, valid, g)
+    return GammaSweep(g, q, q_all, valid, b, t)
+
+
+def _continuous(q: FloatArray, valid: FloatArray, gammas: FloatArray) -> FloatArray:
+    out = np.full(q.shape, np.nan)
+    if not np.any(valid):
+        return out
+    idx = np.flatnonzero(valid)
+    seg = np.unwrap(q[idx], axis=0)
+    anchor = int(np.argmin(np.abs(gammas[idx])))
+    seg = seg - 2 * math.pi * np.round((seg[anchor] - wrap_angle(seg[anchor])) / (2 * math.pi))
+    out[idx] = seg
+    return out
+
+
+@dataclass(frozen=True)
+class LockRange:
+    """Lock angles of ``joint`` absorbable by some ``|gamma| <= gamma_limit``.
+
+    Attributes
+    ----------
+    joint
+        Joint number (1-based).
+    gamma_limit
+        [rad].
+    lower, upper
+        [rad]: min and max of the joint's angle over the sweep on the followed branch
+        (continuous curve, so every angle in between is hit).
+    gamma_at_lower, gamma_at_upper
+        [rad] where they are reached.
+    """
+
+    joint: int
+    gamma_limit: float
+    lower: float
+    upper: float
+    gamma_at_lower: float
+    gamma_at_upper: float
+
+
+def absorbable_range(sweep: GammaSweep, joint: int, gamma_limit: float = math.pi) -> LockRange:
+    """Range of lock angles of ``joint`` that the sweep absorbs within ``|gamma| <= gamma_limit``.
+
+    002: joint 2 of ``q = [5, 60, 35, 10, -120, 90] deg`` -> "48 deg to 123 deg" (+-180 deg)
+    and "59.2 deg to 60.8 deg" (+-2 deg).
+    """
+    if not 1 <= joint <= 6:
+        raise ConfigurationError(f"joint must be 1..6; got {joint}")
+    sel = (np.abs(sweep.gammas) <= gamma_limit + 1e-12) & sweep.valid
+    if not np.any(sel):
+        raise ConfigurationError(f"no valid sweep point with |gamma| <= {math.degrees(gamma_limit):g} deg")
+    vals = sweep.q[sel, joint - 1]
+    g = sweep.gammas[sel]
+    i_lo, i_hi = int(np.argmin(vals)), int(np.argmax(vals))
+    return LockRange(
+        joint, float(gamma_limit), float(vals[i_lo]), float(vals[i_hi]), float(g[i_lo]), float(g[i_hi])
+    )
+
+
+@dataclass(frozen=True)
+class GammaRoot:
+    """A gamma at which the full-arm IK puts the locked joint at its locked angle.
+
+    Attributes
+    ----------
+    gamma
+        [rad].
+    q_full
+        (6,) joint angles [rad]; entry ``joint - 1`` equals ``angle`` to bisection accuracy.
+    joint, angle
+        The locked joint (1-based) and its angle [rad].
+    branch
+        Full-arm IK branch followed.
+    """
+
+    gamma: float
+    q_full: FloatArray
+    joint: int
+    angle: float
+    branch: int
+
+
+def _locked_value(
+    geom: Puma6Geometry, poses: FloatArray, gammas: FloatArray, branch: int, joint: int
+) -> FloatArray:
+    q, valid = _full_branches(geom, tool_x_rotation(poses, gammas))
+    return np.where(valid[..., branch], q[..., branch, joint - 1], np.nan)
+
+
+def _bisect(geom, poses, lo, hi, f_lo, branch, joint, angle):
+    """Vectorised bisection of ``wrap(theta_j(gamma) - angle)`` on brackets (K,)."""
+    lo, hi, f_lo = lo.copy(), hi.copy(), f_lo.copy()
+    for _ in range(ROOT_BISECTIONS):  # bisection steps, every bracket at once
+        mid = 0.5 * (lo + hi)
+        f_mid = wrap_angle(_locked_value(geom, poses, mid, branch, joint) - angle)
+        left = np.sign(f_mid) == np.sign(f_lo)
+        lo = np.where(left, mid, lo)
+        f_lo = np.where(left, f_mid, f_lo)
+        hi = np.where(left, hi, mid)
+    return 0.5 * (lo + hi)
+
+
+def _brackets(f: FloatArray) -> FloatArray:
+    """(..., G-1) sign changes of ``f`` (..., G) that are not 2 pi wrap jumps."""
+    a, b = f[..., :-1], f[..., 1:]
+    ok = np.isfinite(a) & np.isfinite(b) & (np.abs(a) < math.pi / 2) & (np.abs(b) < math.pi / 2)
+    return ok & ((a == 0) | (np.sign(a) != np.sign(b)))
+
+
+def gammas_for_lock(
+    model: ArmModel,
+    target: ArrayLike,
+    joint: int,
+    angle: float,
+    *,
+    q_ref: ArrayLike | None = None,
+    branch: int | None = None,
+    gamma_limit: float = math.pi,
+    step: float = DEFAULT_GAMMA_STEP,
+) -> tuple[GammaRoot, ...]:
+    """Every ``gamma`` in ``[-gamma_limit, gamma_limit]`` at which the full-arm IK of
+    ``T Rx(gamma)`` (on the chosen branch) puts ``joint`` exactly at ``angle`` (002 step 5).
+
+    Parameters
+    ----------
+    model
+        ``puma6``-family arm.
+    target
+        (4, 4) desired pose [m].
+    joint, angle
+        Locked joint (1-based) and its angle [rad].
+    q_ref, branch
+        Branch selection, as in :func:`gamma_sweep`.
+    gamma_limit
+        Fault tolerance [rad].
+    step
+        Grid step used to bracket the roots [rad]; each bracket is then bisected to
+        machine precision.
+
+    Returns
+    -------
+    tuple of GammaRoot, smallest ``|gamma|`` first (empty when the lock cannot be absorbed).
+    """
+    if not 1 <= joint <= 6:
+        raise ConfigurationError(f"joint must be 1..6; got {joint}")
+    geom = _full_geometry(model)
+    t = _as_poses(target)
+    b = _pick_branch(geom, t, None if q_ref is None else np.asarray(q_ref, dtype=float), branch)
+    count = max(2, int(math.ceil(2 * gamma_limit / step)) + 1)
+    grid = np.linspace(-gamma_limit, gamma_limit, count)
+    f = wrap_angle(_locked_value(geom, t, grid, b, joint) - angle)
+    br = np.flatnonzero(_brackets(f))
+    if br.size == 0:
+        return ()
+    gam = _bisect(geom, t, grid[br], grid[br + 1], f[br], b, joint, angle)
+    gam = np.where(f[br] == 0, grid[br], gam)
+    q, _ = _full_branches(geom, tool_x_rotation(t, gam))
+    roots = [GammaRoot(float(g), q[k, b].copy(), joint, float(angle), b) for k, g in enumerate(gam)]
+    roots.sort(key=lambda r: abs(r.gamma))
+    unique: list[GammaRoot] = []
+    for r in roots:
+        if all(abs(r.gamma - u.gamma) > 1e-9 for u in unique):
+            unique.append(r)
+    return tuple(unique)
+
+
+# -- straight-line re-planning ---------------------------------------------------------------
+
+
+def line_waypoints(start: ArrayLike, goal: ArrayLike, steps: int) -> FloatArray:
+    """002 eqs. (19)-(20): ``steps`` interior points plus both ends, (steps + 2, 4, 4).
+
+    Positions are ``p_a + i (p_c - p_a) / (N + 1)``, ``i = 0..N+1``.  002 interpolates only
+    the position; the orientation here follows the geodesic (``R_a exp(s log(R_a^T R_c))``).
+    """
+    a, c = _as_poses(start, "start"), _as_poses(goal, "goal")
+    if steps < 0:
+        raise ConfigurationError(f"steps must be >= 0; got {steps}")
+    s = np.arange(steps + 2) / (steps + 1)
+    rel = rotation_log(a[:3, :3].T @ c[:3, :3])
+    from ..spatial import axis_angle_rotation
+
+    angle = np.linalg.norm(rel)
+    axis = rel / angle if angle > 0 else np.array([1.0, 0.0, 0.0])
+    rots = a[:3, :3] @ axis_angle_rotation(axis, s * angle)
+    out = np.zeros((s.size, 4, 4))
+    out[:, :3, :3] = rots
+    out[:, :3, 3] = a[:3, 3] + s[:, None] * (c[:3, 3] - a[:3, 3])
+    out[:, 3, 3] = 1.0
+    return out
+
+
+@dataclass(frozen=True)
+class ReplanResult:
+    """A straight Cartesian plan executed by the locked arm.
+
+    Attributes
+    ----------
+    times
+        (K,) [s], ``cycle`` apart (002: 250 ms).
+    q
+        (K, n) movable-joint angles [rad], continuous in time.
+    q_full
+        (K, 6) with the locked joint [rad].
+    dq
+        (K, n) joint rates [rad/s] (central differences).
+    gamma
+        (K,) rotation about the tool x axis chosen at each waypoint [rad].
+    absorbed
+        (K,) a gamma within the tolerance puts the full-arm IK exactly on the lock.
+    nominal
+        (K, 4, 4) the straight-line poses [m].
+    target
+        (K, 4, 4) ``nominal Rx(gamma)``: what the locked arm is asked to reach.
+    actual
+        (K, 4, 4) forward kinematics of ``q``.
+    position_error, rotation_error
+        (K,) actual vs target [m], [rad] (the tracking error).
+    position_deviation, rotation_deviation
+        (K,) actual vs nominal [m], [rad] (includes the accepted gamma).
+    ee_velocity
+        (K, 6) end-effector twist ``(v, omega)`` [m/s, rad/s], finite differences, root frame.
+    joint, lock_angle, gamma_tolerance, branch, cycle
+        The settings.
+    """
+
+    times: FloatArray
+    q: FloatArray
+    q_full: FloatArray
+    dq: FloatArray
+    gamma: FloatArray
+    absorbed: FloatArray
+    nominal: FloatArray
+    target: FloatArray
+    actual: FloatArray
+    position_error: FloatArray
+    rotation_error: FloatArray
+    position_deviation: FloatArray
+    rotation_deviation: FloatArray
+    ee_velocity: FloatArray
+    joint: int
+    lock_angle: float
+    gamma_tolerance: float
+    branch: int
+    cycle: float
+
+
+def replan_line(
+    model: ArmModel,
+    start: ArrayLike,
+    goal: ArrayLike,
+    *,
+    steps: int = 40,
+    cycle: float = 0.25,
+    gamma_tolerance: float = 0.0,
+    q_ref: ArrayLike | None = None,
+    branch: int | None = None,
+    gamma_step: float = math.radians(0.05),
+) -> ReplanResult:
+    """Straight-line Cartesian re-planning through the locked-arm closed-form IK (002 §§
+    "Fault-tolerant trajectory planning", eqs. 19-20, Figs. 10-21).
+
+    For every waypoint at once: the gamma grid in ``[-tol, tol]`` is searched for a root of
+    ``theta_j(gamma) = lock`` on the followed full-arm branch (bisected to machine
+    precision, smallest ``|gamma|`` kept); without a root the gamma minimising
+    ``|theta_j(gamma) - lock|`` is taken.  The waypoint ``nominal Rx(gamma)`` is then solved
+    with the locked arm's closed form (002 step 6), taking the branch nearest to the
+    full-arm solution; what it misses is the tracking error.
+
+    Parameters
+    ----------
+    model
+        A ``puma6``-family arm with exactly one locked joint.
+    start, goal
+        (4, 4) end poses [m].
+    steps
+        ``N`` interior points (eq. 19).
+    cycle
+        Time between waypoints [s].
+    gamma_tolerance
+        Largest ``|gamma|`` accepted [rad] (0: the line's orientation is kept).
+    q_ref, branch
+        Full-arm branch to follow (default: the branch nearest the locked arm's closed-form
+        solution of the goal, i.e. chosen by ``q_ref`` if given).
+    gamma_step
+        Grid step for bracketing [rad].
+    """
+    geom_locked = puma6_geometry(model)
+    if geom_locked.lock is None:
+        raise ModelError(f"replan_line needs a model with one locked joint; {model.name!r} has none")
+    if not (cycle > 0):
+        raise ConfigurationError(f"cycle must be > 0 [s]; got {cycle}")
+    if not (gamma_tolerance >= 0):
+        raise ConfigurationError(f"gamma_tolerance must be >= 0 [rad]; got {gamma_tolerance}")
+    joint, angle = geom_locked.lock
+    geom = Puma6Geometry(geom_locked.a2, geom_locked.d4, geom_locked.d6, geom_locked.tool, None)
+    nominal = line_waypoints(start, goal, steps)
+    k = nominal.shape[0]
+    goal_t = nominal[-1]
+    if branch is None and q_ref is None:
+        sol = ik_closed_form(model, goal_t)
+        i = int(np.nanargmin(np.where(sol.valid, sol.position_error + sol.rotation_error, np.inf)))
+        q_ref = sol.q_full[i]
+    b = _pick_branch(geom, goal_t, None if q_ref is None else np.asarray(q_ref, dtype=float), branch)
+
+    count = max(1, 2 * int(math.ceil(gamma_tolerance / gamma_step)) + 1) if gamma_tolerance > 0 else 1
+    grid = np.linspace(-gamma_tolerance, gamma_tolerance, count)
+    f = wrap_angle(_locked_value(geom, nominal[:, None], grid[None, :], b, joint) - angle)  # (K, G)
+    gamma = grid[np.argmin(np.where(np.isfinite(f), np.abs(f), np.inf), axis=1)]
+    absorbed = np.zeros(k, dtype=bool)
+    if count > 1:
+        brk = _brackets(f)  # (K, G-1)
+        mid = 0.5 * (grid[:-1] + grid[1:])
+        score = np.where(brk, np.abs(mid), np.inf)
+        j = np.argmin(score, axis=1)
+        has = np.isfinite(score[np.arange(k), j])
+        if np.any(has):
+            rows = np.flatnonzero(has)
+            g_root = _bisect(
+                geom, nominal[rows], grid[j[rows]], grid[j[rows] + 1], f[rows, j[rows]], b, joint, angle
+            )
+            gamma[rows] = g_root
+            absorbed[rows] = True
+    absorbed |= np.abs(wrap_angle(_locked_value(geom, nominal, gamma, b, joint) - angle)) < 1e-9
+
+    target = tool_x_rotation(nominal, gamma)
+    full_q, full_valid = _full_branches(geom, target)
+    ref = full_q[:, b, :]
+    locked = ik_closed_form(model, target)  # (K, 4)
+    dist = np.max(np.abs(wrap_angle(locked.q_full - ref[:, None, :])), axis=-1)
+    cost = np.where(locked.valid, locked.position_error + locked.rotation_error, np.inf)
+    # prefer the branch on the followed full-arm solution; else the most accurate one
+    choice = np.where(
+        full_valid[:, b], np.argmin(np.where(locked.valid, dist, np.inf), axis=1), np.argmin(cost, 1)
+    )
+    q = locked.q[np.arange(k), choice]
+    q = np.unwrap(q, axis=0)
+    q_full = model.expand(q)
+    actual = ee_pose(model, q)
+    perr, rerr = pose_error(target, actual)
+    pdev, rdev = pose_error(nominal, actual)
+    times = np.arange(k) * cycle
+    dq = np.gradient(q, cycle, axis=0) if k > 1 else np.zeros_like(q)
+    if k > 1:
+        v = np.gradient(actual[:, :3, 3], cycle, axis=0)
+        rel = rotation_log(actual[1:, :3, :3] @ np.swapaxes(actual[:-1, :3, :3], -1, -2)) / cycle
+        w = np.empty((k, 3))
+        w[0], w[-1] = rel[0], rel[-1]
+        w[1:-1] = 0.5 * (rel[:-1] + rel[1:])
+        vel = np.concatenate([v, w], axis=1)
+    else:
+        vel = np.zeros((k, 6))
+    return ReplanResult(
+        times,
+        q,
+        q_full,
+        dq,
+        gamma,
+        absorbed,
+        nominal,
+        target,
+        actual,
+        perr,
+        rerr,
+        pdev,
+        rdev,
+        vel,
+        joint,
+        float(angle),
+        float(gamma_tolerance),
+        b,
+        float(cycle),
+    )
