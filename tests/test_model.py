@@ -81,3 +81,10 @@ def test_models_are_immutable():
         model.tool[0, 3] = 1.0
     with pytest.raises(ValueError):
         model.bodies[0].inertia[0, 0] = 1.0
+
+
+def test_every_public_name_resolves():
+    for name in jl.__all__ + sorted(jl._LAZY):
+        assert getattr(jl, name) is not None, name
+    with pytest.raises(AttributeError):
+        jl.no_such_function  # noqa: B018
