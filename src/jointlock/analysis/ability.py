@@ -154,11 +154,50 @@ def scale_linear_rows(jac: ArrayLike, characteristic_length: float) -> FloatArra
     return out
 
 
+#: Above this condition number :func:`singular_values` with ``method="auto"`` falls back to
+#: the SVD: the Gram route's relative error on ``sigma_i`` is ~ eps * kappa_i^2 / 2, i.e.
+#: below 1.2e-8 up to here.
+GRAM_CONDITION_LIMIT = 1e4
+
+
+def singular_values(jac: ArrayLike, *, method: Literal["svd", "gram", "auto"] = "svd") -> FloatArray:
+    """Singular values of a batch of matrices, descending.
+
+    Parameters
+    ----------
+    jac
+        (..., m, k) matrices.
+    method
+        ``"svd"``: LAPACK's batched SVD, exact to round-off.  ``"gram"``: square roots of the
+        eigenvalues of the smaller Gram matrix (about twice as fast on 6 x 6 batches; relative
+        error ~ eps * kappa_i^2 / 2 on ``sigma_i``).  ``"auto"``: ``"gram"`` with the SVD redone
+        for the matrices whose condition number exceeds :data:`GRAM_CONDITION_LIMIT`, so the
+        relative error stays below ~1.2e-8 for every matrix.
+
+    Returns
+    -------
+    (..., min(m, k)) singular values.
+    """
+    arr = np.asarray(jac, dtype=float)
+    if method == "svd":
+        return np.linalg.svd(arr, compute_uv=False)
+    if method not in ("gram", "auto"):
+        raise ConfigurationError(f"method must be 'svd', 'gram' or 'auto'; got {method!r}")
+    jt = np.swapaxes(arr, -1, -2)
+    gram = jt @ arr if arr.shape[-1] <= arr.shape[-2] else arr @ jt
+    sv = np.sqrt(np.clip(np.linalg.eigvalsh(gram), 0.0, None))[..., ::-1]
+    if method == "auto":
+        bad = sv[..., -1] * GRAM_CONDITION_LIMIT < sv[..., 0]
+        if np.any(bad):
+            sv[bad] = np.linalg.svd(arr[bad], compute_uv=False)
+    return sv
+
+
 def kinematic_indices(
     jac: ArrayLike,
     *,
     characteristic_length: float | None = None,
-    method: Literal["svd", "gram"] = "svd",
+    method: Literal["svd", "gram", "auto"] = "svd",
 ) -> KinematicIndices:
     """Minimum singular value, condition number and manipulability (000 Table 3, eqs. 6-7).
 
@@ -177,6 +216,8 @@ def kinematic_indices(
         ``J J^T``), about 1.5x faster on 6 x 6 batches; absolute error of ``sigma_min`` about
         ``eps sigma_max^2 / sigma_min`` (1e-8 at ``sigma_min = 1e-6``, ``sigma_max = 10``),
         harmless for ranking samples.  Negative round-off eigenvalues are clipped to 0.
+        ``"auto"``: ``"gram"``, with the SVD redone where the condition number exceeds
+        :data:`GRAM_CONDITION_LIMIT` (see :func:`singular_values`).
 
     Returns
     -------
@@ -191,14 +232,7 @@ def kinematic_indices(
         raise ConfigurationError("jacobian must be finite; got NaN or inf entries")
     if characteristic_length is not None:
         arr = scale_linear_rows(arr, characteristic_length)
-    if method == "svd":
-        sv = np.linalg.svd(arr, compute_uv=False)  # (..., min(m, k)), descending
-    elif method == "gram":
-        jt = np.swapaxes(arr, -1, -2)
-        gram = jt @ arr if arr.shape[-1] <= arr.shape[-2] else arr @ jt
-        sv = np.sqrt(np.clip(np.linalg.eigvalsh(gram), 0.0, None))[..., ::-1]
-    else:
-        raise ConfigurationError(f"method must be 'svd' or 'gram'; got {method!r}")
+    sv = singular_values(arr, method=method)
     smax = sv[..., 0]
     smin = sv[..., -1]
     positive = smin > 0
