@@ -86,7 +86,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import ConfigurationError, ModelError
-from .kinematics import chain_state, ee_pose, jacobian
+from .kinematics import ChainState, chain_state, ee_pose, jacobian
 from .model import ArmModel, FloatArray
 from .spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, rotation_log
 
@@ -667,15 +667,8 @@ def ik_numeric(
     return NumericIK(q, gamma, dp, dr, exact, it)
 
 
-def _select_state(mask: FloatArray, a, b):
-    m3 = mask[..., None]
-    return type(a)(
-        np.where(m3[..., None, None], a.rotations, b.rotations),
-        np.where(m3[..., None], a.positions, b.positions),
-        np.where(m3[..., None], a.axes, b.axes),
-        np.where(m3[..., None], a.ee_rotation, b.ee_rotation),
-        np.where(m3, a.ee_position, b.ee_position),
-    )
+def _select_state(mask: FloatArray, a: ChainState, b: ChainState) -> ChainState:
+    return ChainState.select(mask, a, b)
 
 
 # -- one target, every solution ------------------------------------------------------------

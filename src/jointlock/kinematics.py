@@ -15,6 +15,7 @@ angular velocity [rad/s].
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Literal
 
 import numpy as np
@@ -28,6 +29,11 @@ from .spatial import pose, skew
 class ChainState:
     """Frames of a chain for a batch of configurations (all in the root frame).
 
+    The frames are computed and stored with the batch as the *last* axis ("structure of
+    arrays": every arithmetic step runs over one contiguous vector per matrix entry, which
+    is several times faster than small-matrix products per sample).  The attributes below
+    give them in the usual batch-first layout (computed once, on first access).
+
     Attributes
     ----------
     rotations
@@ -40,11 +46,55 @@ class ChainState:
         (..., 3, 3) and (..., 3) [m]: the end-effector frame.
     """
 
-    rotations: FloatArray
-    positions: FloatArray
-    axes: FloatArray
-    ee_rotation: FloatArray
-    ee_position: FloatArray
+    batch_shape: tuple[int, ...]
+    soa_rotations: FloatArray  # (n, 3, 3, N)
+    soa_positions: FloatArray  # (n, 3, N)
+    soa_axes: FloatArray  # (n, 3, N)
+    soa_ee_rotation: FloatArray  # (3, 3, N)
+    soa_ee_position: FloatArray  # (3, N)
+
+    def _batch_first(self, soa: FloatArray) -> FloatArray:
+        return np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(self.batch_shape + soa.shape[:-1])
+
+    @cached_property
+    def rotations(self) -> FloatArray:
+        return self._batch_first(self.soa_rotations)
+
+    @cached_property
+    def positions(self) -> FloatArray:
+        return self._batch_first(self.soa_positions)
+
+    @cached_property
+    def axes(self) -> FloatArray:
+        return self._batch_first(self.soa_axes)
+
+    @cached_property
+    def ee_rotation(self) -> FloatArray:
+        return self._batch_first(self.soa_ee_rotation)
+
+    @cached_property
+    def ee_position(self) -> FloatArray:
+        return self._batch_first(self.soa_ee_position)
+
+    @staticmethod
+    def select(mask: ArrayLike, a: ChainState, b: ChainState) -> ChainState:
+        """Per-sample choice: ``a`` where ``mask`` (batch shape) is true, else ``b``."""
+        m = np.asarray(mask, dtype=bool).reshape(-1)
+        return ChainState(
+            a.batch_shape,
+            *(
+                np.where(m, x, y)
+                for x, y in zip(
+                    (a.soa_rotations, a.soa_positions, a.soa_axes, a.soa_ee_rotation, a.soa_ee_position),
+                    (b.soa_rotations, b.soa_positions, b.soa_axes, b.soa_ee_rotation, b.soa_ee_position),
+                )
+            ),
+        )
+
+
+def _rotate_soa(matrix: FloatArray, soa: FloatArray) -> FloatArray:
+    """``soa[r, j, N] @ matrix[j, k]`` for every sample: (3, 3, N) -> (3, 3, N)."""
+    return np.matmul(matrix.T, soa)
 
 
 def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
@@ -59,46 +109,47 @@ def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
 
     Notes
     -----
-    With ``K`` the cross-product matrix of the joint axis, Rodrigues' formula gives the local
-    rotation ``P (I + sin q K + (1 - cos q) K^2)``.  The three constant products ``P``, ``P K``,
-    ``P K^2`` are multiplied into the parent rotation in one matrix product per joint, and
-    the joint angle only scales the results: the batch is never looped over.
+    Frame ``i`` is ``R_{i-1} P_i Rot(axis_i, q_i)``.  For a joint about ``z`` the rotation
+    only mixes the first two columns of ``A = R_{i-1} P_i``; for any other axis Rodrigues'
+    formula ``A (I + sin q K + (1 - cos q) K^2)`` is used.  No loop over samples.
     """
     q = as_joint_array(model, q)
     n = model.dof
     batch = q.shape[:-1]
-    flat = q.reshape(-1, n)
-    count = flat.shape[0]
-    sin, one_minus_cos = np.sin(flat), 1.0 - np.cos(flat)
-    rotations = np.empty((count, n, 3, 3))
-    positions = np.empty((count, n, 3))
-    axes = np.empty((count, n, 3))
-    rot = np.broadcast_to(np.eye(3), (count, 3, 3))
-    pos = np.zeros((count, 3))
+    flat = q.reshape(-1, n).T  # (n, N)
+    count = flat.shape[1]
+    cos, sin = np.cos(flat), np.sin(flat)
+    rotations = np.empty((n, 3, 3, count))
+    positions = np.empty((n, 3, count))
+    axes = np.empty((n, 3, count))
+    rot: FloatArray | None = None
+    pos: FloatArray | None = None
     for i, joint in enumerate(model.joints):
         place_rot, place_pos = joint.placement[:3, :3], joint.placement[:3, 3]
-        k = skew(joint.axis)
-        stacked = np.concatenate([place_rot, place_rot @ k, place_rot @ k @ k], axis=1)  # (3, 9)
-        pos = pos + rot @ place_pos
-        prod = (rot.reshape(-1, 3) @ stacked).reshape(count, 3, 3, 3)  # [R P, R P K, R P K^2]
-        rot = (
-            prod[:, :, 0]
-            + sin[:, i, None, None] * prod[:, :, 1]
-            + one_minus_cos[:, i, None, None] * prod[:, :, 2]
-        )
-        rotations[:, i] = rot
-        positions[:, i] = pos
-        axes[:, i] = rot @ joint.axis
+        if rot is None:
+            a = np.broadcast_to(place_rot[:, :, None], (3, 3, count))
+            positions[i] = place_pos[:, None]
+        else:
+            a = _rotate_soa(place_rot, rot)
+            positions[i] = pos + np.einsum("rjN,j->rN", rot, place_pos)
+        out = rotations[i]
+        axis = joint.axis
+        if axis[0] == 0.0 and axis[1] == 0.0 and axis[2] > 0:  # about +z: the DH case
+            np.multiply(a[:, 0], cos[i], out=out[:, 0])
+            out[:, 0] += a[:, 1] * sin[i]
+            np.multiply(a[:, 1], cos[i], out=out[:, 1])
+            out[:, 1] -= a[:, 0] * sin[i]
+            out[:, 2] = a[:, 2]
+            axes[i] = a[:, 2]
+        else:
+            k = skew(axis)
+            out[...] = a + sin[i] * _rotate_soa(k, a) + (1.0 - cos[i]) * _rotate_soa(k @ k, a)
+            axes[i] = np.einsum("rjN,j->rN", out, axis)
+        rot, pos = rotations[i], positions[i]
     tool = model.tool
-    ee_rot = rot @ tool[:3, :3]
-    ee_pos = pos + rot @ tool[:3, 3]
-    return ChainState(
-        rotations.reshape(batch + (n, 3, 3)),
-        positions.reshape(batch + (n, 3)),
-        axes.reshape(batch + (n, 3)),
-        ee_rot.reshape(batch + (3, 3)),
-        ee_pos.reshape(batch + (3,)),
-    )
+    ee_rot = _rotate_soa(tool[:3, :3], rot)
+    ee_pos = pos + np.einsum("rjN,j->rN", rot, tool[:3, 3])
+    return ChainState(batch, rotations, positions, axes, ee_rot, ee_pos)
 
 
 def link_poses(model: ArmModel, q: ArrayLike) -> FloatArray:
@@ -158,7 +209,14 @@ def jacobian(
     ``(z_i x (p_e - p_i), z_i)``.
     """
     s = chain_state(model, q) if state is None else state
-    jac = _point_jacobian(s, s.ee_position)
+    z, p, pe = s.soa_axes, s.soa_positions, s.soa_ee_position
+    d = pe[None] - p  # (n, 3, N)
+    soa = np.empty((6, model.dof, pe.shape[-1]))
+    soa[0] = z[:, 1] * d[:, 2] - z[:, 2] * d[:, 1]
+    soa[1] = z[:, 2] * d[:, 0] - z[:, 0] * d[:, 2]
+    soa[2] = z[:, 0] * d[:, 1] - z[:, 1] * d[:, 0]
+    soa[3:] = np.swapaxes(z, 0, 1)
+    jac = np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(s.batch_shape + (6, model.dof))
     if frame == "ee":
         jac = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jac)
     elif frame != "base":
