@@ -1,6 +1,7 @@
 """Benchmark: the full seed-001 pipeline on NOTES-001's default scenario.
 
-40 failure times, kappa probe + grid + refinement, kappa(t) fit, verification with the failure
+40 failure times, kappa probe + grid + multi-start refinement, piecewise kappa(t) fit (with the
+failure times added around its breaks), verification with the failure
 injected at every 50 ms step (and the fixed kappa(t) when the fit breaks a limit).  Target:
 under 10 s on one core.  Run with one BLAS thread for the one-core figure::
 
@@ -53,6 +54,14 @@ def main(argv: list[str]) -> int:
         f"{v.t.size} steps, limits kept {v.limits_ok}; kappa(t) order {st.fit.order}, SSR {st.fit.ssr:.3g}, "
         f"segment points {st.fit.segment_points.tolist()}"
     )
+    f = st.fit
+    print(
+        f"  breaks {f.breaks.tolist()}, segments {list(f.segments)}, {st.search.fail_times.size} failure times searched"
+    )
+    for pc in f.pieces or ():
+        print(
+            f"  piece {pc.start:.3g}..{pc.end:.3g} s: order {pc.order}, {pc.n_samples} samples, {pc.source}"
+        )
     if st.verification_fixed is not None:
         f = st.verification_fixed
         print(

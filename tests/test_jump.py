@@ -15,7 +15,9 @@ from jointlock.planning.jump import (
     JumpScenario,
     cartesian_trapezoid,
     compensated_rates,
+    find_breaks,
     fit_kappa,
+    fit_pieces,
     jump_table,
     load_scenario,
     ramp_schedule,
@@ -238,3 +240,53 @@ def test_cli_sweep_and_errors(capsys, tmp_path):
     bad.write_text("vmax_deg = 10\n")
     assert cli_main(["jump", "canadarm7", "--scenario", str(bad)]) == 2
     assert "did you mean 'vmax_deg_s'" in capsys.readouterr().err
+
+
+def test_piecewise_fit_follows_a_step_single_polynomial_cannot():
+    """A kappa(t) with a branch switch (like halt7's at 8.5 s): one piece per branch."""
+    t = np.arange(1, 41) * 12.0 / 41
+    k = np.where(t < 8.4, 1e-4 + 1.5e-5 * t, -4.26e-3)
+    cuts = find_breaks(k, 8.8e-3)
+    assert cuts.tolist() == [int(np.flatnonzero(t < 8.4)[-1])]
+    pieces = fit_pieces(t, k, cuts, order=5, span=(0.0, 12.0))
+    assert len(pieces) == 2 and pieces[0].start == 0.0 and pieces[1].end == 12.0
+    assert t[cuts[0]] < pieces[0].end == pieces[1].start < t[cuts[0] + 1]
+    fitted = np.where(t < pieces[1].start, pieces[0].polynomial(t), pieces[1].polynomial(t))
+    assert np.abs(fitted - k).max() < 1e-9
+    single = np.polynomial.polynomial.polyval(t / 12, np.polynomial.polynomial.polyfit(t / 12, k, 5))
+    assert np.abs(single - k).max() > 5e-4  # the old single polynomial misses both branches
+    assert find_breaks(1e-3 * np.sin(t / 4), 8.8e-3).size == 0  # smooth: no break
+
+
+@pytest.fixture(scope="module")
+def halt7_search():
+    """halt7, default scenario, with the single-start search: its optimum steps from about
+    +2e-4 to the band edge -4.3e-3 at 8.5 s (a search artefact, but a real step to fit)."""
+    return jl.load_robot("halt7"), search_kappa(jl.load_robot("halt7"), JumpScenario(), n_starts=1)
+
+
+def test_halt7_step_piecewise_fit_beats_single_polynomial(halt7_search):
+    model, s = halt7_search
+    assert s.kappa_opt[s.fail_times < 8.3].max() < 5e-4 and s.kappa_opt[s.fail_times > 8.4][0] < -4e-3
+    single = fit_kappa(model, s, piecewise=False)
+    v_single = verify_kappa(model, None, single, search=s)
+    assert v_single.mean_reduction < 0  # the old behaviour: jumps made worse
+    fit = fit_kappa(model, s)
+    assert fit.breaks.size >= 1 and 8.2 < fit.breaks[0] < 8.5
+    assert fit.search is not None and fit.search.fail_times.size > s.fail_times.size
+    assert np.all(np.diff(fit.search.fail_steps) > 0)
+    assert len(fit.segments) == fit.breaks.size + 1 and len(fit.pieces) >= 1
+    v = verify_kappa(model, None, fit, search=fit.search)
+    assert v.mean_reduction > 0.5 and v.share_improved > 0.8
+    assert v.mean_reduction == pytest.approx(1 - v.jump_after.mean() / v.jump_before.mean())
+    fixed = verify_kappa(model, None, fit, search=fit.search, fix="clip+ramp")
+    assert fixed.limits_ok and fixed.mean_reduction > 0.5  # limits still checked and reported
+
+
+def test_multistart_search_finds_narrow_valley(halt7_search):
+    model, s = halt7_search
+    i = int(np.argmin(np.abs(s.fail_times - 8.5)))
+    multi = search_kappa(model, JumpScenario(), [s.fail_times[i]])
+    assert 0 < multi.kappa_opt[0] < 5e-4
+    assert multi.objective_opt[0] < 0.3 * s.objective_opt[i]
+    assert multi.interval[0, 0] <= multi.kappa_opt[0] <= multi.interval[0, 1]

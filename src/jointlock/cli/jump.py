@@ -54,6 +54,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     how.add_argument("--optimize", action="store_true", help="search the optimal kappa (default)")
     p.add_argument("--order", type=int, default=5, help="polynomial order of kappa(t) (default 5)")
     p.add_argument(
+        "--single",
+        action="store_true",
+        help="one polynomial for kappa(t) (001's form) instead of a piece per branch of the optimum",
+    )
+    p.add_argument(
         "--fix",
         choices=("auto", "clip", "ramp", "clip+ramp", "none"),
         default="auto",
@@ -131,7 +136,13 @@ def run(args: argparse.Namespace) -> int:
             result = _constant_json(model.name, sc, args.kappa, ver)
         else:
             study = study_jump(
-                model, sc, n_samples=n, order=args.order, fix=fix, progress_factory=bar if show else None
+                model,
+                sc,
+                n_samples=n,
+                order=args.order,
+                fix=fix,
+                fit_options={"piecewise": not args.single},
+                progress_factory=bar if show else None,
             )
             result = _study_json(model.name, sc, study)
             ver = study.verification
@@ -193,6 +204,23 @@ def _study_json(robot: str, sc: JumpScenario, st: JumpStudy) -> dict:
             "threshold": f.threshold,
             "accepted": f.accepted,
             "segment_points_s": f.segment_points,
+            "breaks_s": f.breaks,
+            "segments": [{"start_s": a, "end_s": b, "decision": d} for a, b, d in f.segments],
+            "pieces": [
+                {
+                    "start_s": pc.start,
+                    "end_s": pc.end,
+                    "order": pc.order,
+                    "coefficients_u": pc.coefficients,
+                    "u": f"(t - {pc.center:.6g}) / {pc.half_width:.6g}",
+                    "ssr": pc.ssr,
+                    "threshold": pc.threshold,
+                    "accepted": pc.accepted,
+                    "n_samples": pc.n_samples,
+                    "source": pc.source,
+                }
+                for pc in (f.pieces or ())
+            ],
         },
         "verification_t_s": v.t,
         "jump_before": v.jump_before,
@@ -262,6 +290,17 @@ def _print_text(r: dict) -> None:
             f"kappa(t): order {f['order']}, SSR {f['ssr']:.3g} (threshold {f['threshold']:.3g}, "
             f"accepted {f['accepted']}), segment points {t1:.3g} s, {t2:.3g} s"
         )
+        if len(f.get("breaks_s", [])):
+            print(
+                f"  optimal kappa jumps at {', '.join(f'{b:.3g}' for b in f['breaks_s'])} s (piecewise fit)"
+            )
+        for seg in f.get("segments", []):
+            print(f"  segment {seg['start_s']:.3g}..{seg['end_s']:.3g} s: {seg['decision']}")
+        for pc in f.get("pieces", []):
+            print(
+                f"  piece {pc['start_s']:.3g}..{pc['end_s']:.3g} s: order {pc['order']}, {pc['n_samples']} samples, "
+                f"SSR {pc['ssr']:.3g} (threshold {pc['threshold']:.3g}), {pc['source']}"
+            )
     for key in ("verification", "verification_fixed"):
         if key not in r:
             continue
@@ -376,6 +415,8 @@ def _sweep_files(
         for tp in f.segment_points:
             if np.isfinite(tp):
                 ax.axvline(tp, color="k", lw=0.6, ls=":")
+        for tb in f.breaks:
+            ax.axvline(tb, color="r", lw=0.6, ls="--")
         ax.set_xlabel("failure time [s]")
         ax.set_ylabel("kappa")
         ax.legend()

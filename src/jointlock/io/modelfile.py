@@ -32,7 +32,7 @@ from __future__ import annotations
 
 import difflib
 import math
-import sys
+import tomllib
 from pathlib import Path
 from typing import Any
 
@@ -42,11 +42,6 @@ from ..dh import from_dh
 from ..errors import ModelError
 from ..model import ArmModel, Body
 from ..spatial import pose, rpy_matrix
-
-if sys.version_info >= (3, 11):
-    import tomllib
-else:  # pragma: no cover
-    import tomli as tomllib
 
 _TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base"}
 _JOINT_KEYS = {

@@ -24,10 +24,16 @@ Pipeline
 4. :func:`search_kappa` -- feasible kappa interval under ``|qdot| <= qdot_max``,
    ``|qddot| <= qddot_max`` (finite differences over the control step) and
    ``||x - x_nom|| <= eps`` for the healthy run *and* the run with the failure; grid search of
-   ``||dqdot||`` then golden-section refinement inside the bracket of the best grid point.
-5. :func:`fit_kappa` -- least-squares polynomial kappa(t) (5th order by default; order raised
-   until the residual criterion holds), then the piecewise form with kappa = 0 near start and
-   end, joined at "segment points" where compensated and uncompensated objectives are equal.
+   ``||dqdot||`` then parabolic/golden-section refinement inside the brackets of the best
+   feasible local grid minima (multi-start: a narrow valley between grid points is found).
+5. :func:`fit_kappa` -- piecewise polynomial kappa(t): the sampled optimum is split where it
+   jumps from one branch to another (:func:`find_breaks`), failure times are added around each
+   break, one least-squares polynomial per segment (5th order by default; order raised until
+   the residual criterion holds), and per segment, in time order and with the schedule's own
+   history, the piece is kept, the previous piece continued, or kappa = 0 used -- whichever
+   gives the smaller jumps at the segment's samples; a kept piece is trimmed to 001's segment
+   points where compensated and uncompensated objectives are equal (kappa = 0 near start and
+   end).  Without breaks: 001's single polynomial with two segment points.
 6. :func:`verify_kappa` -- failure injected at **every** control step with kappa(t) in the
    law: jumps before/after, mean reduction, share improved, every limit checked (a fitted
    kappa(t) can break a limit that each sampled kappa kept: reported, and clipping to the
@@ -55,6 +61,7 @@ Choices where the paper is silent (arguments / scenario fields):
 
 from __future__ import annotations
 
+import dataclasses
 import difflib
 import logging
 import math
@@ -954,6 +961,9 @@ class KappaSearch:
         Largest ``|(I - J^+J) grad w|_inf`` along the uncompensated run [rad/s per unit kappa].
     scenario
         The settings.
+    options
+        Keyword arguments of :func:`search_kappa` that reproduce this grid (used by
+        :func:`fit_kappa` to add failure times around a breakpoint of kappa(t)).
     """
 
     fail_times: FloatArray
@@ -969,6 +979,7 @@ class KappaSearch:
     probe_range: FloatArray
     null_max: float
     scenario: JumpScenario
+    options: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def reduction(self) -> FloatArray:
@@ -1020,6 +1031,7 @@ def search_kappa(
     n_probe: int = 41,
     n_grid: int = 17,
     refine_iter: int = 3,
+    n_starts: int = 2,
     progress: Any = None,
 ) -> KappaSearch:
     """Optimal kappa for each failure time under the limits (NOTES-001 "Optimal kappa").
@@ -1034,7 +1046,12 @@ def search_kappa(
     3. *Refinement*: safeguarded parabolic interpolation of ``||dqdot||^2`` (nearly quadratic:
        ``dqdot`` is affine in kappa at a fixed configuration, NOTES-001 property 5) in the
        bracket of the best grid value, all failure times at once; a refined value is kept only
-       if it lowers the objective and keeps every limit.
+       if it lowers the objective and keeps every limit.  The refinement starts from the
+       ``n_starts`` best feasible *local* minima of the grid objective, not only the best grid
+       value: the objective can have a narrow valley between two grid values (``halt7``: the
+       optimum near +2e-4 lies between the grid values 0 and 4e-4 and is 6x lower than the
+       best grid value, at the band edge; with one start the search jumped to that edge for
+       ``t_f >= 8.5 s`` -- a spurious branch switch that the kappa(t) fit could not follow).
 
     Parameters
     ----------
@@ -1052,6 +1069,9 @@ def search_kappa(
         Sizes of the probe and of the grid (>= 3).
     refine_iter
         Refinement iterations (0: grid only, as in 001).
+    n_starts
+        Local grid minima refined per failure time (1: only the best grid value, the
+        behaviour before multi-start).
     progress
         Optional :class:`jointlock.progress.Progress`-like object (``update()`` per time step).
     """
@@ -1109,36 +1129,57 @@ def search_kappa(
     interval = np.full((F, 2), np.nan)
     kappa_opt = np.full(F, np.nan)
     obj_opt = np.full(F, np.nan)
-    lo_b = np.zeros(F)
-    hi_b = np.zeros(F)
-    has = np.zeros(F, dtype=bool)
+    # refinement starts: up to n_starts feasible local minima of the grid objective per time
+    s_f, s_lo, s_x, s_hi, s_fx, s_run = [], [], [], [], [], []
     for f in range(F):  # reads off contiguous feasible runs; no simulation in this loop
         feas = feasible[:, f]
         if not feas.any():
             continue
-        best = int(np.argmin(np.where(feas, objective[:, f], np.inf)))
+        obj_f = np.where(feas, objective[:, f], np.inf)
+        best = int(np.argmin(obj_f))
         lo, hi = _contiguous(feas, best)
         interval[f] = grid[lo], grid[hi]
         kappa_opt[f] = grid[best]
         obj_opt[f] = objective[best, f]
-        lo_b[f] = grid[max(best - 1, lo)]
-        hi_b[f] = grid[min(best + 1, hi)]
-        has[f] = True
+        left = np.concatenate([[np.inf], obj_f[:-1]])
+        right = np.concatenate([obj_f[1:], [np.inf]])
+        minima = np.flatnonzero(feas & (obj_f <= left) & (obj_f <= right))
+        minima = minima[np.argsort(obj_f[minima], kind="stable")][: max(int(n_starts), 1)]
+        if best not in minima:
+            minima = np.concatenate([[best], minima[:-1]])
+        for i in minima:
+            rlo, rhi = _contiguous(feas, int(i))
+            s_f.append(f)
+            s_lo.append(grid[max(i - 1, rlo)])
+            s_x.append(grid[i])
+            s_hi.append(grid[min(i + 1, rhi)])
+            s_fx.append(objective[i, f])
+            s_run.append((grid[rlo], grid[rhi]))
 
-    if refine_iter > 0 and has.any() and K > 1:
-        sel = np.flatnonzero(has)
+    if refine_iter > 0 and s_f and K > 1:
+        sf = np.asarray(s_f)
         cand, fcand = _refine(
-            prob, fsteps[sel], lo_b[sel], kappa_opt[sel], hi_b[sel], obj_opt[sel], refine_iter
+            prob,
+            fsteps[sf],
+            np.asarray(s_lo),
+            np.asarray(s_x),
+            np.asarray(s_hi),
+            np.asarray(s_fx),
+            refine_iter,
         )
-        better = fcand < obj_opt[sel]
+        better = fcand < obj_opt[sf]
         if better.any():
-            idx = sel[better]
-            krows_c = _kappa_rows(prob, cand[better])
+            rows = np.flatnonzero(better)
+            krows_c = _kappa_rows(prob, cand[rows])
             h = _healthy_runs(prob, krows_c)
-            p, order_c = _post_runs(prob, krows_c, h, np.arange(idx.size), fsteps[idx])
+            p, order_c = _post_runs(prob, krows_c, h, np.arange(rows.size), fsteps[sf[rows]])
             ok = _unsort(_ok(prob, p), order_c) & _ok(prob, h)
-            kappa_opt[idx[ok]] = cand[better][ok]
-            obj_opt[idx[ok]] = fcand[better][ok]
+            for r in rows[ok][np.argsort(-fcand[rows[ok]], kind="stable")]:  # best written last
+                f = sf[r]
+                if fcand[r] < obj_opt[f]:
+                    kappa_opt[f] = cand[r]
+                    obj_opt[f] = fcand[r]
+                    interval[f] = s_run[r]
     return KappaSearch(
         times,
         fsteps,
@@ -1153,6 +1194,43 @@ def search_kappa(
         np.array([a, b]),
         null_max,
         sc,
+        {
+            "kappa_range": None if kappa_range is None else tuple(float(v) for v in kappa_range),
+            "n_probe": n_probe,
+            "n_grid": n_grid,
+            "refine_iter": refine_iter,
+            "n_starts": n_starts,
+        },
+    )
+
+
+def merge_searches(a: KappaSearch, b: KappaSearch) -> KappaSearch:
+    """The samples of two searches on the same grid, sorted by failure time (``a`` wins on
+    duplicates).  Raises :class:`~jointlock.errors.ScenarioError` if the grids differ."""
+    if a.scenario != b.scenario or not np.array_equal(a.kappa_grid, b.kappa_grid):
+        raise ScenarioError("merge_searches: the searches must share scenario and kappa grid")
+    steps = np.concatenate([a.fail_steps, b.fail_steps])
+    _, first = np.unique(steps, return_index=True)  # first occurrence: a before b
+    idx = first[np.argsort(steps[first], kind="stable")]
+
+    def cat(x: np.ndarray, y: np.ndarray, axis: int = 0) -> np.ndarray:
+        return np.take(np.concatenate([x, y], axis=axis), idx, axis=axis)
+
+    return KappaSearch(
+        cat(a.fail_times, b.fail_times),
+        cat(a.fail_steps, b.fail_steps),
+        a.kappa_grid,
+        cat(a.objective, b.objective, 1),
+        cat(a.feasible, b.feasible, 1),
+        cat(a.interval, b.interval),
+        cat(a.kappa_opt, b.kappa_opt),
+        cat(a.objective_opt, b.objective_opt),
+        cat(a.objective_zero, b.objective_zero),
+        cat(a.zero_feasible, b.zero_feasible),
+        a.probe_range,
+        a.null_max,
+        a.scenario,
+        a.options,
     )
 
 
@@ -1205,33 +1283,91 @@ def _refine(
 
 
 @dataclass(frozen=True)
-class KappaFit:
-    """Fitted kappa(t) and its piecewise form (001 §3.3, §4.3).
+class KappaPiece:
+    """One polynomial piece of a piecewise kappa(t).
 
-    ``kappa(t) = p(t/T)`` for ``t1 <= t <= t2`` and 0 outside, ``p`` a polynomial in the
-    normalised time ``tau = t/T`` (coefficients ascending).
+    ``kappa(t) = p((t - center) / half_width)`` for ``start <= t < end`` (coefficients
+    ascending; the local variable keeps high orders on short pieces well conditioned).
+
+    Attributes
+    ----------
+    start, end
+        Time span where the piece applies [s] (kappa = 0 in gaps between pieces).
+    order
+        Polynomial order (raised from the requested one until the criterion holds).
+    coefficients
+        (order + 1,) ascending powers of the local variable.
+    center, half_width
+        Normalisation of the local variable [s].
+    ssr, threshold, accepted
+        Residual over the samples used, its threshold and ``ssr <= threshold``.
+    n_samples
+        Samples the piece was fitted to.
+    source
+        ``"fit"`` (fitted to its own segment's samples) or ``"continued"`` (its polynomial
+        was carried over the next segment(s), where it beat that segment's own fit).
+    """
+
+    start: float
+    end: float
+    order: int
+    coefficients: FloatArray
+    center: float
+    half_width: float
+    ssr: float
+    threshold: float
+    accepted: bool
+    n_samples: int
+    source: str = "fit"
+
+    def polynomial(self, t: ArrayLike) -> FloatArray:
+        """The piece's polynomial at ``t`` [s] (no span check)."""
+        u = (np.asarray(t, dtype=float) - self.center) / self.half_width
+        return np.polynomial.polynomial.polyval(u, self.coefficients)
+
+
+@dataclass(frozen=True)
+class KappaFit:
+    """Fitted kappa(t) and its piecewise form (001 §3.3, §4.3; NOTES-001 "Unknown failure time").
+
+    ``kappa(t)`` is the sum of :attr:`pieces`, each a polynomial on its span, and 0 outside
+    every piece.  With one segment this is 001's form: ``p(t)`` between the two segment
+    points, 0 near the start and the end.
 
     Attributes
     ----------
     order
-        Polynomial order accepted (raised from the requested one until the criterion holds).
+        Highest polynomial order among the pieces (the single polynomial's order when
+        ``piecewise=False`` or when no piece is kept).
     coefficients
-        (order + 1,) ascending powers of ``tau``.
+        (order + 1,) the *single* least-squares polynomial in ``tau = t/T`` over every
+        feasible sample (001's form; kept for comparison, see :meth:`polynomial`).
     ssr
-        Sum of squared residuals over the samples used [kappa^2].
+        Sum of squared residuals over the samples used [kappa^2] (sum over the pieces).
     threshold
-        Acceptance threshold on ``ssr`` (001's criterion).
+        Acceptance threshold on ``ssr`` (001's criterion; sum over the pieces).
     accepted
-        ``ssr <= threshold`` at ``order <= max_order``.
+        Every piece meets its criterion at ``order <= max_order``.
     segment_points
-        (2,) ``t1, t2`` [s]: where compensated and uncompensated objectives are equal
-        (NaN, NaN when compensation never helps: kappa(t) = 0).
+        (2,) ``t1, t2`` [s]: start of the first and end of the last piece (NaN, NaN when
+        compensation never helps: kappa(t) = 0).
     used
-        (F,) samples used by the final fit.
+        (F,) samples used by the pieces' fits.
     objective_fit, objective_zero
-        (F,) ``||dqdot||`` at the samples with kappa = p(t_i) and with kappa = 0 [rad/s].
+        (F,) ``||dqdot||`` at the samples with the fitted schedule (history included: the
+        healthy run with kappa(t) up to the failure) and with kappa = 0 [rad/s].  With
+        ``piecewise=False``: with the constant kappa = p(t_i), as before.
     duration
         ``T`` [s].
+    pieces
+        The :class:`KappaPiece` list, in time order (empty: kappa(t) = 0, or the single form).
+    breaks
+        Times [s] where the sampled optimum jumps (segment boundaries).
+    search
+        The search with the failure times added around the breaks (``None``: none added).
+    segments
+        One entry per segment of the samples: ``(start, end, decision)`` with decision
+        ``"fit"``, ``"continued"`` or ``"zero"``.
     """
 
     order: int
@@ -1244,18 +1380,32 @@ class KappaFit:
     objective_fit: FloatArray
     objective_zero: FloatArray
     duration: float
+    pieces: tuple[KappaPiece, ...] | None = None
+    breaks: FloatArray = field(default_factory=lambda: np.zeros(0))
+    search: KappaSearch | None = None
+    segments: tuple[tuple[float, float, str], ...] = ()
 
     def polynomial(self, t: ArrayLike) -> FloatArray:
-        """``p(t/T)`` without the segments."""
+        """The single polynomial ``p(t/T)`` (001's form), without segments or pieces."""
         return np.polynomial.polynomial.polyval(np.asarray(t, dtype=float) / self.duration, self.coefficients)
 
     def __call__(self, t: ArrayLike) -> FloatArray:
-        """Piecewise kappa(t): ``p(t/T)`` between the segment points, 0 outside."""
+        """Piecewise kappa(t): each piece on its span, 0 elsewhere."""
         t = np.asarray(t, dtype=float)
-        t1, t2 = self.segment_points
-        if not np.isfinite(t1):
-            return np.zeros_like(t)
-        return np.where((t >= t1) & (t <= t2), self.polynomial(t), 0.0)
+        if self.pieces is None:  # single form (piecewise=False)
+            t1, t2 = self.segment_points
+            if not np.isfinite(t1):
+                return np.zeros_like(t)
+            return np.where((t >= t1) & (t <= t2), self.polynomial(t), 0.0)
+        return _eval_pieces(self.pieces, t, self.duration)
+
+
+def _eval_pieces(pieces: Sequence[KappaPiece], t: FloatArray, duration: float) -> FloatArray:
+    out = np.zeros_like(np.asarray(t, dtype=float))
+    for pc in pieces:
+        inside = (t >= pc.start) & ((t < pc.end) | ((pc.end >= duration) & (t <= pc.end)))
+        out = np.where(inside, pc.polynomial(t), out)
+    return out
 
 
 def _polyfit(t: FloatArray, k: FloatArray, order: int, max_order: int, threshold: float | None, rtol: float):
@@ -1289,6 +1439,65 @@ def _crossings(t: FloatArray, d: FloatArray, usable: np.ndarray, duration: float
     return np.array([t1, t2])
 
 
+def find_breaks(
+    kappa: ArrayLike, width: float, *, jump_rtol: float = 0.1, jump_factor: float = 10.0
+) -> np.ndarray:
+    """Indices ``i`` such that samples ``i`` and ``i + 1`` lie on different branches.
+
+    A jump between consecutive samples is a break when ``|kappa_{i+1} - kappa_i|`` exceeds
+    both ``jump_rtol * width`` (``width``: the searched kappa range, e.g. the feasible band)
+    and ``jump_factor`` times the median step between consecutive samples (what a smooth
+    kappa(t) moves from one sample to the next).
+    """
+    k = np.asarray(kappa, dtype=float)
+    if k.size < 2:
+        return np.zeros(0, dtype=int)
+    d = np.abs(np.diff(k))
+    return np.flatnonzero((d > jump_rtol * width) & (d > jump_factor * np.median(d)))
+
+
+def fit_pieces(
+    t: ArrayLike,
+    kappa: ArrayLike,
+    cuts: ArrayLike = (),
+    *,
+    order: int = 5,
+    max_order: int = 9,
+    threshold: float | None = None,
+    rtol: float = 0.1,
+    span: tuple[float, float] | None = None,
+) -> list[KappaPiece]:
+    """Least-squares polynomial per segment of samples ``(t_i, kappa_i)`` (sorted by ``t``).
+
+    ``cuts`` are sample indices ``i`` after which a new segment starts (e.g. from
+    :func:`find_breaks`).  Each segment is fitted on its own (order raised from ``order`` up to
+    ``max_order`` -- and at most samples - 1 -- until ``SSR <= threshold``, default
+    ``rtol`` times the segment's spread ``sum (kappa_i - mean)^2``).  Adjacent pieces meet
+    half-way between the last sample of one segment and the first of the next; the first
+    starts at ``span[0]`` and the last ends at ``span[1]`` (default: the first / last sample).
+    """
+    t = np.asarray(t, dtype=float)
+    k = np.asarray(kappa, dtype=float)
+    if t.size == 0:
+        return []
+    lo, hi = (float(t[0]), float(t[-1])) if span is None else (float(span[0]), float(span[1]))
+    bounds = [0] + [int(c) + 1 for c in np.unique(np.asarray(cuts, dtype=int))] + [t.size]
+    pieces = []
+    for s in range(len(bounds) - 1):
+        ts, ks = t[bounds[s] : bounds[s + 1]], k[bounds[s] : bounds[s + 1]]
+        start = lo if s == 0 else 0.5 * (t[bounds[s] - 1] + ts[0])
+        end = hi if s == len(bounds) - 2 else 0.5 * (ts[-1] + t[bounds[s + 1]])
+        center = 0.5 * (ts[0] + ts[-1])
+        half = max(0.5 * (ts[-1] - ts[0]), 1e-9)
+        ordr, coef, ssr, thr, acc = _polyfit((ts - center) / half, ks, order, max_order, threshold, rtol)
+        pieces.append(
+            KappaPiece(
+                float(start), float(end), int(ordr), coef, center, half, ssr, float(thr), bool(acc), ts.size
+            )
+        )
+    return pieces
+
+
 def fit_kappa(
     model: ArmModel,
     search: KappaSearch,
@@ -1297,18 +1506,44 @@ def fit_kappa(
     max_order: int = 9,
     threshold: float | None = None,
     rtol: float = 0.1,
+    piecewise: bool = True,
+    jump_rtol: float = 0.1,
+    jump_factor: float = 10.0,
+    refine_breaks: bool = True,
+    max_refine: int = 7,
+    refine_rounds: int = 2,
 ) -> KappaFit:
-    """Fit kappa(t) to the optimal kappa per failure time (001 §3.3 and §4.3).
+    """Fit kappa(t) to the optimal kappa per failure time (001 §3.3 and §4.3), piecewise.
 
-    1. Least squares polynomial ``p`` of ``order`` (in ``tau = t/T``) through every feasible
-       sample; the order is raised up to ``max_order`` until ``SSR <= threshold`` (default
-       ``rtol`` times the samples' spread ``sum (kappa_i - mean)^2``).
-    2. Segment points: with ``d_i = ||dqdot||(kappa = p(t_i)) - ||dqdot||(0)`` at each sample,
-       ``t1`` / ``t2`` are the first / last zero crossings into ``d < 0`` (linear
-       interpolation between samples); samples whose ``p(t_i)`` lies outside their feasible
-       interval do not count (001: "it should be abandoned").
-    3. Refit on the samples inside ``[t1, t2]`` only (001 drops the erratic end samples),
-       then recompute the segment points.
+    The sampled optimum need not be smooth: it can switch branch from one failure time to the
+    next (another local minimum of ``||dqdot||(kappa)`` wins, or the feasible band cuts one
+    off).  One polynomial cannot follow such a step and ends up far from both branches (on
+    ``halt7`` with the single-start search it made the jumps 4.5x larger).  So:
+
+    1. *Breaks*: consecutive samples whose optimum jumps (:func:`find_breaks`: more than
+       ``jump_rtol`` of the searched kappa range and ``jump_factor`` times the median step).
+    2. *Refinement*: new failure times are searched between the two samples of each break
+       (up to ``max_refine`` control steps, evenly spaced; ``refine_rounds`` rounds), so the
+       break is located to a control step where the samples allow (001: "add samples").
+    3. *Pieces*: one least-squares polynomial per segment between breaks (:func:`fit_pieces`;
+       order from ``order`` raised to ``max_order`` until ``SSR <= threshold``, 001's
+       criterion, per segment).
+    4. *Decisions*, segment by segment in time order, each judged by the jumps at the
+       segment's sampled failure times in the **healthy run with the schedule decided so far**
+       (the jump at ``t_f`` depends on kappa over ``[0, t_f]``, not only on ``kappa(t_f)``; an
+       optimum sampled with a constant kappa since ``t = 0`` can be useless after a different
+       history): the segment's own piece; the previous piece continued (when a piece
+       precedes); or kappa = 0.  The lowest mean jump wins; so kappa falls back to 0 on a
+       segment where the fit does not beat kappa = 0.  A kept own piece is then trimmed to
+       001's segment points: where ``d_i = ||dqdot||(fit) - ||dqdot||(kappa = 0)`` crosses
+       zero, first/last crossing into ``d < 0`` (linear interpolation; samples whose fitted
+       kappa lies outside their feasible interval do not count), refitted on the samples
+       inside (001 drops the erratic end samples) and kept if that lowers the mean jump.
+
+    Without breaks, this is 001's single polynomial with segment points (same result as
+    ``piecewise=False`` up to the history-consistent comparison).  The verification
+    (:func:`verify_kappa`) then injects the failure at *every* control step, including the
+    steps between samples, which the decisions never looked at.
 
     Parameters
     ----------
@@ -1319,10 +1554,179 @@ def fit_kappa(
     order, max_order
         Starting and largest polynomial order (001: 5).
     threshold
-        Absolute SSR threshold; ``None`` uses ``rtol``.
+        Absolute SSR threshold (per piece); ``None`` uses ``rtol``.
     rtol
-        Relative threshold (fraction of the samples' spread).
+        Relative threshold (fraction of the samples' spread, per piece).
+    piecewise
+        ``False``: the single polynomial of 001 with its two segment points (no breaks,
+        decisions with constant-kappa runs), the behaviour before piecewise fitting.
+    jump_rtol, jump_factor
+        Break detection (:func:`find_breaks`).
+    refine_breaks, max_refine, refine_rounds
+        Sample refinement around the breaks (needs ``search.options``).
     """
+    if not piecewise:
+        return _fit_single(model, search, order=order, max_order=max_order, threshold=threshold, rtol=rtol)
+    sc = search.scenario
+    prob = _problem(model, sc)
+    finite = np.isfinite(search.kappa_opt)
+    if finite.sum() < 2:
+        raise InfeasibleError(
+            f"fit_kappa: only {int(finite.sum())} failure time(s) have a feasible kappa; need >= 2 to fit kappa(t)"
+        )
+    width = float(search.probe_range[1] - search.probe_range[0]) or 1.0
+    single = _polyfit(
+        search.fail_times[finite] / sc.duration, search.kappa_opt[finite], order, max_order, threshold, rtol
+    )
+
+    def breaks_of(s: KappaSearch) -> tuple[np.ndarray, np.ndarray]:
+        fin = np.flatnonzero(np.isfinite(s.kappa_opt))
+        return fin, find_breaks(s.kappa_opt[fin], width, jump_rtol=jump_rtol, jump_factor=jump_factor)
+
+    merged = search
+    added = False
+    fin, cuts = breaks_of(merged)
+    for _ in range(refine_rounds if refine_breaks else 0):
+        extra = []
+        for c in cuts:
+            k_a, k_b = merged.fail_steps[fin[c]], merged.fail_steps[fin[c + 1]]
+            if k_b - k_a > 1:
+                extra.append(
+                    np.unique(np.round(np.linspace(k_a, k_b, min(k_b - k_a - 1, max_refine) + 2)[1:-1]))
+                )
+        if not extra:
+            break
+        more = search_kappa(model, sc, np.concatenate(extra) * sc.dt, **dict(merged.options))
+        if not np.array_equal(more.kappa_grid, merged.kappa_grid):  # options not reproducible
+            log.warning("fit_kappa: refined search used another grid; breaks not refined")
+            break
+        merged = merge_searches(merged, more)
+        added = True
+        fin, cuts = breaks_of(merged)
+    t_all = merged.fail_times
+    t_s, k_s = t_all[fin], merged.kappa_opt[fin]
+    pieces = fit_pieces(
+        t_s,
+        k_s,
+        cuts,
+        order=order,
+        max_order=max_order,
+        threshold=threshold,
+        rtol=rtol,
+        span=(0.0, sc.duration),
+    )
+    steps = prob.t[:-1]
+    seg_of = np.searchsorted([pc.start for pc in pieces[1:]], t_all, side="right")  # segment of every sample
+    feasible_in = np.all(np.isfinite(merged.interval), axis=1)
+
+    def jumps(schedules: list[FloatArray], k_stop: int) -> FloatArray:
+        out = _healthy_runs(prob, np.stack(schedules), k_stop=k_stop)
+        return np.linalg.norm(out.qd_plus - out.qd, axis=-1)[:, merged.fail_steps]
+
+    kap = np.zeros(prob.N)
+    kept: list[KappaPiece] = []
+    decisions = []
+    used = np.zeros(t_all.size, dtype=bool)
+    for s, pc in enumerate(pieces):
+        on = (steps >= pc.start) & ((steps < pc.end) | (s == len(pieces) - 1))
+        here = (seg_of == s) & feasible_in
+        k_stop = int(merged.fail_steps[seg_of == s].max()) + 1
+        names = ["fit", "zero"]
+        cands = [np.where(on, pc.polynomial(steps), kap), np.where(on, 0.0, kap)]
+        if kept and kept[-1].end >= pc.start - 1e-12:  # the previous segment kept its piece
+            names.append("continued")
+            cands.append(np.where(on, kept[-1].polynomial(steps), kap))
+        jm = jumps(cands, k_stop)
+        best_piece = pc
+        # 001's segment points inside the piece: trim where the fit does not beat kappa = 0
+        d = jm[0] - jm[1]
+        pk = pc.polynomial(t_all)
+        inside = (pk >= merged.interval[:, 0] - 1e-15) & (pk <= merged.interval[:, 1] + 1e-15)
+        idx = np.flatnonzero(seg_of == s)
+        seg = _crossings(t_all[idx], d[idx], inside[idx] & feasible_in[idx], sc.duration)
+        trimmed = None
+        if np.isfinite(seg[0]):
+            a_, b_ = (
+                (pc.start if seg[0] <= t_all[idx[0]] else seg[0]),
+                (pc.end if seg[1] >= t_all[idx[-1]] else seg[1]),
+            )
+            if (a_, b_) != (pc.start, pc.end):
+                use = idx[np.isfinite(merged.kappa_opt[idx]) & (t_all[idx] >= a_) & (t_all[idx] <= b_)]
+                if use.size >= 1:
+                    trimmed = fit_pieces(
+                        t_all[use],
+                        merged.kappa_opt[use],
+                        order=order,
+                        max_order=max_order,
+                        threshold=threshold,
+                        rtol=rtol,
+                        span=(a_, b_),
+                    )[0]
+                    on_t = (steps >= a_) & ((steps < b_) | (b_ >= sc.duration))
+                    jt = jumps([np.where(on, np.where(on_t, trimmed.polynomial(steps), 0.0), kap)], k_stop)
+                    names.append("trimmed")
+                    cands.append(np.where(on, np.where(on_t, trimmed.polynomial(steps), 0.0), kap))
+                    jm = np.concatenate([jm, jt])
+        score = jm[:, here].mean(axis=1) if here.any() else jm[:, idx].mean(axis=1)
+        # ties go to the simpler choice: zero before fit/continued
+        pref = [1, 0] + list(range(2, len(names)))
+        win = min(pref, key=lambda i: (score[i], pref.index(i)))
+        choice = names[win]
+        kap = cands[win]
+        if choice == "fit":
+            kept.append(best_piece)
+            used[idx[np.isfinite(merged.kappa_opt[idx])]] = True
+        elif choice == "trimmed":
+            kept.append(trimmed)
+            used[
+                idx[
+                    np.isfinite(merged.kappa_opt[idx])
+                    & (t_all[idx] >= trimmed.start)
+                    & (t_all[idx] <= trimmed.end)
+                ]
+            ] = True
+            choice = "fit"
+        elif choice == "continued":
+            kept[-1] = dataclasses.replace(kept[-1], end=pc.end, source="continued")
+        decisions.append((float(pc.start), float(pc.end), choice))
+    obj_fit = jumps([kap], int(merged.fail_steps.max()) + 1)[0]
+    seg_pts = np.array([kept[0].start, kept[-1].end]) if kept else np.array([np.nan, np.nan])
+    if kept:
+        ordr = max(pc.order for pc in kept)
+        ssr = float(sum(pc.ssr for pc in kept))
+        thr = float(sum(pc.threshold for pc in kept))
+        acc = all(pc.accepted for pc in kept)
+    else:
+        ordr, ssr, thr, acc = int(single[0]), float(single[2]), float(single[3]), bool(single[4])
+    break_times = 0.5 * (t_s[cuts] + t_s[cuts + 1]) if cuts.size else np.zeros(0)
+    return KappaFit(
+        int(ordr),
+        single[1],
+        ssr,
+        thr,
+        bool(acc),
+        seg_pts,
+        used,
+        obj_fit,
+        merged.objective_zero,
+        sc.duration,
+        tuple(kept),
+        break_times,
+        merged if added else None,
+        tuple(decisions),
+    )
+
+
+def _fit_single(
+    model: ArmModel,
+    search: KappaSearch,
+    *,
+    order: int = 5,
+    max_order: int = 9,
+    threshold: float | None = None,
+    rtol: float = 0.1,
+) -> KappaFit:
+    """001's single polynomial with two segment points (``fit_kappa(..., piecewise=False)``)."""
     sc = search.scenario
     prob = _problem(model, sc)
     t = search.fail_times
@@ -1672,7 +2076,8 @@ class JumpStudy:
     Attributes
     ----------
     search, fit, verification
-        The three stages.
+        The three stages (``search`` includes the failure times :func:`fit_kappa` added
+        around the breaks of kappa(t)).
     verification_fixed
         Verification of the fixed kappa(t) (when asked, or automatically when the fitted
         kappa(t) breaks a limit and ``fix="auto"``).
@@ -1699,6 +2104,7 @@ def study_jump(
     max_order: int = 9,
     fix: Literal["auto", "clip", "ramp", "clip+ramp"] | None = "auto",
     search_options: Mapping[str, Any] | None = None,
+    fit_options: Mapping[str, Any] | None = None,
     progress_factory: Callable[[int, str], Any] | None = None,
 ) -> JumpStudy:
     """Run the whole pipeline of 001 on a scenario (search, fit, verification at every step).
@@ -1718,6 +2124,8 @@ def study_jump(
         ``"clip+ramp"`` only when the fitted kappa(t) breaks a limit; ``None``: never.
     search_options
         Extra keyword arguments of :func:`search_kappa`.
+    fit_options
+        Extra keyword arguments of :func:`fit_kappa` (e.g. ``piecewise=False``).
     progress_factory
         ``(total, description) -> progress`` (e.g. :class:`jointlock.progress.Progress`).
     """
@@ -1733,7 +2141,9 @@ def study_jump(
     if p is not None:
         p.close()
     t1 = time.perf_counter()
-    fit = fit_kappa(model, search, order=order, max_order=max_order)
+    fit = fit_kappa(model, search, order=order, max_order=max_order, **dict(fit_options or {}))
+    if fit.search is not None:  # failure times added around the breaks of kappa(t)
+        search = fit.search
     t2 = time.perf_counter()
     p = bar(2 * N, "verification")
     ver = verify_kappa(model, sc, fit, search=search, progress=p)
@@ -1757,6 +2167,7 @@ __all__ = [
     "JumpStudy",
     "JumpTable",
     "KappaFit",
+    "KappaPiece",
     "KappaSearch",
     "LimitReport",
     "SCENARIO_FIELDS",
@@ -1766,8 +2177,11 @@ __all__ = [
     "compensated_rates",
     "feasible_band",
     "ramp_schedule",
+    "find_breaks",
     "fit_kappa",
+    "fit_pieces",
     "jump_at_time",
+    "merge_searches",
     "jump_table",
     "load_scenario",
     "sample_failure_times",
