@@ -3,6 +3,8 @@ locked joints, batching."""
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -20,7 +22,13 @@ FD_DT = 1e-4
 FD_WRENCH_ATOL = 1e-3
 
 
+URDF_ARM = Path(__file__).parent / "data" / "arm5.urdf"
+
+
 def _arm(name: str = "halt7", base: str = "floating") -> jl.ArmModel:
+    """A built-in, or "arm5": the URDF test arm (axes other than z, off-diagonal inertias)."""
+    if name == "arm5":
+        return jl.read_urdf(URDF_ARM, base=base)
     return jl.load_robot(name, base=base)
 
 
@@ -32,7 +40,7 @@ def _states(model, rng, shape=(5,)):
 
 
 @pytest.mark.oracle
-@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6"])
+@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "arm5"])
 def test_rnea_matches_pinocchio(name, rng):
     po = pytest.importorskip("pin_oracle")
     pin = po.pin
@@ -55,12 +63,13 @@ def test_rnea_matches_pinocchio(name, rng):
 
 
 @pytest.mark.oracle
-def test_floating_base_matches_pinocchio_free_flyer(rng):
+@pytest.mark.parametrize("name", ["halt7", "arm5"])
+def test_floating_base_matches_pinocchio_free_flyer(name, rng):
     """With the base acceleration we solve for, Pinocchio's free-flyer rnea needs no base
     wrench (the spacecraft is free) and gives the same joint torques."""
     po = pytest.importorskip("pin_oracle")
     pin = po.pin
-    model = _arm()
+    model = _arm(name)
     pm, _ = po.to_pinocchio(model, free_flyer=True)
     pm.gravity.linear[:] = 0.0
     data = pm.createData()

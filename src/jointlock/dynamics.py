@@ -9,6 +9,7 @@ and the wrench the arm exerts on its base, with the base held fixed (000) or fre
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 from typing import Literal
 
@@ -128,156 +129,423 @@ class InverseDynamics:
         return np.concatenate([self.base_force, self.base_moment], axis=-1)
 
 
-def _cross(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Cross product of (3, N) component arrays (rows contiguous)."""
-    return np.stack([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
+# -- batch-last Newton-Euler in link frames --------------------------------------------------
+#
+# Every per-sample quantity below is a list of scalar rows, one (N,) array per component
+# (``None`` for an exactly zero component).  Constant matrices (placements, inertias, centres
+# of mass) are applied entry by entry with zero entries skipped and unit entries not
+# multiplied, so a signed-permutation placement (every DH model) costs nothing; the joint
+# rotation about ``z`` is four products and two sums per vector.  Links frames are rotated
+# so that every joint turns about its own ``z`` (see :func:`_link_constants`).
+
+Row = "FloatArray | float | None"
 
 
-def _mv(r: FloatArray, v: FloatArray) -> FloatArray:
-    """Per-sample matrix (3, 3, N) times vector (3, N)."""
-    return r[:, 0] * v[0] + r[:, 1] * v[1] + r[:, 2] * v[2]
-
-
-def _mtv(r: FloatArray, v: FloatArray) -> FloatArray:
-    """Per-sample transposed matrix (3, 3, N) times vector (3, N)."""
-    return r[0] * v[0] + r[1] * v[1] + r[2] * v[2]
-
-
-def _mc(r: FloatArray, c: FloatArray) -> FloatArray:
-    """Per-sample matrix (3, 3, N) times a constant matrix (3, 3) -> (3, 3, N); zero
-    entries of the (usually sparse, DH-built) constant are skipped."""
-    return np.stack([_mvc(r, c[:, col]) for col in range(3)], axis=1)
-
-
-def _mvc(r: FloatArray, v: FloatArray) -> FloatArray:
-    """Per-sample matrix (3, 3, N) times a constant vector (3,) -> (3, N), zeros skipped."""
+def _lc(terms, const: float = 0.0):
+    """Sum of ``coef * row`` over ``terms`` plus ``const``; zero coefficients and ``None``
+    rows skipped, unit coefficients not multiplied; ``None`` when everything is zero."""
     out = None
-    for k in range(3):
-        if v[k] != 0.0:
-            term = r[:, k] if v[k] == 1.0 else r[:, k] * v[k]
-            out = term if out is None else out + term
-    return np.zeros(r.shape[::2]) if out is None else out
+    owned = False
+    for coef, row in terms:
+        if row is None or coef == 0.0:
+            continue
+        if out is None:
+            if coef == 1.0:
+                out = row
+            else:
+                out = row * coef
+                owned = True
+        elif coef == 1.0:
+            if owned:
+                out += row
+            else:
+                out = out + row
+                owned = True
+        elif coef == -1.0:
+            if owned:
+                out -= row
+            else:
+                out = out - row
+                owned = True
+        else:
+            if owned:
+                out += coef * row
+            else:
+                out = out + coef * row
+                owned = True
+    if const != 0.0:
+        out = const if out is None else out + const
+    return out
 
 
-class _Kinematics:
-    """Root-frame link kinematics in structure-of-arrays layout for N flattened samples."""
-
-    def __init__(self, model: ArmModel, q: FloatArray) -> None:
-        n_samples = q.shape[1]
-        self.rot: list[FloatArray] = []  # (3, 3, N) link frame orientation
-        self.pos: list[FloatArray] = []  # (3, N) link frame origin (on the joint axis)
-        self.axis: list[FloatArray] = []  # (3, N) joint axis
-        self.com: list[FloatArray] = []  # (3, N) centre of mass minus origin
-        rot = np.broadcast_to(np.eye(3)[:, :, None], (3, 3, n_samples))
-        pos = np.zeros((3, n_samples))
-        for i, (joint, body) in enumerate(zip(model.joints, model.bodies)):
-            pl = joint.placement
-            pos = pos + _mvc(rot, pl[:3, 3])
-            rp = _mc(rot, pl[:3, :3])
-            a = joint.axis
-            z = _mvc(rp, a)
-            c, sn = np.cos(q[i]), np.sin(q[i])
-            if np.array_equal(a, [0.0, 0.0, 1.0]):  # DH joints: rotate the first two columns
-                x_col = c * rp[:, 0] + sn * rp[:, 1]
-                y_col = c * rp[:, 1] - sn * rp[:, 0]
-                rot = np.stack([x_col, y_col, rp[:, 2]], axis=1)
-            else:  # Rodrigues: R(a, q) = c I + s [a]x + (1 - c) a a^T
-                rot = c * rp + sn * _mc(rp, skew(a)) + (1.0 - c) * z[:, None, :] * a[None, :, None]
-            self.rot.append(rot)
-            self.pos.append(pos)
-            self.axis.append(z)
-            self.com.append(_mvc(rot, body.com))
-
-    def inertia_times(self, i: int, inertia: FloatArray, v: FloatArray) -> FloatArray:
-        """World inertia of link ``i`` times v: ``R I R^T v`` (3, N)."""
-        return _mv(self.rot[i], inertia @ _mtv(self.rot[i], v))
+def _add(a, b):
+    if a is None:
+        return b
+    if b is None:
+        return a
+    return a + b
 
 
-def _forward(
-    model: ArmModel,
-    kin: _Kinematics,
-    dq: FloatArray,
-    ddq: FloatArray,
-    omega0: FloatArray,
-    acc0: FloatArray,
-) -> tuple[list[FloatArray], list[FloatArray]]:
-    """Forward Newton-Euler recursion (000 eq. 28): inertia force and moment of every link
-    (3, N), root frame; the root frame turns at ``omega0`` with no angular acceleration and
-    its origin accelerates at ``acc0``."""
-    w, wd, acc = omega0, np.zeros_like(omega0), acc0
-    prev = np.zeros((3, 1))
-    forces, moments = [], []
-    for i, body in enumerate(model.bodies):
-        z, p, r = kin.axis[i], kin.pos[i], kin.com[i]
-        d = p - prev
-        acc = acc + _cross(wd, d) + _cross(w, _cross(w, d))  # origin i is fixed on body i-1
-        wz = z * dq[i]
-        wd = wd + z * ddq[i] + _cross(w, wz)
-        w = w + wz
-        acc_c = acc + _cross(wd, r) + _cross(w, _cross(w, r))
-        forces.append(body.mass * acc_c)
-        moments.append(
-            kin.inertia_times(i, body.inertia, wd) + _cross(w, kin.inertia_times(i, body.inertia, w))
-        )
-        prev = p
-    return forces, moments
+def _sub(a, b):
+    if b is None:
+        return a
+    if a is None:
+        return -b
+    return a - b
 
 
-def _backward(
-    kin: _Kinematics, forces: list[FloatArray], moments: list[FloatArray]
-) -> tuple[FloatArray, FloatArray, FloatArray]:
-    """Backward recursion (000 eq. 29): joint torques (n, N), and the force ``f_1`` and the
-    moment ``n_1`` about joint 1's origin (3, N) that the root body exerts on link 1."""
-    n = len(forces)
-    f = np.zeros_like(forces[0])
-    nm = np.zeros_like(forces[0])
-    p_next = kin.pos[-1]
-    torques = np.empty((n,) + forces[0].shape[1:])
-    for i in range(n - 1, -1, -1):
-        p = kin.pos[i]
-        nm = moments[i] + _cross(kin.com[i], forces[i]) + _cross(p_next - p, f) + nm
-        f = forces[i] + f
-        torques[i] = np.einsum("in,in->n", kin.axis[i], nm)
-        p_next = p
-    return torques, f, nm
+def _mul(a, b):
+    if a is None or b is None:
+        return None
+    return a * b
 
 
-def _floating_base(
-    model: ArmModel, kin: _Kinematics, dq: FloatArray
-) -> tuple[FloatArray, FloatArray, list[FloatArray]]:
-    """Zero-momentum spacecraft twist (6, N) and base inertia ``H_b`` (N, 6, 6) about the
-    spacecraft's centre of mass ``c_0``, plus every link's centre of mass minus ``c_0``."""
-    n_samples = dq.shape[1]
-    c0 = model.root_body.com[:, None]
-    hb = np.zeros((n_samples, 6, 6))
-    hb[:, :3, :3] = model.root_body.mass * np.eye(3)
-    hb[:, 3:, 3:] = model.root_body.inertia
-    lin = np.zeros((3, n_samples))
-    ang = np.zeros((3, n_samples))
-    w = np.zeros((3, n_samples))
-    v = np.zeros((3, n_samples))
-    prev = np.zeros((3, 1))
-    rel = []
-    for i, body in enumerate(model.bodies):
+def _add3(a, b, c):
+    return [_add(_add(x, y), z) for x, y, z in zip(a, b, c)]
+
+
+def _cmv(c: FloatArray, v):
+    """Constant (3, 3) times a row vector."""
+    return [_lc(((c[r, 0], v[0]), (c[r, 1], v[1]), (c[r, 2], v[2]))) for r in range(3)]
+
+
+def _cross(a, b):
+    """Cross product of two row vectors."""
+    return [
+        _sub(_mul(a[1], b[2]), _mul(a[2], b[1])),
+        _sub(_mul(a[2], b[0]), _mul(a[0], b[2])),
+        _sub(_mul(a[0], b[1]), _mul(a[1], b[0])),
+    ]
+
+
+def _cross_vc(v, p: FloatArray):
+    """Row vector ``v`` cross a constant vector ``p``."""
+    return [
+        _lc(((p[2], v[1]), (-p[1], v[2]))),
+        _lc(((p[0], v[2]), (-p[2], v[0]))),
+        _lc(((p[1], v[0]), (-p[0], v[1]))),
+    ]
+
+
+def _rz(c, s, v, transpose: bool = False):
+    """``Rot(z, q) v`` (or its transpose) for rows ``c = cos q``, ``s = sin q``."""
+    x, y = v[0], v[1]
+    if x is None and y is None:
+        return [None, None, v[2]]
+    if transpose:
+        return [_add(_mul(c, x), _mul(s, y)), _sub(_mul(c, y), _mul(s, x)), v[2]]
+    return [_sub(_mul(c, x), _mul(s, y)), _add(_mul(s, x), _mul(c, y)), v[2]]
+
+
+@dataclass(frozen=True)
+class _Link:
+    """Constants of one link in its ``z``-joint frame (the joint frame turned by ``Q`` so that
+    the joint axis is ``z``): rotation ``E`` and translation ``p`` from the parent's frame,
+    mass, centre of mass, inertia about the centre of mass, and the composite-inertia
+    transform coefficients of :func:`_composite`."""
+
+    rot: FloatArray  # E (3, 3)
+    pos: FloatArray  # p (3,)
+    mass: float
+    com: FloatArray
+    inertia: FloatArray
+    own_first: FloatArray  # m c (3,)
+    own_inertia: FloatArray  # inertia about the frame origin (3, 3)
+    sym_rot: FloatArray  # (6, 6), see _sym_coefficients
+    sym_shift: FloatArray  # (6, 3)
+
+
+_SYM = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+
+
+def _axis_frame(axis: FloatArray) -> FloatArray:
+    """Rotation ``Q`` with ``Q e_z = axis`` (identity for ``+z``)."""
+    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
+    if a[0] == 0.0 and a[1] == 0.0 and a[2] > 0:
+        return np.eye(3)
+    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+    u = np.cross(helper, a)
+    u /= np.linalg.norm(u)
+    return np.column_stack([u, np.cross(a, u), a])
+
+
+#: Link constants of recently used models, by ``id`` (models are immutable); each entry keeps
+#: a weak reference to its model so that a recycled ``id`` is never mistaken for it.
+_LINK_CACHE: dict[tuple[int, bytes], tuple[weakref.ref, list[_Link]]] = {}
+_LINK_CACHE_SIZE = 64
+
+
+def _link_constants(model: ArmModel, origin: FloatArray) -> list[_Link]:
+    """Per-link constants (cached per model); the parent of link 1 is the root frame moved
+    to ``origin``."""
+    key = (id(model), np.asarray(origin, dtype=float).tobytes())
+    hit = _LINK_CACHE.get(key)
+    if hit is not None and hit[0]() is model:
+        return hit[1]
+    links = _compute_link_constants(model, origin)
+    if len(_LINK_CACHE) >= _LINK_CACHE_SIZE:
+        _LINK_CACHE.clear()
+    _LINK_CACHE[key] = (weakref.ref(model), links)
+    return links
+
+
+def _compute_link_constants(model: ArmModel, origin: FloatArray) -> list[_Link]:
+    links = []
+    q_prev = np.eye(3)
+    for i, (joint, body) in enumerate(zip(model.joints, model.bodies)):
+        qi = _axis_frame(joint.axis)
+        pos = joint.placement[:3, 3] - (origin if i == 0 else 0.0)
+        e = q_prev.T @ joint.placement[:3, :3] @ qi
+        e[np.abs(e) < 1e-15] = 0.0
+        e[np.abs(np.abs(e) - 1.0) < 1e-15] = np.sign(e[np.abs(np.abs(e) - 1.0) < 1e-15])
+        com = qi.T @ body.com
+        inertia = qi.T @ body.inertia @ qi
         m = body.mass
-        p, r, z = kin.pos[i], kin.com[i], kin.axis[i]
-        v = v + _cross(w, p - prev)
-        w = w + z * dq[i]
-        vc = v + _cross(w, r)
-        rc = p + r - c0
-        rel.append(rc)
-        lin = lin + m * vc
-        ang = ang + kin.inertia_times(i, body.inertia, w) + m * _cross(rc, vc)
-        sk = skew(rc.T)  # (N, 3, 3)
-        rot = np.moveaxis(kin.rot[i], -1, 0)
-        hb[:, :3, :3] += m * np.eye(3)
-        hb[:, :3, 3:] -= m * sk
-        hb[:, 3:, :3] += m * sk
-        hb[:, 3:, 3:] += rot @ body.inertia @ np.swapaxes(rot, -1, -2) - m * sk @ sk
-        prev = p
-    h_arm = np.concatenate([lin, ang]).T  # (N, 6) momentum of the arm, base still
-    nu0 = -np.linalg.solve(hb, h_arm[..., None])[..., 0].T
-    return nu0, hb, rel
+        own = inertia + m * (com @ com * np.eye(3) - np.outer(com, com))
+        p = q_prev.T @ pos
+        links.append(_Link(e, p, m, com, inertia, m * com, own, *_sym_coefficients(e, p)))
+        q_prev = qi
+    return links
+
+
+def _cross_cv(p: FloatArray, v):
+    """Constant vector ``p`` cross a row vector ``v``."""
+    return [
+        _lc(((p[1], v[2]), (-p[2], v[1]))),
+        _lc(((p[2], v[0]), (-p[0], v[2]))),
+        _lc(((p[0], v[1]), (-p[1], v[0]))),
+    ]
+
+
+def _forward(links, cos, sin, dq, ddq, w, wd, a):
+    """Forward Newton-Euler recursion (000 eq. 28) in link frames: inertia force and moment
+    (rows) of every link.  ``w``, ``wd``, ``a``: angular velocity, angular acceleration and
+    origin acceleration of the parent of link 1, in its frame."""
+    out = []
+    for i, link in enumerate(links):
+        c, s = cos[i], sin[i]
+        ap = _add3(a, _cross_vc(wd, link.pos), _cross(w, _cross_vc(w, link.pos)))
+        et = link.rot.T
+        wu = _rz(c, s, _cmv(et, w), True)
+        wdu = _rz(c, s, _cmv(et, wd), True)
+        a = _rz(c, s, _cmv(et, ap), True)
+        w = [wu[0], wu[1], _add(wu[2], dq[i])]
+        wd = [_add(wdu[0], _mul(wu[1], dq[i])), _sub(wdu[1], _mul(wu[0], dq[i])), _add(wdu[2], ddq[i])]
+        acc = _add3(a, _cross_vc(wd, link.com), _cross(w, _cross_vc(w, link.com)))
+        force = [_lc(((link.mass, x),)) for x in acc]
+        moment = [_add(x, y) for x, y in zip(_cmv(link.inertia, wd), _cross(w, _cmv(link.inertia, w)))]
+        out.append((force, moment))
+    return out
+
+
+def _backward(links, cos, sin, wrenches):
+    """Backward recursion (000 eq. 29): joint torques (rows), and the force and the moment
+    about joint 1's origin that the root body exerts on link 1, in the parent frame of link 1."""
+    n = len(links)
+    tau = [None] * n
+    f = nm = None
+    for i in range(n - 1, -1, -1):
+        force, moment = wrenches[i]
+        nm_own = _add3(moment, _cross_cv(links[i].com, force), [None] * 3)
+        if f is None:
+            f, nm = force, nm_own
+        else:
+            nxt = links[i + 1]
+            fr = _cmv(nxt.rot, _rz(cos[i + 1], sin[i + 1], f))
+            nr = _cmv(nxt.rot, _rz(cos[i + 1], sin[i + 1], nm))
+            f = [_add(x, y) for x, y in zip(force, fr)]
+            nm = _add3(nm_own, nr, _cross_cv(nxt.pos, fr))
+        tau[i] = nm[2]
+    first = links[0]
+    return tau, _cmv(first.rot, _rz(cos[0], sin[0], f)), _cmv(first.rot, _rz(cos[0], sin[0], nm))
+
+
+def _sym_coefficients(e: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """Coefficients of ``E K E^T`` on the six stored entries of ``K`` (6, 6), and of the
+    parallel-axis cross terms ``2 (p.g) 1 - p g^T - g p^T`` with ``g = E h`` on ``h`` (6, 3)."""
+    a = np.zeros((6, 6))
+    g = np.zeros((6, 3))
+    eye = np.eye(3)
+    for r, (i, j) in enumerate(_SYM):
+        for col, (k, l) in enumerate(_SYM):
+            a[r, col] = e[i, k] * e[j, l] + (e[i, l] * e[j, k] if k != l else 0.0)
+        for k in range(3):
+            g[r, k] = 2.0 * p[k] * eye[i, j] - p[i] * eye[j, k] - p[j] * eye[i, k]
+    a[np.abs(a) < 1e-15] = 0.0
+    b = g @ e
+    b[np.abs(b) < 1e-15] = 0.0
+    return a, b
+
+
+def _nz(x):
+    return 0.0 if x is None else x
+
+
+def _move_inertia(link, c, s, cos2, sin2, mass, first, inertia, own_inertia, own_first):
+    """Move a composite body (mass, first moment and inertia about its frame origin, rows,
+    in the frame of ``link``) into the parent frame of ``link``, about the parent origin,
+    and add the parent's own constant inertia and first moment."""
+    xx, yy, zz, xy, xz, yz = inertia
+    tot, dif = xx + yy, xx - yy
+    rxx = 0.5 * tot + (0.5 * cos2) * dif - sin2 * xy
+    rot_k = (rxx, tot - rxx, zz, (0.5 * sin2) * dif + cos2 * xy, c * xz - s * yz, s * xz + c * yz)
+    hz = _rz(c, s, first)
+    a, b, p = link.sym_rot, link.sym_shift, link.pos
+    const = mass * (p @ p * np.eye(3) - np.outer(p, p)) + own_inertia
+    new_inertia = [
+        _nz(_lc([(a[r, k], rot_k[k]) for k in range(6)] + [(b[r, k], hz[k]) for k in range(3)], const[i, j]))
+        for r, (i, j) in enumerate(_SYM)
+    ]
+    new_first = [
+        _nz(_lc([(link.rot[r, k], hz[k]) for k in range(3)], mass * p[r] + own_first[r])) for r in range(3)
+    ]
+    return new_first, new_inertia
+
+
+def _move_momentum(link, c, s, ang, lin):
+    """Move a momentum (angular about the frame origin, linear) into the parent frame."""
+    lin = _cmv(link.rot, _rz(c, s, lin))
+    ang = _add3(_cmv(link.rot, _rz(c, s, ang)), _cross_cv(link.pos, lin), [None] * 3)
+    return ang, lin
+
+
+def _composite(links, cos, sin, cos2, sin2, dq=None):
+    """Composite inertia of the links outboard of every joint, recursively in link frames
+    (as in the composite-rigid-body algorithm), and the momentum of the arm on a still base.
+
+    Returns ``(mass, first, inertia, columns, momentum)``: the arm's mass, first moment (3
+    rows) and inertia (6 rows, order ``_SYM``) about the parent origin of link 1, in its
+    frame; per link ``j`` the momentum (angular about origin ``j``, linear; frame ``j``) of
+    the outboard composite turning at unit rate about joint ``j``, as 5 rows
+    ``(K_xz, K_yz, K_zz, h_x, h_y)`` (angular ``K e_z``, linear ``e_z x h``); and, with
+    ``dq``, the arm's momentum ``(L, P)`` (rows, parent frame of link 1, ``L`` about its
+    origin), else ``None``."""
+    n = len(links)
+    columns = [None] * n
+    last = links[-1]
+    mass = last.mass
+    inertia = [float(last.own_inertia[i, j]) for i, j in _SYM]
+    first = [float(x) for x in last.own_first]
+    momentum = None
+    for j in range(n - 1, -1, -1):
+        if j < n - 1:
+            nxt = links[j + 1]
+            first, inertia = _move_inertia(
+                nxt,
+                cos[j + 1],
+                sin[j + 1],
+                cos2[j + 1],
+                sin2[j + 1],
+                mass,
+                first,
+                inertia,
+                links[j].own_inertia,
+                links[j].own_first,
+            )
+            mass += links[j].mass
+            if momentum is not None:
+                momentum = _move_momentum(nxt, cos[j + 1], sin[j + 1], *momentum)
+        col = (inertia[4], inertia[5], inertia[2], first[0], first[1])
+        columns[j] = col
+        if dq is not None:
+            d = dq[j]
+            own = ([col[0] * d, col[1] * d, col[2] * d], [-col[4] * d, col[3] * d, None])
+            momentum = (
+                own
+                if momentum is None
+                else tuple([_add(x, y) for x, y in zip(u, v)] for u, v in zip(momentum, own))
+            )
+    zero3 = np.zeros(3)
+    first, inertia = _move_inertia(
+        links[0], cos[0], sin[0], cos2[0], sin2[0], mass, first, inertia, np.zeros((3, 3)), zero3
+    )
+    if momentum is not None:
+        momentum = _move_momentum(links[0], cos[0], sin[0], *momentum)
+    return mass, first, inertia, columns, momentum
+
+
+def _base_solver(mass: float, first, inertia):
+    """Solver of ``H_b x = [r_f; r_n]`` for the spacecraft-plus-arm inertia about the
+    spacecraft's centre of mass, ``H_b = [[M 1, -[h]x], [[h]x, K]]`` (rows): the Schur
+    complement ``K + [h]x [h]x / M`` (the inertia about the system's centre of mass) is
+    inverted by its adjugate."""
+    hx, hy, hz = first
+    xx, yy, zz, xy, xz, yz = inertia
+    im = 1.0 / mass
+    kxx = xx - (hy * hy + hz * hz) * im
+    kyy = yy - (hx * hx + hz * hz) * im
+    kzz = zz - (hx * hx + hy * hy) * im
+    kxy = xy + hx * hy * im
+    kxz = xz + hx * hz * im
+    kyz = yz + hy * hz * im
+    cxx = kyy * kzz - kyz * kyz
+    cxy = kxz * kyz - kxy * kzz
+    cxz = kxy * kyz - kxz * kyy
+    cyy = kxx * kzz - kxz * kxz
+    cyz = kxy * kxz - kxx * kyz
+    czz = kxx * kyy - kxy * kxy
+    inv_det = 1.0 / (kxx * cxx + kxy * cxy + kxz * cxz)
+
+    def solve(rf, rn):
+        b = [x - im * y for x, y in zip(rn, _cross(first, rf))]
+        alpha = [
+            (cxx * b[0] + cxy * b[1] + cxz * b[2]) * inv_det,
+            (cxy * b[0] + cyy * b[1] + cyz * b[2]) * inv_det,
+            (cxz * b[0] + cyz * b[1] + czz * b[2]) * inv_det,
+        ]
+        lin = [(x + y) * im for x, y in zip(rf, _cross(first, alpha))]
+        return lin, alpha
+
+    return solve
+
+
+def _rows_out(rows, n_samples: int, batch: tuple[int, ...]) -> FloatArray:
+    out = np.empty((n_samples, len(rows)))
+    for k, row in enumerate(rows):
+        out[:, k] = 0.0 if row is None else row
+    return out.reshape(batch + (len(rows),))
+
+
+def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
+    """Rows of torques, base force, base moment, base acceleration and twist."""
+    cos, sin = np.cos(qf), np.sin(qf)
+    dq, ddq = list(dqf), list(ddqf)
+    none3 = [None] * 3
+    if base == "fixed":
+        links = _link_constants(model, np.zeros(3))
+        acc0 = [None if x == 0.0 else -float(x) for x in g]  # gravity as an upward base acceleration
+        wrenches = _forward(links, cos, sin, dq, ddq, none3, none3, acc0)
+        tau, f1, n1 = _backward(links, cos, sin, wrenches)
+        force = [_lc(((-1.0, x),)) for x in f1]
+        moment = [_lc(((-1.0, x), (-1.0, y))) for x, y in zip(n1, _cross_cv(links[0].pos - point, f1))]
+        zero6 = [None] * 6
+        return tau, force, moment, zero6, zero6
+    root = model.root_body
+    c0 = root.com
+    links = _link_constants(model, c0)
+    cos2, sin2 = cos * cos - sin * sin, 2.0 * sin * cos
+    mass, first, inertia, columns, (ang, lin) = _composite(links, cos, sin, cos2, sin2, dq)
+    inertia = [x + root.inertia[i, j] for x, (i, j) in zip(inertia, _SYM)]
+    solve = _base_solver(mass + root.mass, first, inertia)
+    v0, w0 = solve([_lc(((-1.0, x),)) for x in lin], [_lc(((-1.0, x),)) for x in ang])
+    wrenches = _forward(links, cos, sin, dq, ddq, w0, none3, none3)
+    tau, f1, n1 = _backward(links, cos, sin, wrenches)
+    spin = _cross(w0, _cmv(root.inertia, w0))
+    rf = [_lc(((-1.0, x),)) for x in f1]
+    rn = [_lc(((-1.0, x), (-1.0, y), (-1.0, z))) for x, y, z in zip(n1, _cross_cv(links[0].pos, f1), spin)]
+    a0, alpha0 = solve(rf, rn)
+    # joint torques from the spacecraft's acceleration (linear in it): the rigid acceleration
+    # carried out to every link, against each outboard composite's unit-rate momentum
+    acc, alpha = a0, alpha0
+    for j, link in enumerate(links):
+        et = link.rot.T
+        acc = _rz(cos[j], sin[j], _cmv(et, _add3(acc, _cross_vc(alpha, link.pos), none3)), True)
+        alpha = _rz(cos[j], sin[j], _cmv(et, alpha), True)
+        kxz, kyz, kzz, hx, hy = columns[j]
+        tau[j] = tau[j] + kxz * alpha[0] + kyz * alpha[1] + kzz * alpha[2] + hx * acc[1] - hy * acc[0]
+    force = [root.mass * x for x in a0]
+    moment = _add3(_cmv(root.inertia, alpha0), spin, _cross_cv(c0 - point, force))
+    return tau, force, moment, a0 + alpha0, v0 + w0
 
 
 def rnea(
@@ -358,39 +626,10 @@ def rnea(
 
     qf, dqf, ddqf = flat(q), flat(dq), flat(ddq)
     n_samples = qf.shape[1]
-    kin = _Kinematics(model, qf)
-    p1 = kin.pos[0]
-    pt = point[:, None]
-    if base == "fixed":
-        acc0 = np.broadcast_to(-g[:, None], (3, n_samples))  # gravity as an upward base acceleration
-        forces, moments = _forward(model, kin, dqf, ddqf, np.zeros((3, n_samples)), acc0)
-        tau, f1, n1 = _backward(kin, forces, moments)
-        force = -f1
-        moment = -(n1 + _cross(p1 - pt, f1))
-        acc_base = np.zeros((6, n_samples))
-        nu0 = np.zeros((6, n_samples))
-    else:
-        nu0, hb, rel = _floating_base(model, kin, dqf)
-        w0 = nu0[3:]
-        c0 = model.root_body.com[:, None]
-        acc_origin = _cross(w0, _cross(w0, np.broadcast_to(-c0, (3, n_samples))))
-        forces, moments = _forward(model, kin, dqf, ddqf, w0, acc_origin)
-        f_tot = -sum(forces)
-        n_tot = -sum(m + _cross(r, f) for m, r, f in zip(moments, rel, forces))
-        rhs = np.concatenate([f_tot, n_tot - _cross(w0, model.root_body.inertia @ w0)]).T
-        acc_base = np.linalg.solve(hb, rhs[..., None])[..., 0].T  # (6, N)
-        a0, alpha0 = acc_base[:3], acc_base[3:]
-        for i, body in enumerate(model.bodies):  # add the base acceleration (linear in it)
-            forces[i] = forces[i] + body.mass * (a0 + _cross(alpha0, rel[i]))
-            moments[i] = moments[i] + kin.inertia_times(i, body.inertia, alpha0)
-        tau, f1, n1 = _backward(kin, forces, moments)
-        force = -f1
-        moment = -(n1 + _cross(p1 - pt, f1))
-
-    def unflat(x: FloatArray) -> FloatArray:
-        return np.ascontiguousarray(x.T).reshape(batch + (x.shape[0],))
-
-    return InverseDynamics(unflat(tau), unflat(force), unflat(moment), unflat(acc_base), unflat(nu0), point)
+    tau, force, moment, acc_base, nu0 = _rnea_rows(model, qf, dqf, ddqf, base, g, point)
+    return InverseDynamics(
+        *(_rows_out(rows, n_samples, batch) for rows in (tau, force, moment, acc_base, nu0)), point
+    )
 
 
 def joint_torques(
@@ -419,3 +658,56 @@ def base_wrench(
     """(..., 6) wrench ``[f_d; n_d]`` [N, N m] the arm exerts on its base (000 eqs. 30-31),
     moment about the spacecraft's centre of mass, root frame.  See :func:`rnea`."""
     return rnea(model, q, dq, ddq, base=base, gravity=gravity, moment_point=moment_point).base_wrench
+
+
+def _momentum_matrix_soa(model: ArmModel, qf: FloatArray, state: ChainState) -> FloatArray:
+    """:func:`jointlock.kinematics.momentum_matrix` as (6, 6 + n, N) for flattened joint
+    angles ``qf`` (n, N): composite inertias recursively in link frames, each joint's column
+    turned into the root frame once."""
+    n = model.dof
+    cos, sin = np.cos(qf), np.sin(qf)
+    cos2, sin2 = cos * cos - sin * sin, 2.0 * sin * cos
+    links = _link_constants(model, np.zeros(3))
+    mass, first, inertia, columns, _ = _composite(links, cos, sin, cos2, sin2)
+    out = np.zeros((6, 6 + n, qf.shape[1]))
+    for j, joint in enumerate(model.joints):
+        rot = state.soa_rotations[j]
+        qa = _axis_frame(joint.axis)
+        if not np.array_equal(qa, np.eye(3)):
+            rot = np.matmul(qa.T, rot)  # frame j turned so that its z is the joint axis
+        kxz, kyz, kzz, hx, hy = columns[j]
+        lin = out[0:3, 6 + j]
+        np.multiply(rot[:, 1], hx, out=lin)
+        lin -= rot[:, 0] * hy
+        ang = out[3:6, 6 + j]
+        np.multiply(rot[:, 0], kxz, out=ang)
+        ang += rot[:, 1] * kyz
+        ang += rot[:, 2] * kzz
+        p = state.soa_positions[j]
+        ang[0] += p[1] * lin[2] - p[2] * lin[1]
+        ang[1] += p[2] * lin[0] - p[0] * lin[2]
+        ang[2] += p[0] * lin[1] - p[1] * lin[0]
+    root = model.root_body
+    m0, r0 = root.mass, root.com
+    h = first
+    for k in range(3):
+        out[k, k] = m0 + mass
+        for col in range(3):
+            out[3 + k, 3 + col] = root.inertia[k, col]
+    for r, (i, j) in enumerate(_SYM):
+        out[3 + i, 3 + j] += inertia[r]
+        if i != j:
+            out[3 + j, 3 + i] += inertia[r]
+    # -skew(h - M r0) (linear from omega_0), skew(h + m0 r0) (angular from v_0), skew(h) skew(r0)
+    for a, b, c in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
+        lin_w = h[c] - mass * r0[c]
+        out[a, 3 + b] += lin_w
+        out[b, 3 + a] -= lin_w
+        ang_v = h[c] + m0 * r0[c]
+        out[3 + a, b] -= ang_v
+        out[3 + b, a] += ang_v
+    dot = h[0] * r0[0] + h[1] * r0[1] + h[2] * r0[2]
+    for a in range(3):  # skew(h) @ skew(r0) = r0 h^T - (h . r0) 1
+        for b in range(3):
+            out[3 + a, 3 + b] += h[b] * r0[a] - (dot if a == b else 0.0)
+    return out

@@ -265,37 +265,16 @@ def momentum_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = No
     as in the composite-rigid-body algorithm): mass ``M_j``, first moment ``S_j = sum m_i c_i``
     and inertia about the root origin ``K_j = sum I_i + m_i (|c_i|^2 E - c_i c_i^T)``.  Joint
     ``j`` contributes ``z_j x (S_j - M_j p_j)`` to ``P`` and ``K_j z_j - S_j x (z_j x p_j)`` to
-    ``L``.
+    ``L``.  Computed in :func:`jointlock.dynamics._momentum_matrix_soa` (composite inertias
+    recursively in link frames, batch last).
     """
-    s = chain_state(model, q) if state is None else state
-    n = model.dof
-    batch = s.positions.shape[:-2]
-    masses = np.array([b.mass for b in model.bodies])
-    coms = com_positions(model, q, s)  # (..., n, 3)
-    first = masses[:, None] * coms  # (..., n, 3)
-    about_origin = _world_inertias(model, s) + masses[:, None, None] * (
-        np.einsum("...i,...i->...", coms, coms)[..., None, None] * np.eye(3)
-        - coms[..., :, None] * coms[..., None, :]
-    )
-    # suffix sums over the links: composite body outboard of joint j
-    mass_out = np.cumsum(masses[::-1])[::-1]  # (n,)
-    first_out = np.flip(np.cumsum(np.flip(first, -2), axis=-2), -2)  # (..., n, 3)
-    inertia_out = np.flip(np.cumsum(np.flip(about_origin, -3), axis=-3), -3)  # (..., n, 3, 3)
-    z, p = s.axes, s.positions
-    lin_cols = np.cross(z, first_out - mass_out[:, None] * p)
-    ang_cols = np.einsum("...ij,...j->...i", inertia_out, z) - np.cross(first_out, np.cross(z, p))
+    from .dynamics import _momentum_matrix_soa  # dynamics imports this module
 
-    m0, r0, i0 = model.root_body.mass, model.root_body.com, model.root_body.inertia
-    total = m0 + masses.sum()
-    first_links = first_out[..., 0, :]
-    out = np.zeros(batch + (6, 6 + n))
-    out[..., 0:3, 0:3] = total * np.eye(3)
-    out[..., 0:3, 3:6] = -skew(first_links - masses.sum() * r0)
-    out[..., 3:6, 0:3] = skew(first_links + m0 * r0)
-    out[..., 3:6, 3:6] = inertia_out[..., 0, :, :] + i0 + skew(first_links) @ skew(r0)
-    out[..., 0:3, 6:] = np.swapaxes(lin_cols, -1, -2)
-    out[..., 3:6, 6:] = np.swapaxes(ang_cols, -1, -2)
-    return out
+    s = chain_state(model, q) if state is None else state
+    q = as_joint_array(model, q)
+    flat = np.ascontiguousarray(q.reshape(-1, model.dof).T)
+    soa = _momentum_matrix_soa(model, flat, s)
+    return np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(s.batch_shape + soa.shape[:2])
 
 
 def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
