@@ -1,7 +1,12 @@
 """Writing results for people: atomic file writes, arm drawings and a self-contained HTML page.
 
 Library code here never prints.  Images are embedded as base64 PNG so a report is a single
-file that opens without a network.
+file that opens without a network: inline CSS, no scripts, no external resources (a test
+renders it in headless Chromium and checks the console stays clean).
+
+A report is a list of :class:`Section` objects rendered by :func:`render_html`: headings,
+paragraphs, key/value facts, tables (with kept/broken cells coloured), preformatted blocks
+(command lines), notes (assumptions and readings) and figures.
 """
 
 from __future__ import annotations
@@ -12,7 +17,7 @@ import io
 import json
 import os
 import tempfile
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -32,10 +37,17 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
 
 
 def atomic_write_text(path: str | Path, text: str) -> None:
@@ -82,14 +94,75 @@ def figure_png(fig: Any, dpi: int = 110) -> bytes:
     return buf.getvalue()
 
 
+def figure_svg(fig: Any) -> bytes:
+    """The figure as SVG (text kept as paths, so it renders the same everywhere)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="svg", bbox_inches="tight")
+    return buf.getvalue()
+
+
+def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = 110) -> bytes:
+    """Write ``folder/stem.png`` and ``folder/stem.svg`` atomically; returns the PNG bytes
+    (to embed in a report).  The figure is left open."""
+    png = figure_png(fig, dpi=dpi)
+    atomic_write_bytes(Path(folder) / f"{stem}.png", png)
+    atomic_write_bytes(Path(folder) / f"{stem}.svg", figure_svg(fig))
+    return png
+
+
+def arm_figure(model: ArmModel, configurations: dict[str, np.ndarray], *, title: str = "") -> Any:
+    """A 3-D drawing of ``model`` at each ``{label: q (n,) [rad]}`` (root frame, equal axes),
+    e.g. the configuration at failure and the halt configuration.  Returns the figure."""
+    import matplotlib.pyplot as plt
+
+    fig = plt.figure(figsize=(6.0, 5.0))
+    ax = fig.add_subplot(projection="3d")
+    colours = ["tab:blue", "tab:red", "tab:green", "tab:orange", "0.5"]
+    pts = []
+    for i, (label, q) in enumerate(configurations.items()):
+        draw_arm(ax, model, np.asarray(q, dtype=float), label=label, color=colours[i % len(colours)])
+        pts.append(arm_points(model, np.asarray(q, dtype=float))[0])
+    set_equal_3d(ax, np.vstack(pts))
+    ax.legend(loc="upper left", fontsize=8)
+    if title:
+        ax.set_title(title, fontsize=10)
+    return fig
+
+
+def limits_rows(
+    joints: Sequence[int], values: Sequence[float], limits: Sequence[float], quantity: str, unit: str
+) -> list[list[Any]]:
+    """Rows ``[joint, quantity, peak, limit, margin, status]`` for a limits table; status is
+    ``"kept"`` or ``"BROKEN"`` (coloured by :func:`render_html`)."""
+    rows = []
+    for j, v, lim in zip(joints, values, limits):
+        v, lim = abs(float(v)), float(lim)
+        ok = v <= lim * (1 + 1e-9)
+        rows.append([j, f"{quantity} [{unit}]", v, lim, lim - v, "kept" if ok else "BROKEN"])
+    return rows
+
+
+#: Header of :func:`limits_rows` tables.
+LIMITS_HEADER = ["joint", "quantity", "peak |value|", "limit", "margin", "status"]
+
+
 @dataclass
 class Section:
-    """One part of an HTML report: a heading, paragraphs, tables and images (PNG bytes)."""
+    """One part of an HTML report: a heading, paragraphs (HTML allowed), key/value facts,
+    tables, preformatted blocks, notes (assumptions, readings) and images (PNG bytes).
+
+    A table is ``(header, rows)`` or ``(header, rows, caption)``; a cell reading ``"kept"``,
+    ``"BROKEN"``, ``"reproduced"`` or ``"not reproduced"`` is coloured.
+    """
 
     title: str
     paragraphs: list[str] = field(default_factory=list)
-    tables: list[tuple[Sequence[str], Iterable[Sequence[Any]]]] = field(default_factory=list)
+    tables: list[tuple[Any, ...]] = field(default_factory=list)
     images: list[tuple[str, bytes]] = field(default_factory=list)
+    facts: list[tuple[str, Any]] = field(default_factory=list)
+    code: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)
+    level: int = 2
 
 
 _CSS = """
@@ -101,37 +174,105 @@ td,th{border:1px solid #ccd;padding:.3em .6em;text-align:right}th{background:#ee
 td:first-child,th:first-child{text-align:left}
 figure{margin:1em 0}figure img{max-width:100%;border:1px solid #dde}
 figcaption{font-size:.9em;color:#555}.ok{color:#176f2c}.bad{color:#b00020;font-weight:600}
+.warn{color:#8a5a00}dl.facts{display:grid;grid-template-columns:max-content auto;gap:.2em 1em}
+dl.facts dt{font-weight:600}dl.facts dd{margin:0}pre{background:#f6f8fa;padding:.6em;overflow-x:auto;
+font-size:.85em;white-space:pre-wrap}nav ul{columns:2}.notes{background:#fffbe6;border-left:4px solid #e0c050;
+padding:.4em 1em}caption{caption-side:top;text-align:left;font-weight:600;padding:.2em 0}
+@media print{nav{display:none}}
 """
 
 
+_STATUS_CLASS = {
+    "kept": "ok",
+    "reproduced": "ok",
+    "feasible": "ok",
+    "yes": "ok",
+    "BROKEN": "bad",
+    "not reproduced": "bad",
+    "INFEASIBLE": "bad",
+    "ours only": "warn",
+}
+
+
 def _cell(value: Any) -> str:
+    if value is None:
+        return "&mdash;"
+    if isinstance(value, (bool, np.bool_)):
+        return "yes" if value else "no"
     if isinstance(value, float) or isinstance(value, np.floating):
-        return f"{float(value):.6g}"
-    return html.escape(str(value))
+        v = float(value)
+        return f"{v:.6g}" if np.isfinite(v) else "&mdash;"
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return html.escape(", ".join(_cell(v) for v in value))
+    text = str(value)
+    cls = _STATUS_CLASS.get(text) or next(
+        (c for k, c in _STATUS_CLASS.items() if text.startswith(k + " ") or text.startswith(k + ":")), None
+    )
+    return f'<span class="{cls}">{html.escape(text)}</span>' if cls else html.escape(text)
 
 
-def render_html(title: str, sections: Sequence[Section], intro: str = "") -> str:
-    """A self-contained HTML page (inline CSS, images as data URIs, no scripts)."""
+def _anchor(i: int) -> str:
+    return f"s{i}"
+
+
+def render_html(
+    title: str,
+    sections: Sequence[Section],
+    intro: str = "",
+    *,
+    toc: bool = False,
+    footer: str = "",
+) -> str:
+    """A self-contained HTML page (inline CSS, images as data URIs, no scripts).
+
+    ``intro`` and paragraphs may hold HTML; everything else is escaped.  ``toc`` adds a list
+    of the sections at the top.
+    """
     parts = [
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
+        '<meta name="viewport" content="width=device-width, initial-scale=1">',
         f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
         f"<h1>{html.escape(title)}</h1>",
     ]
     if intro:
         parts.append(f"<p>{intro}</p>")
-    for sec in sections:
-        parts.append(f"<h2>{html.escape(sec.title)}</h2>")
+    if toc and sections:
+        parts.append("<nav><ul>")
+        parts.extend(
+            f'<li><a href="#{_anchor(i)}">{html.escape(sec.title)}</a></li>'
+            for i, sec in enumerate(sections)
+            if sec.level == 2
+        )
+        parts.append("</ul></nav>")
+    for i, sec in enumerate(sections):
+        tag = f"h{min(max(sec.level, 2), 4)}"
+        parts.append(f'<{tag} id="{_anchor(i)}">{html.escape(sec.title)}</{tag}>')
         parts.extend(f"<p>{p}</p>" for p in sec.paragraphs)
-        for header, rows in sec.tables:
-            parts.append("<table><tr>" + "".join(f"<th>{html.escape(h)}</th>" for h in header) + "</tr>")
+        if sec.facts:
+            parts.append('<dl class="facts">')
+            parts.extend(f"<dt>{html.escape(str(k))}</dt><dd>{_cell(v)}</dd>" for k, v in sec.facts)
+            parts.append("</dl>")
+        for table in sec.tables:
+            header, rows = table[0], table[1]
+            caption = f"<caption>{html.escape(table[2])}</caption>" if len(table) > 2 and table[2] else ""
+            parts.append(
+                f"<table>{caption}<tr>" + "".join(f"<th>{html.escape(str(h))}</th>" for h in header) + "</tr>"
+            )
             parts.extend("<tr>" + "".join(f"<td>{_cell(v)}</td>" for v in row) + "</tr>" for row in rows)
             parts.append("</table>")
+        parts.extend(f"<pre>{html.escape(block)}</pre>" for block in sec.code)
+        if sec.notes:
+            parts.append('<div class="notes"><ul>')
+            parts.extend(f"<li>{html.escape(n)}</li>" for n in sec.notes)
+            parts.append("</ul></div>")
         for caption, png in sec.images:
             uri = "data:image/png;base64," + base64.b64encode(png).decode("ascii")
             parts.append(
                 f'<figure><img src="{uri}" alt="{html.escape(caption)}">'
                 f"<figcaption>{html.escape(caption)}</figcaption></figure>"
             )
+    if footer:
+        parts.append(f"<footer><p>{footer}</p></footer>")
     parts.append("</body></html>")
     return "\n".join(parts)

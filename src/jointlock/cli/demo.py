@@ -1,15 +1,17 @@
-"""``jointlock demo``: the main job on the built-in arms, report written to a folder.
+"""``jointlock demo``: the main job on the built-in default scenario, report written to a folder.
 
-Until the halt pipeline lands this is a kinematic report of the built-in arms: forward
-kinematics, Jacobian conditioning fixed vs free-floating, the lock-equivalence check for
-every joint, the virtual manipulator, and a 3-D drawing of each arm.
+The main job is 000 §5 on ``halt7`` (joint 4 locks at 0 deg): the optimal halt configuration,
+then the optimal halt motion from 000's state at failure, with the feasibility verdict -- the
+same run as ``jointlock run examples/halt_000.toml`` (:data:`DEMO_SCENARIO`).  Then a
+kinematic overview of every built-in arm: forward kinematics, Jacobian conditioning fixed vs
+free-floating, the lock-equivalence check for every joint, the virtual manipulator, and a 3-D
+drawing.  One ``report.html``, one ``results.json`` (``robots``: the overview; ``jobs``,
+``summary``, ``scenario``: the main job).
 """
 
 from __future__ import annotations
 
 import argparse
-import math
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -22,14 +24,27 @@ from ..report import (
     Section,
     arm_points,
     atomic_write_bytes,
-    atomic_write_json,
-    atomic_write_text,
     draw_arm,
     figure_png,
-    render_html,
     set_equal_3d,
 )
 from ..robots import BUILTIN_ROBOTS, load_robot
+from ..scenario import scenario_from_dict
+from .halt import PAPER_SCENARIO
+from .run import run_jobs, summary_lines, write_results
+
+#: The built-in default scenario: 000 §5 on halt7 (the content of examples/halt_000.toml).
+DEMO_SCENARIO = {
+    "title": "000 §5: halt7 halts after joint 4 locks at 0 deg",
+    "robot": "halt7",
+    "base": "floating",
+    "seed": 0,
+    "failure": {"joint": 4, "angle_deg": 0.0},
+    "state": {k: list(PAPER_SCENARIO[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg")},
+    "limits": {"vmax_deg": PAPER_SCENARIO["vmax_deg"], "amax_deg": PAPER_SCENARIO["amax_deg"]},
+    "halt_config": {"samples": 36000, "jacobian": "generalized"},
+    "halt": {"T": PAPER_SCENARIO["T"], "base": "fixed", "solver": "scan"},
+}
 
 #: Reference configurations [deg]: 000 §5 start (joint 4 at its lock angle 0), NOTES-001's
 #: start, 002's terminal example.
@@ -80,8 +95,19 @@ def run(args: argparse.Namespace) -> int:
     import matplotlib.pyplot as plt
 
     out = Path(args.out)
-    results: dict = {"jointlock_version": __version__, "robots": {}}
-    sections = []
+    scenario = scenario_from_dict(DEMO_SCENARIO, source="built-in demo scenario (000 §5, halt7)")
+    results: dict = run_jobs(scenario, out, quiet=args.quiet)
+    results.update({"jointlock_version": __version__, "robots": {}})
+    sections = [
+        Section(
+            "The built-in arms",
+            paragraphs=[
+                "A kinematic overview of every built-in arm at a reference configuration: conditioning of "
+                "the fixed-base and generalized Jacobians, the lock-equivalence check (each joint locked "
+                "vs the full model frozen), the virtual manipulator."
+            ],
+        )
+    ]
     for name in BUILTIN_ROBOTS:
         fixed = load_robot(name)
         floating = load_robot(name, base="floating")
@@ -112,6 +138,7 @@ def run(args: argparse.Namespace) -> int:
         worst = max(max(r["pose_error_m"], r["jacobian_error"], r["mass_matrix_error"]) for r in equivalence)
         sections.append(
             Section(
+                level=3,
                 title=f"{name}: {fixed.dof} joints",
                 paragraphs=[
                     fixed.description,
@@ -161,16 +188,20 @@ def run(args: argparse.Namespace) -> int:
                 ],
             )
         )
-    atomic_write_json(out / "results.json", results)
-    atomic_write_text(
-        out / "report.html",
-        render_html("jointlock demo: the built-in arms", sections, intro=f"jointlock {__version__}."),
+    write_results(
+        scenario,
+        results,
+        out,
+        title="jointlock demo: 000's halt on halt7, and the built-in arms",
+        extra_sections=sections,
     )
     if not args.quiet:
-        print(f"wrote {out / 'report.html'} and {out / 'results.json'}", file=sys.stderr)
+        for line in summary_lines(results):
+            print(line)
         for name, r in results["robots"].items():
             print(
                 f"{name:<10} ee {np.round(r['ee_position_m'], 3).tolist()} m, "
                 f"sigma_min fixed {r['singular_values_fixed'][-1]:.4g}, floating {r['singular_values_floating'][-1]:.4g}"
             )
-    return 0 if math.isfinite(0.0) else 1
+        print(f"wrote {out / 'report.html'} and {out / 'results.json'}")
+    return 0

@@ -1,0 +1,129 @@
+"""Scenario files: validation in one place, errors that name the file, the field and what is
+allowed; the resolved scenario is plain data; CLI options override the file."""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import pytest
+
+from jointlock.errors import ScenarioError
+from jointlock.scenario import JOB_ORDER, load_scenario, parse_set, scenario_from_dict
+
+EXAMPLES = Path(__file__).resolve().parents[1] / "examples"
+
+
+def write(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("name", ["halt_000", "jump_001", "replan_002", "singular_004"])
+def test_examples_validate_and_resolve_to_plain_data(name):
+    sc = load_scenario(EXAMPLES / f"{name}.toml")
+    assert sc.jobs and set(sc.jobs) <= set(JOB_ORDER)
+    data = sc.to_dict()
+    text = json.dumps(data, allow_nan=False)  # plain data, no NaN
+    assert json.loads(text) == data
+    for job in sc.jobs:
+        assert job in data  # every job's settings, defaults filled in
+
+
+def test_defaults_are_filled_in(tmp_path):
+    sc = load_scenario(write(tmp_path, 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0\n[halt]\n'))
+    h = sc.data["halt"]
+    assert h["T"] == 10.0 and h["solver"] == "scan" and h["n_samples"] == 501
+    assert sc.data["state"]["q0_deg"] == [-180.0, -180.0, -100.0, -10.0, 20.0, 20.0]  # 000 §5.2
+    assert sc.data["seed"] == 0 and sc.data["base"] == "fixed"
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ('robot = "halt7"\nsed = 1\n[workspace]\n', ["unknown key 'sed'", "did you mean 'seed'"]),
+        (
+            'robot = "halt7"\n[workspace]\nsamles = 10\n',
+            ["[workspace]", "'samles'", "did you mean 'samples'"],
+        ),
+        ('robot = "halt7"\n[workspace]\nsamples = "many"\n', ["workspace.samples", "an integer", "'many'"]),
+        ('robot = "halt7"\n[workspace]\nsamples = -5\n', ["workspace.samples", ">= 1", "-5"]),
+        ('robot = "halt7"\n[workspace]\nvoxel = nan\n', ["workspace.voxel", "finite"]),
+        ('robot = "halt7"\nbase = "floatin"\n[workspace]\n', ["base", "did you mean 'floating'"]),
+        ('robot = "halt77"\n[workspace]\n', ["robot", "did you mean 'halt7'"]),
+        ('robot = "nope.urdf"\n[workspace]\n', ["robot", "not found", "nope.urdf"]),
+        ('robot = "halt7"\n', ["no job to run"]),
+        ('robot = "halt7"\n[halt]\nT = 10\n', ["[halt] needs the failure", "failure.joint"]),
+        ('robot = "halt7"\nT = 10\n[workspace]\n', ["unknown key 'T'", "belongs in [halt]"]),
+        (
+            'robot = "halt7"\n[failure]\njoint = 9\nangle_deg = 0\n[workspace]\n',
+            ["failure.joint", "1..7", "9"],
+        ),
+        (
+            'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0\n[state]\nq0_deg = [1, 2]\n[halt]\n',
+            ["state.q0_deg", "6 or 7 values", "got 2"],
+        ),
+        ('robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0\n[halt]\nn_samples = 500\n', ["odd"]),
+        ('robot = "canadarm7"\n[jump]\nduration_s = 12.01\n', ["[jump]", "whole number"]),
+        ('robot = "halt7"\n[workspace\n', ["not valid TOML"]),
+    ],
+)
+def test_errors_name_file_field_and_what_is_allowed(tmp_path, text, words):
+    path = write(tmp_path, text)
+    with pytest.raises(ScenarioError) as err:
+        load_scenario(path)
+    msg = str(err.value)
+    assert str(path) in msg and "\n" not in msg
+    for w in words:
+        assert w in msg
+
+
+def test_missing_scenario_file(tmp_path):
+    with pytest.raises(ScenarioError, match="does not exist"):
+        load_scenario(tmp_path / "missing.toml")
+
+
+def test_model_file_paths_are_resolved_against_the_scenario(tmp_path):
+    data = Path(__file__).parent / "data" / "arm5.urdf"
+    sub = tmp_path / "sub"
+    sub.mkdir()
+    (sub / "arm.urdf").write_text(data.read_text())
+    sc = load_scenario(write(sub, 'robot = "arm.urdf"\n[workspace]\nsamples = 10\n'))
+    assert Path(sc.data["robot"]) == (sub / "arm.urdf").resolve()
+
+
+@pytest.mark.parametrize(
+    "content, suffix",
+    [("<robot><link name='a'></robot", ".urdf"), ("[[joint]]\na_m = 'x'\n", ".toml"), ("", ".urdf")],
+)
+def test_malformed_model_files(tmp_path, content, suffix):
+    (tmp_path / f"arm{suffix}").write_text(content)
+    with pytest.raises(ScenarioError) as err:
+        load_scenario(write(tmp_path, f'robot = "arm{suffix}"\n[workspace]\n'))
+    assert "robot" in str(err.value) and f"arm{suffix}" in str(err.value)
+
+
+def test_overrides_win_over_the_file(tmp_path):
+    path = write(tmp_path, 'robot = "puma6"\nseed = 1\n[workspace]\nsamples = 100\n')
+    sc = load_scenario(
+        path, {"seed": 7, "workspace.samples": 20, "failure.joint": 2, "failure.angle_deg": 30.0}
+    )
+    assert sc.data["seed"] == 7 and sc.data["workspace"]["samples"] == 20 and sc.lock == (2, 30.0)
+    assert parse_set("halt.T=12") == ("halt.T", 12)
+    assert parse_set("halt.solver=ga") == ("halt.solver", "ga")
+    assert parse_set("state.q0_deg=[1, 2.5]") == ("state.q0_deg", [1, 2.5])
+
+
+def test_jobs_list_selects_and_orders(tmp_path):
+    sc = scenario_from_dict(
+        {
+            "robot": "puma6",
+            "jobs": ["workspace"],
+            "failure": {"joint": 2, "angle_deg": 60.0},
+            "replan": {"from_deg": [0] * 6, "to_deg": [1] * 6},
+        }
+    )
+    assert sc.jobs == ("workspace",)
+    assert math.isclose(sc.lock[1], 60.0)
