@@ -339,8 +339,9 @@ def run(args: argparse.Namespace) -> int:
         lo, hi = res.k_interval / K_UNIT_SCALE["deg/s^6"]
         print(f"\nfeasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}")
         print(f"k* = {np.array2string(kd, precision=6)} deg/s^6")
+    at = "k*" if res.feasible else "least-violating k (infeasible)"
     print(
-        f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; k*: {res.global_torque:.4f} N m "
+        f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
         f"({100 * res.reduction:.1f} % lower)"
     )
     print("000 printed: k = 0.0018, 22.25 -> 15.55 N m (30.1 %) -- not reproduced, see docs/halt-motion.md")
