@@ -16,6 +16,7 @@ from jointlock.cli import main
 from jointlock.errors import ConfigurationError, ModelError
 from jointlock.ik import ik_closed_form, wrap_angle
 from jointlock.planning.replan import (
+    ReplanResult,
     absorbable_range,
     gamma_sweep,
     gammas_for_lock,
@@ -147,6 +148,138 @@ def test_replan_tolerance_absorbs_more(puma):
     assert np.abs(np.degrees(wrap_angle(loose.q_full[-1])) - EQ22_DEG).max() < 1e-4
 
 
+# 002 §"... (fault-tolerant attitude error <= 10 deg)": the line whose pointwise plan jumps
+Q0_B = np.radians([0, 30, 30, 10, -80, 30])
+LOCK_B = math.radians(52.0547)
+
+
+@pytest.fixture(scope="module")
+def plans_b(puma):
+    """002's second example (41 steps, 250 ms, gamma within 10 deg): pointwise vs continuous."""
+    locked = jl.lock(puma, 2, LOCK_B)
+    start, goal = jl.ee_pose(puma, Q0_B), jl.ee_pose(puma, QD_B)
+    kw = dict(steps=40, cycle=0.25, gamma_tolerance=math.radians(10.0), q_ref=QD_B)
+    return (
+        locked,
+        replan_line(locked, start, goal, method="pointwise", **kw),
+        replan_line(locked, start, goal, **kw),
+    )
+
+
+def _path_length_inf(res: ReplanResult) -> float:
+    """Joint-space path length in the max norm: sum over steps of the largest joint change [rad]."""
+    return float(res.joint_step.max(axis=1).sum())
+
+
+def test_pointwise_plan_of_002_second_example_jumps(plans_b):
+    """The first implementation switches gamma from -10 to +10 deg at t = 5.75 s: joint 1 jumps 160 deg."""
+    _, pointwise, _ = plans_b
+    assert pointwise.method == "pointwise"
+    assert math.degrees(pointwise.max_joint_step) == pytest.approx(160.29, abs=0.01)
+    assert pointwise.max_joint_step_at == (23, 1)
+    assert (
+        math.degrees(pointwise.gamma[23]) == pytest.approx(-10.0)
+        and math.degrees(pointwise.gamma[24]) == 10.0
+    )
+    flagged = {(f.index, f.joint) for f in pointwise.jumps}
+    assert (23, 1) in flagged and (23, 6) in flagged
+    assert all(f.step > pointwise.jump_threshold for f in pointwise.jumps)
+    assert pointwise.max_joint_step > 0.5 * _path_length_inf(pointwise)  # one step is most of the path
+
+
+def test_continuous_plan_of_002_second_example_has_no_jump(plans_b):
+    locked, pointwise, res = plans_b
+    assert res.method == "continuous"
+    steps = res.joint_step.max(axis=1)
+    # no step above a tenth of the path length (max norm) nor above 4x the mean step
+    assert res.max_joint_step <= 0.1 * _path_length_inf(res)
+    assert res.max_joint_step <= 4.0 * steps.mean()
+    assert math.degrees(res.max_joint_step) < 20.0 < math.degrees(pointwise.max_joint_step) / 8
+    assert res.jumps == ()
+    assert np.array_equal(res.joint_step, np.abs(np.diff(res.q, axis=0)))
+    assert np.all(np.abs(np.diff(res.q, axis=0)) < math.pi)  # q is continuous, no 2 pi wrap inside
+    # gamma stays within the tolerance
+    assert np.all(np.abs(res.gamma) <= math.radians(10.0) + 1e-12)
+    # the goal is the pose of eq. (21) on eq. (22)'s branch (the exact root -10.000015 deg is
+    # 1.5e-5 deg outside the tolerance, so gamma = -10 deg and the arm misses by < 1e-7 m)
+    assert math.degrees(res.gamma[-1]) == pytest.approx(-10.0, abs=1e-9)
+    assert np.abs(np.degrees(wrap_angle(res.q_full[-1])) - EQ22_DEG).max() < 1e-4
+    assert res.absorbed[-1] and res.position_error[-1] < 1e-7
+
+
+def test_continuous_plan_reports_tracking_error_honestly(plans_b):
+    locked, pointwise, res = plans_b
+    # the tracking error is the locked arm's FK against nominal Rx(gamma), recomputed here
+    target = tool_x_rotation(res.nominal, res.gamma)
+    dp, dr = pose_error(target, jl.ee_pose(locked, res.q))
+    assert np.allclose(dp, res.position_error, atol=1e-12, rtol=0)
+    assert np.allclose(dr, res.rotation_error, atol=1e-12, rtol=0)
+    assert np.array_equal(res.absorbed, (dp <= 1e-7) & (dr <= 1e-7))
+    # the lock is absorbed exactly at the start and end of the line (20 of 42 waypoints) ...
+    assert res.absorbed.sum() >= 18
+    assert res.position_error[res.absorbed].max() < 1e-7
+    # ... and where it is not, the price of continuity is a larger (reported) tracking error
+    # than the jumping plan's: up to ~109 mm instead of 72 mm, as the line passes near the
+    # base axis (joint 1 has to turn 170 deg)
+    assert 0.06 < pointwise.position_error.max() < 0.08
+    assert 0.08 < res.position_error.max() < 0.13
+    assert np.all(res.rotation_error < 1e-9)  # the joint-2-locked closed form keeps the orientation
+    assert np.abs(np.degrees(res.q_full[-1, 0] - res.q_full[0, 0])) > 150
+
+
+def test_continuous_plan_tolerances_and_weights(puma):
+    locked = jl.lock(puma, 2, LOCK_B)
+    start, goal = jl.ee_pose(puma, Q0_B), jl.ee_pose(puma, QD_B)
+    for tol_deg in (0.0, 3.0, 10.5):
+        res = replan_line(locked, start, goal, steps=15, gamma_tolerance=math.radians(tol_deg), q_ref=QD_B)
+        assert np.all(np.abs(res.gamma) <= math.radians(tol_deg) + 1e-12)
+        assert res.position_error[res.absorbed].max(initial=0.0) < 1e-7
+    # a heavier step weight never gives a larger largest step here; a light one drifts to the jump
+    kw = dict(steps=40, gamma_tolerance=math.radians(10.0), q_ref=QD_B)
+    heavy = replan_line(locked, start, goal, step_weight=2.0, **kw)
+    light = replan_line(locked, start, goal, step_weight=0.01, **kw)  # 78 deg on joint 1
+    assert heavy.max_joint_step < math.radians(12.0)
+    assert light.max_joint_step > math.radians(60.0) and light.jumps
+    with pytest.raises(ConfigurationError, match="method"):
+        replan_line(locked, start, goal, method="greedy")
+    with pytest.raises(ConfigurationError, match="step_weight"):
+        replan_line(locked, start, goal, step_weight=-1.0)
+
+
+def test_continuous_equals_pointwise_when_lock_matches(puma):
+    """002's first example (no tolerance): gamma = 0 everywhere, both choose the same branch."""
+    locked = jl.lock(puma, 2, math.radians(60.0))
+    start = jl.ee_pose(puma, np.radians([0, 60, 30, 10, -80, 30]))
+    goal = jl.ee_pose(puma, QD_B)
+    a = replan_line(locked, start, goal, steps=40, q_ref=QD_B, method="pointwise")
+    b = replan_line(locked, start, goal, steps=40, q_ref=QD_B)
+    assert np.allclose(a.q, b.q, atol=1e-12) and np.all(b.gamma == 0)
+    assert math.degrees(b.max_joint_step) == pytest.approx(1.538, abs=1e-3) and b.jumps == ()
+
+
+def test_velocity_limits_flagged(puma):
+    """Steps needing more than a joint's speed limit at the cycle time are listed."""
+    from dataclasses import replace
+
+    limit = math.radians(30.0)
+    slow = replace(puma, joints=tuple(replace(j, velocity_limit=limit) for j in puma.joints))
+    locked = jl.lock(slow, 2, LOCK_B)
+    start, goal = jl.ee_pose(puma, Q0_B), jl.ee_pose(puma, QD_B)
+    res = replan_line(locked, start, goal, steps=40, gamma_tolerance=math.radians(10.0), q_ref=QD_B)
+    assert np.all(res.velocity_limit == limit)
+    over = res.joint_step / 0.25 > limit
+    assert len(res.over_velocity) == over.sum() > 0
+    assert {(f.index, f.joint) for f in res.over_velocity} == {
+        (i, locked.joint_numbers[j]) for i, j in zip(*np.nonzero(over))
+    }
+    assert all(f.rate > f.limit == limit for f in res.over_velocity)
+    fast = replace(puma, joints=tuple(replace(j, velocity_limit=math.radians(100.0)) for j in puma.joints))
+    res = replan_line(
+        jl.lock(fast, 2, LOCK_B), start, goal, steps=40, gamma_tolerance=math.radians(10), q_ref=QD_B
+    )
+    assert res.over_velocity == ()
+
+
 def test_replan_errors(puma):
     with pytest.raises(ModelError, match="locked"):
         replan_line(puma, np.eye(4), np.eye(4))
@@ -224,6 +357,23 @@ def test_cli_replan(capsys, tmp_path):
     assert out["q_goal_deg"] == pytest.approx([5, 60, 65, 10, -120, 90], abs=1e-7)
     for name in ("joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv"):
         assert (tmp_path / name).exists()
+    assert out["method"] == "continuous" and out["jumps"] == []
+    assert out["max_joint_step_deg"] < 10 and out["max_joint_step_at"]["joint"] in (1, 3, 4, 5, 6)
+
+
+def test_cli_replan_reports_the_jump(capsys):
+    """002's second example: the pointwise plan's jump is reported, the continuous plan has none."""
+    argv = ["replan", "puma6", "--from-deg", "0", "30", "30", "10", "-80", "30", "--to-deg", "5", "60"]
+    argv += ["65", "10", "-120", "90", "--lock", "2=52.0547", "--tolerance-deg", "10", "--json"]
+    old = _json(capsys, argv + ["--method", "pointwise"])
+    new = _json(capsys, argv)
+    assert old["max_joint_step_at"] == {"step": 23, "time_s": 5.75, "joint": 1}
+    assert old["max_joint_step_deg"] == pytest.approx(160.29, abs=0.01)
+    assert {"step": 23, "joint": 1} in [{"step": j["step"], "joint": j["joint"]} for j in old["jumps"]]
+    assert new["jumps"] == [] and new["max_joint_step_deg"] < 20
+    assert new["velocity_limit_deg_s"] == [None] * 5 and new["over_velocity"] == []
+    assert -10 - 1e-9 <= new["gamma_deg_range"][0] and new["gamma_deg_range"][1] <= 10 + 1e-9
+    assert new["max_tracking_position_error_m"] > old["max_tracking_position_error_m"]
 
 
 def test_cli_ik_installed_entry_point():

@@ -12,7 +12,7 @@ from ..errors import ScenarioError
 from ..ik import zyx_angles
 from ..kinematics import ee_pose
 from ..locking import lock
-from ..planning.replan import replan_line
+from ..planning.replan import DEFAULT_STEP_WEIGHT, replan_line
 from ..robots import load_robot
 from ._common import add_robot_arguments, print_json
 
@@ -24,7 +24,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Start and goal are the poses of the full-arm joint vectors --from-deg and --to-deg; the "
             "line (002 eqs. 19-20) is followed by the arm with --lock, each waypoint rotated about the "
-            "tool x axis by the smallest |gamma| <= --tolerance-deg that the lock can absorb."
+            "tool x axis by some |gamma| <= --tolerance-deg.  --method continuous (default) chooses "
+            "gamma and the IK branch along the whole path (shortest path: tracking error plus "
+            "--step-weight times the squared joint steps), so the joints do not jump; --method "
+            "pointwise takes the smallest |gamma| that absorbs the lock at each waypoint on its own. "
+            "The largest joint step, every jump and every step over a joint's speed limit are reported."
         ),
     )
     add_robot_arguments(p)
@@ -36,6 +40,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--cycle", type=float, default=0.25, help="time between points [s] (002: 0.25)")
     p.add_argument(
         "--tolerance-deg", type=float, default=0.0, help="largest |gamma| accepted [deg] (default 0)"
+    )
+    p.add_argument(
+        "--method",
+        choices=("continuous", "pointwise"),
+        default="continuous",
+        help="choose gamma and branch along the path (default) or at each waypoint alone",
+    )
+    p.add_argument(
+        "--step-weight",
+        type=float,
+        default=DEFAULT_STEP_WEIGHT,
+        metavar="M_PER_RAD2",
+        help=f"continuous: tracking error [m] traded per rad^2 of joint step (default {DEFAULT_STEP_WEIGHT:g})",
+    )
+    p.add_argument(
+        "--jump-deg",
+        type=float,
+        default=None,
+        metavar="DEG",
+        help="flag joint steps above this [deg] (default: 5x the median step, at least 2 deg)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", type=Path, metavar="DIR", help="write plots, trajectory.csv and plan.json here")
@@ -56,6 +80,10 @@ def run(args: argparse.Namespace) -> int:
         raise ScenarioError(f"--cycle must be > 0 [s]; got {args.cycle}")
     if not (0 <= args.tolerance_deg <= 180):
         raise ScenarioError(f"--tolerance-deg must be in [0, 180]; got {args.tolerance_deg}")
+    if not (args.step_weight >= 0):
+        raise ScenarioError(f"--step-weight must be >= 0; got {args.step_weight}")
+    if args.jump_deg is not None and not (args.jump_deg > 0):
+        raise ScenarioError(f"--jump-deg must be > 0; got {args.jump_deg}")
     model = lock(full, joint, angle)
     q_to = np.radians(args.to_deg)
     start, goal = ee_pose(full, np.radians(args.from_deg)), ee_pose(full, q_to)
@@ -67,7 +95,11 @@ def run(args: argparse.Namespace) -> int:
         cycle=args.cycle,
         gamma_tolerance=math.radians(args.tolerance_deg),
         q_ref=q_to,
+        method=args.method,
+        step_weight=args.step_weight,
+        jump_threshold=None if args.jump_deg is None else math.radians(args.jump_deg),
     )
+    step_at, step_joint = res.max_joint_step_at
     summary = {
         "robot": full.name,
         "lock": {"joint": joint, "angle_deg": math.degrees(angle)},
@@ -85,6 +117,17 @@ def run(args: argparse.Namespace) -> int:
         "q_start_deg": np.degrees(res.q_full[0]),
         "q_goal_deg": np.degrees(res.q_full[-1]),
         "gamma_goal_deg": float(np.degrees(res.gamma[-1])),
+        "method": res.method,
+        "step_weight": args.step_weight,
+        "mean_tracking_position_error_m": float(res.position_error.mean()),
+        "max_joint_step_deg": math.degrees(res.max_joint_step),
+        "max_joint_step_at": {"step": step_at, "time_s": float(res.times[step_at]), "joint": step_joint},
+        "max_joint_step_per_joint_deg": np.degrees(res.joint_step.max(axis=0)) if res.joint_step.size else [],
+        "max_step_rate_deg_s": np.degrees(res.step_rate.max(axis=0)) if res.joint_step.size else [],
+        "velocity_limit_deg_s": [v if math.isfinite(v) else None for v in np.degrees(res.velocity_limit)],
+        "jump_threshold_deg": math.degrees(res.jump_threshold),
+        "jumps": [_flag(f, "deg") for f in res.jumps],
+        "over_velocity": [_flag(f, "deg_s") for f in res.over_velocity],
     }
     trajectory = {
         "time_s": res.times,
@@ -109,10 +152,40 @@ def run(args: argparse.Namespace) -> int:
         f"  max tracking error: {summary['max_tracking_position_error_m'] * 1e3:.4f} mm, "
         f"{summary['max_tracking_rotation_error_deg']:.4g} deg"
     )
+    print(
+        f"  largest joint step: {summary['max_joint_step_deg']:.4g} deg (joint {step_joint}, waypoint "
+        f"{step_at} -> {step_at + 1}, t = {res.times[step_at]:g} s); jump threshold "
+        f"{summary['jump_threshold_deg']:.4g} deg"
+    )
+    for f in res.jumps:
+        print(
+            f"  JUMP: joint {f.joint} moves {math.degrees(f.step):.4g} deg between t = {f.time:g} s and "
+            f"{f.time + res.cycle:g} s ({math.degrees(f.rate):.4g} deg/s)"
+        )
+    if res.over_velocity:
+        worst = max(res.over_velocity, key=lambda f: f.rate / f.limit)
+        print(
+            f"  {len(res.over_velocity)} joint steps exceed the speed limit; worst: joint {worst.joint} at "
+            f"t = {worst.time:g} s needs {math.degrees(worst.rate):.4g} deg/s (limit {math.degrees(worst.limit):.4g})"
+        )
+    elif np.all(np.isfinite(res.velocity_limit)):
+        print("  every joint step is within the speed limits at this cycle")
     print("  goal q [deg]: " + " ".join(f"{v:.4f}" for v in summary["q_goal_deg"]))
     for f in summary.get("files", []):
         print(f"wrote {f}")
     return 0
+
+
+def _flag(f, unit: str) -> dict:
+    lim = math.degrees(f.limit)
+    return {
+        "step": f.index,
+        "time_s": f.time,
+        "joint": f.joint,
+        "step_deg": math.degrees(f.step),
+        "rate_deg_s": math.degrees(f.rate),
+        f"limit_{unit}": lim,
+    }
 
 
 def _write(out_dir: Path, res, summary, trajectory) -> list[str]:

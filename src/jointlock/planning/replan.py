@@ -10,9 +10,11 @@
 * :func:`gammas_for_lock` -- step 5: every ``gamma`` at which the full-arm IK puts the
   locked joint exactly at its locked angle (bracketing on a grid, then vectorised
   bisection), with the joint solution at each.
-* :func:`replan_line` -- step 6 and eqs. (19)-(20): a straight Cartesian line, each
-  waypoint rotated by the smallest admissible ``gamma`` and solved with the locked-arm
-  closed form; joint trajectories, poses and tracking errors.
+* :func:`replan_line` -- step 6 and eqs. (19)-(20): a straight Cartesian line solved with
+  the locked-arm closed form, ``gamma`` (within the tolerance) and the branch chosen along
+  the whole path (shortest path over waypoint x gamma x branch, tracking error against the
+  squared joint steps) so that the joints do not jump; joint trajectories, poses, tracking
+  errors, the largest joint step, jumps and speed-limit excesses.
 
 Everything is batched over ``gamma`` and over waypoints; SI units and radians.
 """
@@ -20,13 +22,22 @@ Everything is batched over ``gamma`` and over waypoints; SI units and radians.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ConfigurationError, ModelError
-from ..ik import Puma6Geometry, _as_poses, ik_closed_form, puma6_branches, puma6_geometry, wrap_angle
+from ..ik import (
+    EXACT_POSITION_TOL,
+    EXACT_ROTATION_TOL,
+    Puma6Geometry,
+    _as_poses,
+    ik_closed_form,
+    puma6_branches,
+    puma6_geometry,
+    wrap_angle,
+)
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose_error, rot_x, rotation_log
@@ -333,6 +344,53 @@ def line_waypoints(start: ArrayLike, goal: ArrayLike, steps: int) -> FloatArray:
     return out
 
 
+#: Gamma grid step of the continuous plan's path search [rad]; absorbed waypoints are then
+#: refined to the exact root within one cell either side.
+PATH_GAMMA_STEP = math.radians(0.25)
+#: Most gamma values per waypoint in the path search (the grid coarsens beyond).
+PATH_MAX_GAMMAS = 161
+#: Golden-section steps of that refinement (a cell shrinks by 0.618**64 ~ 4e-14).
+REFINE_STEPS = 64
+#: Default weight of the squared joint step against the tracking error [m / rad^2].
+DEFAULT_STEP_WEIGHT = 0.5
+#: The goal's tracking error counts this many times (the task is to reach it).
+GOAL_WEIGHT = 100.0
+#: Default jump threshold: this many times the median largest joint step ...
+JUMP_MEDIAN_FACTOR = 5.0
+#: ... and at least this [rad].
+JUMP_MIN_STEP = math.radians(2.0)
+
+_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
+
+
+@dataclass(frozen=True)
+class StepFlag:
+    """One joint's motion between waypoints ``index`` and ``index + 1`` that is flagged.
+
+    Attributes
+    ----------
+    index
+        The step goes from waypoint ``index`` to ``index + 1``.
+    time
+        [s] at waypoint ``index``.
+    joint
+        Full-arm number (1-based) of the joint.
+    step
+        Its change over the step [rad] (absolute, wrapped).
+    rate
+        ``step / cycle`` [rad/s].
+    limit
+        The threshold it exceeds: [rad] for a jump, [rad/s] for a velocity limit.
+    """
+
+    index: int
+    time: float
+    joint: int
+    step: float
+    rate: float
+    limit: float
+
+
 @dataclass(frozen=True)
 class ReplanResult:
     """A straight Cartesian plan executed by the locked arm.
@@ -342,15 +400,17 @@ class ReplanResult:
     times
         (K,) [s], ``cycle`` apart (002: 250 ms).
     q
-        (K, n) movable-joint angles [rad], continuous in time.
+        (K, n) movable-joint angles [rad], unwrapped in time.
     q_full
         (K, 6) with the locked joint [rad].
     dq
         (K, n) joint rates [rad/s] (central differences).
     gamma
-        (K,) rotation about the tool x axis chosen at each waypoint [rad].
+        (K,) rotation about the tool x axis chosen at each waypoint [rad], within the tolerance.
     absorbed
-        (K,) a gamma within the tolerance puts the full-arm IK exactly on the lock.
+        (K,) the lock is absorbed exactly: the locked arm reaches ``nominal Rx(gamma)``
+        (tracking error within :data:`jointlock.ik.EXACT_POSITION_TOL` /
+        :data:`~jointlock.ik.EXACT_ROTATION_TOL`).
     nominal
         (K, 4, 4) the straight-line poses [m].
     target
@@ -364,7 +424,20 @@ class ReplanResult:
     ee_velocity
         (K, 6) end-effector twist ``(v, omega)`` [m/s, rad/s], finite differences, root frame.
     joint, lock_angle, gamma_tolerance, branch, cycle
-        The settings.
+        The settings (``branch``: the full-arm branch followed at the goal).
+    joint_step
+        (K-1, n) ``|q[k+1] - q[k]|`` per movable joint [rad].
+    velocity_limit
+        (n,) the model's joint speed limits [rad/s] (``inf`` when unknown).
+    jump_threshold
+        A step of any joint above this is a jump [rad].
+    jumps
+        Every (step, joint) above ``jump_threshold``, in time order.
+    over_velocity
+        Every (step, joint) whose ``joint_step / cycle`` exceeds the joint's speed limit.
+    method
+        ``"continuous"`` (gamma and branch chosen along the path) or ``"pointwise"``
+        (each waypoint on its own, the first implementation).
     """
 
     times: FloatArray
@@ -386,6 +459,32 @@ class ReplanResult:
     gamma_tolerance: float
     branch: int
     cycle: float
+    joint_step: FloatArray = field(default_factory=lambda: np.zeros((0, 0)))
+    velocity_limit: FloatArray = field(default_factory=lambda: np.zeros(0))
+    jump_threshold: float = math.inf
+    jumps: tuple[StepFlag, ...] = ()
+    over_velocity: tuple[StepFlag, ...] = ()
+    method: str = "pointwise"
+
+    @property
+    def max_joint_step(self) -> float:
+        """Largest change of any joint between neighbouring waypoints [rad]."""
+        return float(self.joint_step.max()) if self.joint_step.size else 0.0
+
+    @property
+    def max_joint_step_at(self) -> tuple[int, int]:
+        """``(index, joint)``: the step ``index -> index + 1`` and the full-arm joint number
+        of :attr:`max_joint_step`."""
+        if not self.joint_step.size:
+            return (0, 0)
+        i, j = np.unravel_index(int(np.argmax(self.joint_step)), self.joint_step.shape)
+        numbers = [n for n in range(1, self.q_full.shape[1] + 1) if n != self.joint]
+        return int(i), int(numbers[j])
+
+    @property
+    def step_rate(self) -> FloatArray:
+        """(K-1, n) ``joint_step / cycle`` [rad/s]: the speed each step needs."""
+        return self.joint_step / self.cycle
 
 
 def replan_line(
@@ -399,16 +498,36 @@ def replan_line(
     q_ref: ArrayLike | None = None,
     branch: int | None = None,
     gamma_step: float = math.radians(0.05),
+    method: str = "continuous",
+    step_weight: float = DEFAULT_STEP_WEIGHT,
+    length_scale: float = 1.0,
+    jump_threshold: float | None = None,
 ) -> ReplanResult:
     """Straight-line Cartesian re-planning through the locked-arm closed-form IK (002 §§
     "Fault-tolerant trajectory planning", eqs. 19-20, Figs. 10-21).
 
-    For every waypoint at once: the gamma grid in ``[-tol, tol]`` is searched for a root of
-    ``theta_j(gamma) = lock`` on the followed full-arm branch (bisected to machine
-    precision, smallest ``|gamma|`` kept); without a root the gamma minimising
-    ``|theta_j(gamma) - lock|`` is taken.  The waypoint ``nominal Rx(gamma)`` is then solved
-    with the locked arm's closed form (002 step 6), taking the branch nearest to the
-    full-arm solution; what it misses is the tracking error.
+    Every waypoint ``nominal Rx(gamma)`` is solved with the locked arm's closed form (002
+    step 6); what the locked arm misses is the tracking error.  ``gamma`` (within the
+    tolerance) and the locked-arm branch are chosen by ``method``:
+
+    ``"continuous"`` (default)
+        One shortest path over (waypoint x gamma grid x branch), all waypoints and
+        candidates batched: the cost is ``sum_k e_k + step_weight * sum_k |q_{k+1} - q_k|^2``
+        with ``e = position error + length_scale * rotation error`` [m] and the step in
+        radians (wrapped), the goal held on the followed full-arm branch.  Where the path
+        passes a gamma cell holding an exact root, gamma is refined to it (golden section
+        within one cell either side, so the joints move by at most that), so the lock is
+        absorbed exactly wherever the path can.  Where the lock cannot be absorbed the path
+        moves gamma gradually rather than jumping between ``-tol`` and ``+tol``.
+    ``"pointwise"``
+        The first implementation, each waypoint on its own: the smallest ``|gamma|`` root of
+        ``theta_j(gamma) = lock`` on the followed full-arm branch, else the ``gamma``
+        minimising ``|theta_j(gamma) - lock|``, then the locked branch nearest the full-arm
+        solution.  Neighbouring waypoints can switch between ``-tol`` and ``+tol`` or between
+        branches, and the joints then jump (kept for comparison).
+
+    Either way the result lists the largest joint step, every jump above ``jump_threshold``
+    and every step that needs more than a joint's speed limit at this ``cycle``.
 
     Parameters
     ----------
@@ -423,10 +542,20 @@ def replan_line(
     gamma_tolerance
         Largest ``|gamma|`` accepted [rad] (0: the line's orientation is kept).
     q_ref, branch
-        Full-arm branch to follow (default: the branch nearest the locked arm's closed-form
-        solution of the goal, i.e. chosen by ``q_ref`` if given).
+        Full-arm branch to follow at the goal (default: the branch nearest the locked arm's
+        closed-form solution of the goal, i.e. chosen by ``q_ref`` if given).
     gamma_step
-        Grid step for bracketing [rad].
+        Grid step for bracketing roots (``"pointwise"``) [rad]; the continuous path search
+        uses ``max(gamma_step, PATH_GAMMA_STEP)`` with at most ``PATH_MAX_GAMMAS`` values.
+    method
+        ``"continuous"`` or ``"pointwise"``.
+    step_weight
+        [m / rad^2]: tracking error traded for one rad^2 of squared joint step.
+    length_scale
+        [m / rad]: weight of the rotation error in the tracking error.
+    jump_threshold
+        [rad]; default ``max(JUMP_MEDIAN_FACTOR * median step, JUMP_MIN_STEP)``, the median
+        taken over the steps' largest joint change.
     """
     geom_locked = puma6_geometry(model)
     if geom_locked.lock is None:
@@ -435,6 +564,14 @@ def replan_line(
         raise ConfigurationError(f"cycle must be > 0 [s]; got {cycle}")
     if not (gamma_tolerance >= 0):
         raise ConfigurationError(f"gamma_tolerance must be >= 0 [rad]; got {gamma_tolerance}")
+    if method not in ("continuous", "pointwise"):
+        raise ConfigurationError(f"method must be 'continuous' or 'pointwise'; got {method!r}")
+    if not (step_weight >= 0) or not (length_scale >= 0):
+        raise ConfigurationError(
+            f"step_weight and length_scale must be >= 0; got {step_weight}, {length_scale}"
+        )
+    if jump_threshold is not None and not (jump_threshold > 0):
+        raise ConfigurationError(f"jump_threshold must be > 0 [rad]; got {jump_threshold}")
     joint, angle = geom_locked.lock
     geom = Puma6Geometry(geom_locked.a2, geom_locked.d4, geom_locked.d6, geom_locked.tool, None)
     nominal = line_waypoints(start, goal, steps)
@@ -446,42 +583,30 @@ def replan_line(
         q_ref = sol.q_full[i]
     b = _pick_branch(geom, goal_t, None if q_ref is None else np.asarray(q_ref, dtype=float), branch)
 
-    count = max(1, 2 * int(math.ceil(gamma_tolerance / gamma_step)) + 1) if gamma_tolerance > 0 else 1
-    grid = np.linspace(-gamma_tolerance, gamma_tolerance, count)
-    f = wrap_angle(_locked_value(geom, nominal[:, None], grid[None, :], b, joint) - angle)  # (K, G)
-    gamma = grid[np.argmin(np.where(np.isfinite(f), np.abs(f), np.inf), axis=1)]
-    absorbed = np.zeros(k, dtype=bool)
-    if count > 1:
-        brk = _brackets(f)  # (K, G-1)
-        mid = 0.5 * (grid[:-1] + grid[1:])
-        score = np.where(brk, np.abs(mid), np.inf)
-        j = np.argmin(score, axis=1)
-        has = np.isfinite(score[np.arange(k), j])
-        if np.any(has):
-            rows = np.flatnonzero(has)
-            g_root = _bisect(
-                geom, nominal[rows], grid[j[rows]], grid[j[rows] + 1], f[rows, j[rows]], b, joint, angle
-            )
-            gamma[rows] = g_root
-            absorbed[rows] = True
-    absorbed |= np.abs(wrap_angle(_locked_value(geom, nominal, gamma, b, joint) - angle)) < 1e-9
+    if method == "pointwise":
+        gamma, q = _pointwise_plan(model, geom, nominal, b, joint, angle, gamma_tolerance, gamma_step)
+    else:
+        gamma, q = _continuous_plan(
+            model,
+            geom_locked,
+            geom,
+            nominal,
+            b,
+            gamma_tolerance,
+            max(gamma_step, PATH_GAMMA_STEP),
+            step_weight,
+            length_scale,
+        )
 
     target = tool_x_rotation(nominal, gamma)
-    full_q, full_valid = _full_branches(geom, target)
-    ref = full_q[:, b, :]
-    locked = ik_closed_form(model, target)  # (K, 4)
-    dist = np.max(np.abs(wrap_angle(locked.q_full - ref[:, None, :])), axis=-1)
-    cost = np.where(locked.valid, locked.position_error + locked.rotation_error, np.inf)
-    # prefer the branch on the followed full-arm solution; else the most accurate one
-    choice = np.where(
-        full_valid[:, b], np.argmin(np.where(locked.valid, dist, np.inf), axis=1), np.argmin(cost, 1)
-    )
-    q = locked.q[np.arange(k), choice]
     q = np.unwrap(q, axis=0)
     q_full = model.expand(q)
     actual = ee_pose(model, q)
     perr, rerr = pose_error(target, actual)
     pdev, rdev = pose_error(nominal, actual)
+    absorbed = (perr <= EXACT_POSITION_TOL) & (rerr <= EXACT_ROTATION_TOL)
+    if method == "pointwise":  # the first implementation's flag: a root on the followed branch
+        absorbed |= _pointwise_absorbed(geom, nominal, gamma, b, joint, angle, gamma_tolerance, gamma_step)
     times = np.arange(k) * cycle
     dq = np.gradient(q, cycle, axis=0) if k > 1 else np.zeros_like(q)
     if k > 1:
@@ -493,6 +618,15 @@ def replan_line(
         vel = np.concatenate([v, w], axis=1)
     else:
         vel = np.zeros((k, 6))
+
+    step = np.abs(np.diff(q, axis=0))  # (K-1, n), q is unwrapped
+    vlim = np.array([jt.velocity_limit for jt in model.joints], dtype=float)
+    if jump_threshold is None:
+        typical = float(np.median(step.max(axis=1))) if step.size else 0.0
+        jump_threshold = max(JUMP_MEDIAN_FACTOR * typical, JUMP_MIN_STEP)
+    numbers = model.joint_numbers
+    jumps = _flags(step, times, cycle, numbers, np.full(step.shape[1], float(jump_threshold)), per_rate=False)
+    over = _flags(step, times, cycle, numbers, vlim, per_rate=True)
     return ReplanResult(
         times,
         q,
@@ -513,4 +647,171 @@ def replan_line(
         float(gamma_tolerance),
         b,
         float(cycle),
+        step,
+        vlim,
+        float(jump_threshold),
+        jumps,
+        over,
+        method,
     )
+
+
+def _flags(step, times, cycle, numbers, limit, *, per_rate: bool) -> tuple[StepFlag, ...]:
+    value = step / cycle if per_rate else step
+    rows, cols = np.nonzero(value > limit[None, :])
+    return tuple(
+        StepFlag(
+            int(i),
+            float(times[i]),
+            int(numbers[j]),
+            float(step[i, j]),
+            float(step[i, j] / cycle),
+            float(limit[j]),
+        )
+        for i, j in zip(rows, cols)
+    )
+
+
+def _pointwise_grid(gamma_tolerance: float, gamma_step: float) -> FloatArray:
+    count = max(1, 2 * int(math.ceil(gamma_tolerance / gamma_step)) + 1) if gamma_tolerance > 0 else 1
+    return np.linspace(-gamma_tolerance, gamma_tolerance, count)
+
+
+def _pointwise_plan(model, geom, nominal, b, joint, angle, gamma_tolerance, gamma_step):
+    """The first implementation: gamma and branch chosen at each waypoint on its own."""
+    k = nominal.shape[0]
+    grid = _pointwise_grid(gamma_tolerance, gamma_step)
+    f = wrap_angle(_locked_value(geom, nominal[:, None], grid[None, :], b, joint) - angle)  # (K, G)
+    gamma = grid[np.argmin(np.where(np.isfinite(f), np.abs(f), np.inf), axis=1)]
+    if grid.size > 1:
+        brk = _brackets(f)  # (K, G-1)
+        mid = 0.5 * (grid[:-1] + grid[1:])
+        score = np.where(brk, np.abs(mid), np.inf)
+        j = np.argmin(score, axis=1)
+        has = np.isfinite(score[np.arange(k), j])
+        if np.any(has):
+            rows = np.flatnonzero(has)
+            gamma[rows] = _bisect(
+                geom, nominal[rows], grid[j[rows]], grid[j[rows] + 1], f[rows, j[rows]], b, joint, angle
+            )
+    target = tool_x_rotation(nominal, gamma)
+    full_q, full_valid = _full_branches(geom, target)
+    ref = full_q[:, b, :]
+    locked = ik_closed_form(model, target)  # (K, 4)
+    dist = np.max(np.abs(wrap_angle(locked.q_full - ref[:, None, :])), axis=-1)
+    cost = np.where(locked.valid, locked.position_error + locked.rotation_error, np.inf)
+    # prefer the branch on the followed full-arm solution; else the most accurate one
+    choice = np.where(
+        full_valid[:, b], np.argmin(np.where(locked.valid, dist, np.inf), axis=1), np.argmin(cost, 1)
+    )
+    return gamma, locked.q[np.arange(k), choice]
+
+
+def _pointwise_absorbed(geom, nominal, gamma, b, joint, angle, gamma_tolerance, gamma_step):
+    k = nominal.shape[0]
+    grid = _pointwise_grid(gamma_tolerance, gamma_step)
+    out = np.zeros(k, dtype=bool)
+    if grid.size > 1:
+        f = wrap_angle(_locked_value(geom, nominal[:, None], grid[None, :], b, joint) - angle)
+        out = np.any(_brackets(f), axis=1)
+    return out | (np.abs(wrap_angle(_locked_value(geom, nominal, gamma, b, joint) - angle)) < 1e-9)
+
+
+def _continuous_plan(
+    model, geom_locked, geom, nominal, b, gamma_tolerance, grid_step, step_weight, length_scale
+):
+    """Shortest path over (waypoint x gamma x locked branch); see :func:`replan_line`."""
+    k = nominal.shape[0]
+    if gamma_tolerance > 0:
+        count = min(2 * int(math.ceil(gamma_tolerance / grid_step)) + 1, PATH_MAX_GAMMAS)
+        grid = np.linspace(-gamma_tolerance, gamma_tolerance, max(count, 3))
+    else:
+        grid = np.zeros(1)
+    g = grid.size
+    sol = ik_closed_form(model, tool_x_rotation(nominal[:, None], grid[None, :]))  # (K, G, B)
+    nb = sol.valid.shape[-1]
+    err = np.where(sol.valid, sol.position_error + length_scale * sol.rotation_error, np.inf)
+    # the goal stays on the followed full-arm branch: its nearest locked branch at each gamma
+    full_q, full_valid = _full_branches(geom, tool_x_rotation(nominal[-1], grid))  # (G, 8, 6)
+    ref = full_q[:, b, :]
+    dist = np.max(np.abs(wrap_angle(sol.q_full[-1] - ref[:, None, :])), axis=-1)  # (G, B)
+    near = np.argmin(np.where(sol.valid[-1], dist, np.inf), axis=1)
+    keep = (np.arange(nb)[None, :] == near[:, None]) | ~full_valid[:, b, None]
+    if np.any(keep & sol.valid[-1]):
+        err[-1] = np.where(keep, err[-1], np.inf)
+    err[-1] *= GOAL_WEIGHT
+    node = _shortest_path(sol.q.reshape(k, g * nb, -1), err.reshape(k, g * nb), step_weight)
+    gi, bi = np.divmod(node, nb)
+    rows = np.arange(k)
+    gamma = grid[gi]
+    q = sol.q[rows, gi, bi]
+    if g > 1:  # refine to an exact root within one cell either side, where there is one
+        lo = grid[np.maximum(gi - 1, 0)]
+        hi = grid[np.minimum(gi + 1, g - 1)]
+        gam_r = _golden(lambda x: _branch_error(model, geom_locked, nominal, x, bi, length_scale)[0], lo, hi)
+        pe, re, q_r = _branch_error(model, geom_locked, nominal, gam_r, bi, 0.0)
+        exact = (pe <= EXACT_POSITION_TOL) & (re <= EXACT_ROTATION_TOL)
+        gamma = np.where(exact, gam_r, gamma)
+        q = np.where(exact[:, None], q_r, q)
+    return gamma, q
+
+
+def _branch_error(model, geom_locked, nominal, gammas, branches, length_scale):
+    """Tracking error (position + length_scale * rotation), rotation error and joints of one
+    locked branch per waypoint, each at its own gamma (closed form without the geometry fit)."""
+    rows = np.arange(nominal.shape[0])
+    target = tool_x_rotation(nominal, gammas)
+    q_full, valid = puma6_branches(geom_locked, target @ invert(geom_locked.tool))
+    q = model.healthy(q_full[rows, branches])
+    ok = valid[rows, branches]
+    pe, re = pose_error(target, ee_pose(model, np.where(ok[:, None], q, 0.0)))
+    pe, re = np.where(ok, pe, np.inf), np.where(ok, re, np.inf)
+    return pe + length_scale * re, re, q
+
+
+def _golden(fun, lo: FloatArray, hi: FloatArray) -> FloatArray:
+    """Vectorised golden-section minimisation of ``fun`` (K,) -> (K,) on ``[lo, hi]``."""
+    a, b = lo.astype(float).copy(), hi.astype(float).copy()
+    c = b - _GOLDEN * (b - a)
+    d = a + _GOLDEN * (b - a)
+    fc, fd = fun(c), fun(d)
+    for _ in range(REFINE_STEPS):
+        left = ~(fc > fd)  # minimum in [a, d]; NaN/inf compare False -> keep left
+        b = np.where(left, d, b)
+        a = np.where(left, a, c)
+        new = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
+        fnew = fun(new)
+        c, d, fc, fd = (
+            np.where(left, new, d),
+            np.where(left, c, new),
+            np.where(left, fnew, fd),
+            np.where(left, fc, fnew),
+        )
+    return np.where(fc <= fd, c, d)
+
+
+def _shortest_path(q: FloatArray, cost: FloatArray, weight: float) -> np.ndarray:
+    """Viterbi over waypoints: nodes ``q`` (K, N, n) [rad] (NaN where invalid) with node
+    costs ``cost`` (K, N) (``inf`` where invalid); edge cost ``weight * |wrap(dq)|^2``.
+    Returns the (K,) node of the cheapest path."""
+    k, n_nodes, n = q.shape
+    ok = np.isfinite(cost)
+    bad = np.flatnonzero(~np.any(ok, axis=1))
+    if bad.size:
+        raise ConfigurationError(f"waypoint {int(bad[0])} has no locked-arm IK solution")
+    qz = np.where(ok[..., None], q, 0.0)
+    acc = cost[0].copy()
+    back = np.zeros((k, n_nodes), dtype=np.intp)
+    cols = np.arange(n_nodes)
+    two_pi = 2.0 * math.pi
+    for i in range(1, k):
+        d = np.abs(qz[i][None, :, :] - qz[i - 1][:, None, :])  # (prev, next, n), in [0, 2 pi)
+        d = np.minimum(d, two_pi - d)  # wrapped |dq|
+        trans = acc[:, None] + weight * np.einsum("ijk,ijk->ij", d, d)
+        back[i] = np.argmin(trans, axis=0)
+        acc = trans[back[i], cols] + cost[i]
+    path = np.empty(k, dtype=np.intp)
+    path[-1] = int(np.argmin(acc))
+    for i in range(k - 1, 0, -1):
+        path[i - 1] = back[i, path[i]]
+    return path
