@@ -81,8 +81,9 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
         velocity_limit=[deg(40.0)] * 7,
         spacecraft=HALT7_SPACECRAFT if base == "floating" else None,
         description=(
-            "Seed 000 Tables 6-7 read as modified DH with the theta column as offsets "
-            f"(theta_offsets={theta_offsets}); spacecraft base: jointlock's default (000 gives none)."
+            "Seed 000 Tables 6-7 read as modified DH; theta column "
+            + ("added as joint offsets" if theta_offsets else "taken as the initial configuration, not added")
+            + f" (theta_offsets={theta_offsets}); spacecraft base: jointlock's default (000 gives none)."
         ),
     )
 

@@ -614,7 +614,7 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
         decisions.append(("k* [deg/s^6]" if r["feasible"] else "least-violating k [deg/s^6]", r["k"]))
         decisions.append(
             (
-                "global base torque k = 0 -> k* [N m]",
+                "global base torque k = 0 -> " + ("k*" if r["feasible"] else "least-violating k") + " [N m]",
                 f"{r['global_torque_k0_Nm']:.5g} -> {r['global_torque_Nm']:.5g} ({_pct(r['reduction'])} lower)",
             )
         )
