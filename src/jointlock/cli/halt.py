@@ -81,6 +81,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--samples", type=int, default=36000, help="Monte Carlo samples for the halt configuration"
     )
+    p.add_argument(
+        "--no-reachability",
+        action="store_true",
+        help="search the halt configuration over the whole joint ranges (000's way) instead of only "
+        "where each joint can come to rest within T under the limits",
+    )
     p.add_argument("--n-samples", type=int, default=501, help="time samples of the objective (odd)")
     p.add_argument("--generations", type=int, default=100, help="GA generations (default 100)")
     p.add_argument("--population", type=int, default=50, help="GA population (default 50)")
@@ -143,11 +149,29 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
         qf = joint_vector_deg(model, PAPER_SCENARIO["qf_deg"], "--paper-qf")
         notes["qf_source"] = "000's printed q_best"
     else:
-        from ..planning.halt_config import optimal_halt_configuration
+        from ..errors import InfeasibleError
+        from ..planning.halt_config import ReachabilityBound, optimal_halt_configuration
 
+        reach = None
+        if not getattr(args, "no_reachability", False):
+            # Only rest angles each joint can reach within T under the limits (a necessary
+            # condition for the halt motion): 000 samples the whole ranges, which can pick a
+            # configuration the halt cannot get to.
+            reach = ReachabilityBound(q0, dq0, float(T), vmax, amax, ddq0)
+            try:
+                reach.interval(model.joint_numbers)
+            except InfeasibleError as exc:
+                notes["reachability"] = f"not applied: {exc}"
+                reach = None
         bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
-        hc = optimal_halt_configuration(model, samples=args.samples, rng=args.seed, progress=bar)
+        hc = optimal_halt_configuration(
+            model, samples=args.samples, rng=args.seed, progress=bar, reachability=reach
+        )
         bar.close()
+        if reach is not None:
+            notes["reachability"] = (
+                "halt configuration sampled within the rest angles reachable in T (bang-bang bound)"
+            )
         qf = np.asarray(hc.q_best, dtype=float)
         notes["qf_source"] = (
             f"optimal halt configuration (Monte Carlo, {args.samples} samples, seed {args.seed})"
