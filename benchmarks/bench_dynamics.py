@@ -7,11 +7,11 @@ run of the halt motion (000 §4.2).  Run on one core:
 from __future__ import annotations
 
 import os
-import platform
 import sys
 import time
 
 import numpy as np
+from _info import best_of, machine_info
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 
@@ -21,23 +21,8 @@ from jointlock.planning.ga import GASettings  # noqa: E402
 from jointlock.planning.halt_motion import HaltProblem, optimal_halt_motion  # noqa: E402
 
 
-def best_of(fn, repeat=5):
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
-
-
 def main() -> None:
-    print(
-        f"python {platform.python_version()}, numpy {np.__version__}, CPU {platform.processor() or platform.machine()}"
-    )
-    print(
-        f"os.cpu_count={os.cpu_count()}, OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}, "
-        f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}"
-    )
+    print(machine_info())
     model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
     d = np.radians
     p = HaltProblem(
@@ -75,7 +60,7 @@ def main() -> None:
                 out[i, 3:] = rot @ f.angular
             return out
 
-        t_pin = best_of(loop)
+        t_pin = best_of(loop, 5)
         print(
             f"pinocchio rnea loop, 1001 samples (fixed):   {1e3 * t_pin:8.2f} ms  -> ratio "
             f"{t_pin / t_ours['fixed']:.1f}x (fixed), {t_pin / t_ours['floating']:.1f}x (floating)"

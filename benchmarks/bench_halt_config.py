@@ -11,55 +11,17 @@ Run: ``python benchmarks/bench_halt_config.py [--samples 36000] [--repeat 3]``.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from _info import best_of, machine_info
 
 import jointlock as jl
 from jointlock.analysis.ability import configuration_indices
 from jointlock.planning.halt_config import optimal_halt_configuration
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-
-
-def machine_info() -> str:
-    cpu = platform.processor() or platform.machine()
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
-                cpu = line.split(":", 1)[1].strip()
-                break
-    except OSError:
-        pass
-    threads = {k: os.environ.get(k) for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")}
-    blas = "unknown"
-    try:
-        from threadpoolctl import threadpool_info
-
-        blas = ", ".join(
-            f"{i['internal_api']} {i['version']} ({i['num_threads']} threads)" for i in threadpool_info()
-        )
-    except ImportError:
-        cfg = np.show_config(mode="dicts") if np.lib.NumpyVersion(np.__version__) >= "1.26.0" else {}
-        dep = cfg.get("Build Dependencies", {}).get("blas", {}) if isinstance(cfg, dict) else {}
-        blas = f"{dep.get('name', '?')} {dep.get('version', '')}".strip()
-    return (
-        f"CPU: {cpu}; cores: {os.cpu_count()}; Python {platform.python_version()}; numpy {np.__version__}; "
-        f"BLAS: {blas}; thread env: {threads}"
-    )
-
-
-def best_of(fn, repeat: int) -> float:
-    times = []
-    for _ in range(repeat):
-        t = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t)
-    return min(times)
 
 
 def pinocchio_loop(model: jl.ArmModel, q: np.ndarray, floating: bool) -> np.ndarray:

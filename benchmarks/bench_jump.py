@@ -10,12 +10,10 @@ under 10 s on one core.  Run with one BLAS thread for the one-core figure::
 
 from __future__ import annotations
 
-import os
-import platform
 import sys
 import time
 
-import numpy as np
+from _info import machine_info
 
 import jointlock as jl
 from jointlock.planning.jump import JumpScenario, study_jump
@@ -23,20 +21,7 @@ from jointlock.planning.jump import JumpScenario, study_jump
 
 def main(argv: list[str]) -> int:
     robot = argv[1] if len(argv) > 1 else "canadarm7"
-    threads = {
-        k: os.environ.get(k, "unset") for k in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
-    }
-    print(
-        f"python {platform.python_version()}, numpy {np.__version__}, cpu: {platform.processor() or platform.machine()}"
-    )
-    print(f"cores visible: {os.cpu_count()}, affinity: {len(os.sched_getaffinity(0))}, threads: {threads}")
-    try:
-        from threadpoolctl import threadpool_info
-
-        for info in threadpool_info():
-            print(f"  {info.get('internal_api')} {info.get('version')} threads={info.get('num_threads')}")
-    except ImportError:
-        pass
+    print(machine_info())
     model = jl.load_robot(robot)
     sc = JumpScenario()
     times = []

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 
 # One core: OpenBLAS threads fight over a busy machine and make small-matrix products erratic.
@@ -23,18 +22,9 @@ import numpy as np  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).parent))
 sys.path.insert(0, str(Path(__file__).parent.parent / "tests"))
-from _info import machine_info  # noqa: E402
+from _info import best_of, machine_info  # noqa: E402
 
 import jointlock as jl  # noqa: E402
-
-
-def best_of(fn, repeat: int = 3) -> float:
-    times = []
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        times.append(time.perf_counter() - t0)
-    return min(times)
 
 
 def main() -> None:
@@ -50,7 +40,11 @@ def main() -> None:
 
     rates = {}
     for method in ("svd", "auto"):
-        label = "exact SVD" if method == "svd" else "auto: Gram eigenvalues, SVD where cond > 1e4 (rel. error < 1.2e-8)"
+        label = (
+            "exact SVD"
+            if method == "svd"
+            else "auto: Gram eigenvalues, SVD where cond > 1e4 (rel. error < 1.2e-8)"
+        )
         print(f"\njointlock batched (halt7, joint 4 locked): Jacobian + singular values [{label}]")
         for k in sorted({100, 1000, 10000, args.samples}):
             q = rng.uniform(-np.pi, np.pi, (k, model.dof))

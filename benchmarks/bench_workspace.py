@@ -12,26 +12,15 @@ Prints end-effector positions per second of :func:`jointlock.analysis.workspace.
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
+from _info import best_of, machine_info
 
 import jointlock as jl
 from jointlock.analysis.workspace import ee_positions, sample_configurations
 from jointlock.ik import ik_closed_form
-
-
-def _best(fn, repeat: int = 3) -> float:
-    best = np.inf
-    for _ in range(repeat):
-        t0 = time.perf_counter()
-        fn()
-        best = min(best, time.perf_counter() - t0)
-    return best
 
 
 def main() -> None:
@@ -40,29 +29,17 @@ def main() -> None:
     parser.add_argument("--pin-subset", type=int, default=100_000)
     args = parser.parse_args()
 
-    print(
-        f"python {platform.python_version()}, numpy {np.__version__}, CPU {platform.processor() or platform.machine()}"
-    )
-    print(
-        f"cpus {os.cpu_count()}, OMP_NUM_THREADS={os.environ.get('OMP_NUM_THREADS')}, "
-        f"OPENBLAS_NUM_THREADS={os.environ.get('OPENBLAS_NUM_THREADS')}"
-    )
-    try:
-        cfg = np.show_config(mode="dicts")
-        blas = cfg.get("Build Dependencies", {}).get("blas", {})
-        print(f"BLAS: {blas.get('name')} {blas.get('version')}")
-    except Exception:  # noqa: BLE001 - informational only
-        pass
+    print(machine_info())
 
     arm = jl.load_robot("puma6")
     locked = jl.lock(arm, 2, np.radians(60.0))
     q = sample_configurations(arm, args.samples, rng=0)
     ql = sample_configurations(locked, args.samples, rng=1)
 
-    t_fast = _best(lambda: ee_positions(arm, q))
-    t_fast_l = _best(lambda: ee_positions(locked, ql))
+    t_fast = best_of(lambda: ee_positions(arm, q))
+    t_fast_l = best_of(lambda: ee_positions(locked, ql))
     sub = q[: min(args.samples, 200_000)]
-    t_chain = _best(lambda: jl.chain_state(arm, sub), 1) * (args.samples / sub.shape[0])
+    t_chain = best_of(lambda: jl.chain_state(arm, sub), 1) * (args.samples / sub.shape[0])
     rate = args.samples / t_fast
     print(f"\nworkspace sampling, {args.samples:.0e} configurations:")
     print(f"  ee_positions (full arm)      : {rate:12,.0f} points/s  ({t_fast:.3f} s)")
@@ -87,7 +64,7 @@ def main() -> None:
                 pin.forwardKinematics(pm, data, qq)
                 out[k] = pin.updateFramePlacement(pm, data, fid).translation
 
-        t_pin = _best(loop)
+        t_pin = best_of(loop)
         assert np.abs(out - ee_positions(arm, q[:n])).max() < 1e-12
         pin_rate = n / t_pin
         print(f"  pinocchio FK loop ({n:.0e})   : {pin_rate:12,.0f} points/s")
@@ -96,10 +73,10 @@ def main() -> None:
     print("\nclosed-form IK (every branch), puma6:")
     for batch in (1, 100, 10_000, 100_000):
         t = jl.ee_pose(arm, q[:batch])
-        tt = _best(lambda t=t: ik_closed_form(arm, t))
+        tt = best_of(lambda t=t: ik_closed_form(arm, t))
         print(f"  batch {batch:>7}: {batch / tt:12,.0f} poses/s (8 branches, errors checked by FK)")
     t = jl.ee_pose(arm, ql[:100_000, [0, 0, 1, 2, 3, 4]])
-    tt = _best(lambda: ik_closed_form(locked, t))
+    tt = best_of(lambda: ik_closed_form(locked, t))
     print(f"  joint 2 locked, batch 100000: {1e5 / tt:12,.0f} poses/s (4 branches)")
 
 

@@ -129,6 +129,11 @@ def arm_figure(model: ArmModel, configurations: dict[str, np.ndarray], *, title:
     return fig
 
 
+def limit_status(value: float, limit: float) -> str:
+    """``"kept"`` when ``value <= limit`` (up to a relative 1e-9), else ``"BROKEN"``."""
+    return "kept" if value <= limit * (1 + 1e-9) else "BROKEN"
+
+
 def limits_rows(
     joints: Sequence[int], values: Sequence[float], limits: Sequence[float], quantity: str, unit: str
 ) -> list[list[Any]]:
@@ -137,8 +142,7 @@ def limits_rows(
     rows = []
     for j, v, lim in zip(joints, values, limits):
         v, lim = abs(float(v)), float(lim)
-        ok = v <= lim * (1 + 1e-9)
-        rows.append([j, f"{quantity} [{unit}]", v, lim, lim - v, "kept" if ok else "BROKEN"])
+        rows.append([j, f"{quantity} [{unit}]", v, lim, lim - v, limit_status(v, lim)])
     return rows
 
 

@@ -30,7 +30,19 @@ def parse_lock(text: str) -> tuple[int, float]:
     return joint, math.radians(angle)
 
 
-def add_robot_arguments(parser: argparse.ArgumentParser, *, lock: bool = True) -> None:
+def add_robot_arguments(
+    parser: argparse.ArgumentParser,
+    *,
+    lock: bool = True,
+    base_choices: tuple[str, ...] = ("fixed", "floating"),
+    base_default: str | None = "fixed",
+    base_help: str = "fixed base, or free-floating spacecraft (generalized Jacobian); default fixed",
+) -> None:
+    """Add ROBOT, ``--lock J=DEG`` (unless ``lock=False``) and ``--base`` to ``parser``.
+
+    ``base_choices``, ``base_default`` and ``base_help`` let a subcommand offer other bases
+    (e.g. ``singular``'s "virtual") or leave the default to be decided later (``None``).
+    """
     parser.add_argument(
         "robot",
         metavar="ROBOT",
@@ -47,16 +59,33 @@ def add_robot_arguments(parser: argparse.ArgumentParser, *, lock: bool = True) -
         )
     parser.add_argument(
         "--base",
-        choices=("fixed", "floating"),
-        default="fixed",
-        help="fixed base, or free-floating spacecraft (generalized Jacobian); default fixed",
+        choices=base_choices,
+        default=base_default,
+        help=base_help,
     )
+
+
+def single_lock(args: argparse.Namespace) -> tuple[int, float]:
+    """The one ``--lock J=DEG`` of a subcommand that takes exactly one: (joint, angle [rad])."""
+    if len(args.lock) != 1:
+        raise ScenarioError(f"--lock must be given exactly once (J=DEG); got {len(args.lock)}")
+    return args.lock[0]
 
 
 def model_from_args(args: argparse.Namespace) -> ArmModel:
     model = load_robot(args.robot, base=args.base)
     locks = dict(getattr(args, "lock", []) or [])
     return lock_joints(model, locks) if locks else model
+
+
+def locked_deg(model: ArmModel) -> dict[str, float]:
+    """``{"J": angle [deg]}`` of the locked joints, for JSON output."""
+    return {str(lj.number): math.degrees(lj.angle) for lj in model.locked}
+
+
+def locked_text(locked: dict[str, float]) -> str:
+    """``"joint J at DEG deg, ..."`` (or ``"none"``) from :func:`locked_deg`'s mapping."""
+    return ", ".join(f"joint {k} at {v:g} deg" for k, v in locked.items()) or "none"
 
 
 def joint_vector_deg(model: ArmModel, values: list[float] | None, option: str) -> np.ndarray:

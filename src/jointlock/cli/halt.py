@@ -29,7 +29,7 @@ from ..planning.halt_motion import (
 )
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import add_robot_arguments, joint_vector_deg, print_json
+from ._common import add_robot_arguments, joint_vector_deg, locked_deg, locked_text, print_json
 
 #: 000 §5.1-5.2 scenario on halt7 (healthy joints 1, 2, 3, 5, 6, 7) [deg, deg/s, deg/s^2, s].
 PAPER_SCENARIO: dict[str, Any] = {
@@ -191,7 +191,7 @@ def result_dict(res: HaltMotion, notes: dict) -> dict:
         "robot": p.model.name,
         "base": p.base,
         "joint_numbers": list(p.model.joint_numbers),
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in p.model.locked},
+        "locked": locked_deg(p.model),
         "T_s": p.T,
         "k": np.asarray(res.k) / scale,
         "k_unit": "deg/s^6",
@@ -344,9 +344,7 @@ def run(args: argparse.Namespace) -> int:
         return 0
     p = problem
     nums = list(p.model.joint_numbers)
-    locked = (
-        ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):g} deg" for lj in p.model.locked) or "none"
-    )
+    locked = locked_text(locked_deg(p.model))
     print(f"{p.model.name}: healthy joints {nums}, locked: {locked}, base torque with {p.base} base")
     print(
         f"halt configuration ({notes['qf_source']}): "

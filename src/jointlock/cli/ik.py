@@ -9,7 +9,7 @@ import numpy as np
 
 from ..errors import ScenarioError
 from ..ik import pose_from_zyx, solve_ik, zyx_angles
-from ._common import add_robot_arguments, format_matrix, model_from_args, print_json
+from ._common import add_robot_arguments, format_matrix, locked_deg, locked_text, model_from_args, print_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -79,7 +79,7 @@ def run(args: argparse.Namespace) -> int:
     res = solve_ik(model, target, method=args.method, rng=args.seed, length_scale=args.length_scale)
     out = {
         "robot": model.name,
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+        "locked": locked_deg(model),
         "method": res.method,
         "target": target,
         "target_position_m": target[:3, 3],
@@ -103,7 +103,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in out["locked"].items()) or "none"
+    locked = locked_text(out["locked"])
     print(f"{model.name}: {res.method} IK, locked: {locked}")
     print("target T_base_ee [m]:")
     print(format_matrix(target, "{:>11.6f}"))

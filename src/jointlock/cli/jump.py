@@ -107,6 +107,19 @@ def _ver_json(v: Verification) -> dict:
     }
 
 
+def _ver_series_json(v: Verification) -> dict:
+    """The verification's jumps per failure time, its headline figures and :func:`_ver_json`."""
+    return {
+        "verification_t_s": v.t,
+        "jump_before": v.jump_before,
+        "jump_after": v.jump_after,
+        "mean_reduction": v.mean_reduction,
+        "share_improved": v.share_improved,
+        "limits_ok": v.limits_ok,
+        "verification": _ver_json(v),
+    }
+
+
 def run(args: argparse.Namespace) -> int:
     sc = _scenario(args)
     model = load_robot(args.robot, base=args.base)
@@ -222,13 +235,7 @@ def _study_json(robot: str, sc: JumpScenario, st: JumpStudy) -> dict:
                 for pc in (f.pieces or ())
             ],
         },
-        "verification_t_s": v.t,
-        "jump_before": v.jump_before,
-        "jump_after": v.jump_after,
-        "mean_reduction": v.mean_reduction,
-        "share_improved": v.share_improved,
-        "limits_ok": v.limits_ok,
-        "verification": _ver_json(v),
+        **_ver_series_json(v),
         "elapsed_s": st.elapsed,
     }
     if st.verification_fixed is not None:
@@ -243,13 +250,7 @@ def _constant_json(robot: str, sc: JumpScenario, kappa: float, v: Verification) 
         "scenario": sc.to_fields(),
         "lock_joint": sc.lock_joint,
         "kappa": kappa,
-        "verification_t_s": v.t,
-        "jump_before": v.jump_before,
-        "jump_after": v.jump_after,
-        "mean_reduction": v.mean_reduction,
-        "share_improved": v.share_improved,
-        "limits_ok": v.limits_ok,
-        "verification": _ver_json(v),
+        **_ver_series_json(v),
     }
 
 

@@ -9,7 +9,15 @@ import numpy as np
 
 from ..kinematics import chain_state, generalized_jacobian, jacobian
 from ..spatial import pose
-from ._common import add_robot_arguments, format_matrix, joint_vector_deg, model_from_args, print_json
+from ._common import (
+    add_robot_arguments,
+    format_matrix,
+    joint_vector_deg,
+    locked_deg,
+    locked_text,
+    model_from_args,
+    print_json,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -41,7 +49,7 @@ def run(args: argparse.Namespace) -> int:
         "robot": model.name,
         "base": "floating" if model.floating else "fixed",
         "joint_numbers": list(model.joint_numbers),
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+        "locked": locked_deg(model),
         "q_deg": np.degrees(q),
         "pose": ee,
         "jacobian": jac,
@@ -54,7 +62,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in result["locked"].items()) or "none"
+    locked = locked_text(result["locked"])
     print(
         f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: {locked}, base: {result['base']}"
     )

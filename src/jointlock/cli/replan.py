@@ -14,7 +14,7 @@ from ..kinematics import ee_pose
 from ..locking import lock
 from ..planning.replan import DEFAULT_STEP_WEIGHT, replan_line
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json
+from ._common import add_robot_arguments, print_json, single_lock
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -67,9 +67,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if len(args.lock) != 1:
-        raise ScenarioError(f"--lock must be given exactly once (J=DEG); got {len(args.lock)}")
-    joint, angle = args.lock[0]
+    joint, angle = single_lock(args)
     full = load_robot(args.robot, base=args.base)
     for opt, vals in (("--from-deg", args.from_deg), ("--to-deg", args.to_deg)):
         if len(vals) != full.dof or not np.all(np.isfinite(vals)):
@@ -201,6 +199,11 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
     files = []
 
     def save(fig, name):
+        # every panel plots against time, with a legend and a light grid
+        for ax in fig.axes:
+            ax.set_xlabel("time [s]")
+            ax.legend(fontsize=8)
+            ax.grid(alpha=0.3)
         fig.tight_layout()
         fig.savefig(out_dir / name, dpi=110)
         plt.close(fig)
@@ -209,10 +212,7 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
     fig, ax = plt.subplots(figsize=(7, 4))
     for k in range(res.q_full.shape[1]):
         ax.plot(t, np.degrees(res.q_full[:, k]), label=f"joint {k + 1}")
-    ax.set_xlabel("time [s]")
     ax.set_ylabel("angle [deg]")
-    ax.legend(fontsize=8)
-    ax.grid(alpha=0.3)
     save(fig, "joints.png")
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
@@ -224,10 +224,6 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
         a2.plot(t, eul[:, k], label=lab)
     a1.set_ylabel("position [mm]")
     a2.set_ylabel("ZYX Euler [deg]")
-    for ax in (a1, a2):
-        ax.set_xlabel("time [s]")
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
     save(fig, "pose.png")
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
@@ -238,10 +234,6 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
     a2.plot(t, np.degrees(res.gamma), ":", label="gamma")
     a1.set_ylabel("position error [mm]")
     a2.set_ylabel("rotation [deg]")
-    for ax in (a1, a2):
-        ax.set_xlabel("time [s]")
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
     save(fig, "error.png")
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
@@ -250,10 +242,6 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
         a2.plot(t, np.degrees(res.ee_velocity[:, 3 + k]), label=f"w{'xyz'[k]}")
     a1.set_ylabel("linear velocity [mm/s]")
     a2.set_ylabel("angular velocity [deg/s]")
-    for ax in (a1, a2):
-        ax.set_xlabel("time [s]")
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
     save(fig, "velocity.png")
 
     header = "time_s," + ",".join(f"q{k + 1}_deg" for k in range(res.q_full.shape[1]))

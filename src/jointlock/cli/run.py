@@ -522,7 +522,7 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..report import LIMITS_HEADER, Section, arm_figure, limits_rows, save_figure
+    from ..report import LIMITS_HEADER, Section, arm_figure, limit_status, limits_rows, save_figure
 
     d = scenario.data
     jobs = results["jobs"]
@@ -736,28 +736,16 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
                 (
                     ["quantity", "worst value", "limit", "status"],
                     [
-                        [
-                            "joint speed [deg/s]",
-                            lim["max_velocity_deg_s"],
-                            sc["vmax_deg_s"],
-                            "kept"
-                            if lim["max_velocity_deg_s"] <= sc["vmax_deg_s"] * (1 + 1e-9)
-                            else "BROKEN",
-                        ],
-                        [
-                            "joint acceleration [deg/s^2]",
-                            lim["max_acceleration_deg_s2"],
-                            sc["amax_deg_s2"],
-                            "kept"
-                            if lim["max_acceleration_deg_s2"] <= sc["amax_deg_s2"] * (1 + 1e-9)
-                            else "BROKEN",
-                        ],
-                        [
-                            "position deviation [mm]",
-                            lim["max_deviation_mm"],
-                            1e3 * sc["eps_m"],
-                            "kept" if lim["max_deviation_mm"] <= 1e3 * sc["eps_m"] * (1 + 1e-9) else "BROKEN",
-                        ],
+                        [quantity, worst, limit, limit_status(worst, limit)]
+                        for quantity, worst, limit in (
+                            ("joint speed [deg/s]", lim["max_velocity_deg_s"], sc["vmax_deg_s"]),
+                            (
+                                "joint acceleration [deg/s^2]",
+                                lim["max_acceleration_deg_s2"],
+                                sc["amax_deg_s2"],
+                            ),
+                            ("position deviation [mm]", lim["max_deviation_mm"], 1e3 * sc["eps_m"]),
+                        )
                     ],
                     f"jump: {label}",
                 )

@@ -15,8 +15,8 @@ from ..errors import ModelError, ScenarioError
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..progress import Progress
-from ..robots import BUILTIN_ROBOTS, load_robot
-from ._common import format_matrix, joint_vector_deg, parse_lock, print_json
+from ..robots import load_robot
+from ._common import add_robot_arguments, format_matrix, joint_vector_deg, locked_deg, locked_text, print_json
 
 TWIST = ("vx", "vy", "vz", "wx", "wy", "wz")
 
@@ -32,24 +32,11 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Cond1-Cond5 of seed 004 are evaluated too."
         ),
     )
-    p.add_argument(
-        "robot",
-        metavar="ROBOT",
-        help=f"built-in name ({', '.join(BUILTIN_ROBOTS)}) or a model file (.urdf, .toml)",
-    )
-    p.add_argument(
-        "--lock",
-        metavar="J=DEG",
-        type=parse_lock,
-        action="append",
-        default=[],
-        help="lock joint J (numbered from 1) at DEG degrees; repeat for several",
-    )
-    p.add_argument(
-        "--base",
-        choices=sg.BASE_KINDS,
-        default=None,
-        help="fixed, floating (generalized Jacobian) or virtual (virtual manipulator); "
+    add_robot_arguments(
+        p,
+        base_choices=sg.BASE_KINDS,
+        base_default=None,
+        base_help="fixed, floating (generalized Jacobian) or virtual (virtual manipulator); "
         "default: virtual with --verify-conditions, fixed otherwise",
     )
     p.add_argument(
@@ -134,7 +121,7 @@ def _single(args: argparse.Namespace) -> int:
         "base": base,
         "weighting": args.weighting if base == "virtual" else None,
         "joint_numbers": list(model.joint_numbers),
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+        "locked": locked_deg(model),
         "q_deg": np.degrees(q),
         "singular_values": res.singular_values,
         "sigma_min": float(res.sigma_min),
@@ -152,7 +139,7 @@ def _single(args: argparse.Namespace) -> int:
     if args.json:
         print_json(out)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in out["locked"].items()) or "none"
+    locked = locked_text(out["locked"])
     print(
         f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: {locked}, Jacobian: {base}"
     )

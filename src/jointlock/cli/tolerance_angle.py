@@ -12,7 +12,7 @@ from ..errors import ScenarioError
 from ..kinematics import ee_pose
 from ..planning.replan import absorbable_range, gamma_sweep, gammas_for_lock
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json
+from ._common import add_robot_arguments, print_json, single_lock
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -38,9 +38,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if len(args.lock) != 1:
-        raise ScenarioError(f"--lock must be given exactly once (J=DEG); got {len(args.lock)}")
-    joint, angle = args.lock[0]
+    joint, angle = single_lock(args)
     model = load_robot(args.robot, base=args.base)
     if not 1 <= joint <= model.dof:
         raise ScenarioError(f"--lock joint must be 1..{model.dof}; got {joint}")

@@ -1498,6 +1498,16 @@ def fit_pieces(
     return pieces
 
 
+def _feasible_samples(search: KappaSearch) -> np.ndarray:
+    """Mask of the failure times with a feasible kappa; raise when fewer than two (no fit)."""
+    finite = np.isfinite(search.kappa_opt)
+    if finite.sum() < 2:
+        raise InfeasibleError(
+            f"fit_kappa: only {int(finite.sum())} failure time(s) have a feasible kappa; need >= 2 to fit kappa(t)"
+        )
+    return finite
+
+
 def fit_kappa(
     model: ArmModel,
     search: KappaSearch,
@@ -1569,11 +1579,7 @@ def fit_kappa(
         return _fit_single(model, search, order=order, max_order=max_order, threshold=threshold, rtol=rtol)
     sc = search.scenario
     prob = _problem(model, sc)
-    finite = np.isfinite(search.kappa_opt)
-    if finite.sum() < 2:
-        raise InfeasibleError(
-            f"fit_kappa: only {int(finite.sum())} failure time(s) have a feasible kappa; need >= 2 to fit kappa(t)"
-        )
+    finite = _feasible_samples(search)
     width = float(search.probe_range[1] - search.probe_range[0]) or 1.0
     single = _polyfit(
         search.fail_times[finite] / sc.duration, search.kappa_opt[finite], order, max_order, threshold, rtol
@@ -1730,11 +1736,7 @@ def _fit_single(
     sc = search.scenario
     prob = _problem(model, sc)
     t = search.fail_times
-    finite = np.isfinite(search.kappa_opt)
-    if finite.sum() < 2:
-        raise InfeasibleError(
-            f"fit_kappa: only {int(finite.sum())} failure time(s) have a feasible kappa; need >= 2 to fit kappa(t)"
-        )
+    finite = _feasible_samples(search)
     tau = t / sc.duration
     used = finite.copy()
     res = None
