@@ -31,6 +31,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import ConfigurationError
 from .kinematics import ChainState, chain_state, generalized_jacobian, jacobian
 from .model import ArmModel, FloatArray, as_joint_array
 
@@ -49,7 +50,7 @@ def _rows(rows: RowBlock | slice) -> slice:
         return rows
     table = {"position": POSITION_ROWS, "orientation": ORIENTATION_ROWS, "full": slice(0, 6)}
     if rows not in table:
-        raise ValueError(f"rows must be one of {sorted(table)} or a slice; got {rows!r}")
+        raise ConfigurationError(f"rows must be one of {sorted(table)} or a slice; got {rows!r}")
     return table[rows]
 
 
@@ -201,10 +202,15 @@ def manipulability_and_gradient(
         mask = np.asarray(columns, dtype=bool)
         js = js * mask[..., None, :]
         dj = dj * mask[..., None, None, :]
-    gram = js @ np.swapaxes(js, -1, -2)
-    w = np.sqrt(np.maximum(np.linalg.det(gram), 0.0))
-    m = np.linalg.solve(gram, js)  # (..., m, n) = (J J^T)^-1 J
-    grad = w[..., None] * np.einsum("...rc,...irc->...i", m, dj)
+    # w = prod(sigma_r); dw/dq_i = sum_r (prod_{s != r} sigma_s) u_r^T dJ_i v_r, equal to
+    # w tr((J J^T)^-1 J dJ_i^T) where J has full row rank and finite where it has not.
+    u, s, vh = np.linalg.svd(js, full_matrices=False)
+    k = s.shape[-1]
+    w = np.prod(s, axis=-1) if k == js.shape[-2] else np.zeros(s.shape[:-1])
+    others = np.prod(np.where(np.eye(k, dtype=bool), 1.0, s[..., None, :]), axis=-1)
+    if k < js.shape[-2]:
+        others = np.zeros_like(others)
+    grad = np.einsum("...r,...ar,...iab,...rb->...i", others, u, dj, vh)
     if columns is not None:
         grad = grad * mask
     return w, grad
@@ -264,5 +270,5 @@ def manipulability_gradient(
         jac = generalized_jacobian(model, q)
         djac = generalized_jacobian_derivatives(model, q)
     else:
-        raise ValueError(f"base must be 'fixed' or 'floating'; got {base!r}")
+        raise ConfigurationError(f"base must be 'fixed' or 'floating'; got {base!r}")
     return manipulability_and_gradient(jac, djac, rows=rows, columns=columns)

@@ -16,6 +16,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import ModelError
 from .kinematics import ChainState, _world_inertias, chain_state, com_jacobians, com_positions
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import skew
@@ -82,7 +83,12 @@ def generalized_inertia(model: ArmModel, q: ArrayLike) -> FloatArray:
     ``H* = H_m - H_bm^T H_b^{-1} H_bm`` (..., n, n) [kg m^2]."""
     m = system_mass_matrix(model, q)
     hb, hbm, hm = m[..., :6, :6], m[..., :6, 6:], m[..., 6:, 6:]
-    return hm - np.swapaxes(hbm, -1, -2) @ np.linalg.solve(hb, hbm)
+    try:
+        return hm - np.swapaxes(hbm, -1, -2) @ np.linalg.solve(hb, hbm)
+    except np.linalg.LinAlgError:
+        raise ModelError(
+            f"model {model.name!r}: the free-floating system's inertia is singular; H* is undefined"
+        ) from None
 
 
 # -- recursive Newton-Euler and the base reaction wrench (000 eqs. 28-31) ------------------
@@ -137,8 +143,6 @@ class InverseDynamics:
 # multiplied, so a signed-permutation placement (every DH model) costs nothing; the joint
 # rotation about ``z`` is four products and two sums per vector.  Links frames are rotated
 # so that every joint turns about its own ``z`` (see :func:`_link_constants`).
-
-Row = "FloatArray | float | None"
 
 
 def _lc(terms, const: float = 0.0):
@@ -484,16 +488,23 @@ def _base_solver(mass: float, first, inertia):
     cyy = kxx * kzz - kxz * kxz
     cyz = kxy * kxz - kxx * kyz
     czz = kxx * kyy - kxy * kxy
-    inv_det = 1.0 / (kxx * cxx + kxy * cxy + kxz * cxz)
+    det = kxx * cxx + kxy * cxy + kxz * cxz
+    if np.any(np.asarray(det) <= 0):
+        raise ModelError(
+            "the free-floating system's rotational inertia about its centre of "
+            "mass is singular (e.g. collinear point masses on a point-mass spacecraft); the base "
+            "reaction is undefined"
+        )
+    inv_det = 1.0 / det
 
     def solve(rf, rn):
-        b = [x - im * y for x, y in zip(rn, _cross(first, rf))]
+        b = [_nz(x) - im * _nz(y) for x, y in zip(rn, _cross(first, rf))]
         alpha = [
             (cxx * b[0] + cxy * b[1] + cxz * b[2]) * inv_det,
             (cxy * b[0] + cyy * b[1] + cyz * b[2]) * inv_det,
             (cxz * b[0] + cyz * b[1] + czz * b[2]) * inv_det,
         ]
-        lin = [(x + y) * im for x, y in zip(rf, _cross(first, alpha))]
+        lin = [(_nz(x) + _nz(y)) * im for x, y in zip(rf, _cross(first, alpha))]
         return lin, alpha
 
     return solve
@@ -542,7 +553,7 @@ def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
         acc = _rz(cos[j], sin[j], _cmv(et, _add3(acc, _cross_vc(alpha, link.pos), none3)), True)
         alpha = _rz(cos[j], sin[j], _cmv(et, alpha), True)
         kxz, kyz, kzz, hx, hy = columns[j]
-        tau[j] = tau[j] + kxz * alpha[0] + kyz * alpha[1] + kzz * alpha[2] + hx * acc[1] - hy * acc[0]
+        tau[j] = _nz(tau[j]) + kxz * alpha[0] + kyz * alpha[1] + kzz * alpha[2] + hx * acc[1] - hy * acc[0]
     force = [root.mass * x for x in a0]
     moment = _add3(_cmv(root.inertia, alpha0), spin, _cross_cv(c0 - point, force))
     return tau, force, moment, a0 + alpha0, v0 + w0

@@ -21,6 +21,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .errors import ConfigurationError, ModelError
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import pose, skew
 
@@ -171,16 +172,6 @@ def com_positions(model: ArmModel, q: ArrayLike, state: ChainState | None = None
     return s.positions + np.einsum("...nij,nj->...ni", s.rotations, coms)
 
 
-def _point_jacobian(state: ChainState, point: FloatArray, upto: int | None = None) -> FloatArray:
-    """(..., 6, n) twist Jacobian of a point (..., 3) moving with link ``upto`` (all links by default)."""
-    lin = np.cross(state.axes, point[..., None, :] - state.positions)  # (..., n, 3)
-    ang = state.axes.copy()
-    if upto is not None:
-        lin[..., upto + 1 :, :] = 0.0
-        ang[..., upto + 1 :, :] = 0.0
-    return np.concatenate([np.swapaxes(lin, -1, -2), np.swapaxes(ang, -1, -2)], axis=-2)
-
-
 def jacobian(
     model: ArmModel,
     q: ArrayLike,
@@ -220,7 +211,7 @@ def jacobian(
     if frame == "ee":
         jac = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jac)
     elif frame != "base":
-        raise ValueError(f"frame must be 'base' or 'ee'; got {frame!r}")
+        raise ConfigurationError(f"frame must be 'base' or 'ee'; got {frame!r}")
     return jac
 
 
@@ -287,7 +278,13 @@ def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None
     ``-H_b^{-1} H_bm`` with the blocks of :func:`momentum_matrix`.
     """
     h = momentum_matrix(model, q, state)
-    return -np.linalg.solve(h[..., :, :6], h[..., :, 6:])
+    try:
+        return -np.linalg.solve(h[..., :, :6], h[..., :, 6:])
+    except np.linalg.LinAlgError:
+        raise ModelError(
+            f"model {model.name!r}: the free-floating system's inertia is singular (e.g. collinear "
+            "point masses on a point-mass spacecraft); the base motion is undefined"
+        ) from None
 
 
 def generalized_jacobian(
@@ -328,7 +325,7 @@ def generalized_jacobian(
     if frame == "ee":
         jm = _rotate_twist(np.swapaxes(s.ee_rotation, -1, -2), jm)
     elif frame != "base":
-        raise ValueError(f"frame must be 'base' or 'ee'; got {frame!r}")
+        raise ConfigurationError(f"frame must be 'base' or 'ee'; got {frame!r}")
     return jm
 
 
@@ -349,6 +346,8 @@ def system_com(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -
     masses = np.array([b.mass for b in model.bodies])
     coms = com_positions(model, q, s)
     total = masses.sum() + model.root_body.mass
+    if total <= 0:
+        raise ModelError(f"model {model.name!r} has no mass: the system centre of mass is undefined")
     return (np.einsum("n,...ni->...i", masses, coms) + model.root_body.mass * model.root_body.com) / total
 
 
@@ -383,7 +382,7 @@ def virtual_link_vectors(model: ArmModel, *, weighting: VMWeighting = "vafa-dubo
     (n + 1, 3) [m]; row 0 in the root frame, row ``k`` in link frame ``k``.
     """
     if weighting not in ("vafa-dubowsky", "segment"):
-        raise ValueError(f"weighting must be 'vafa-dubowsky' or 'segment'; got {weighting!r}")
+        raise ConfigurationError(f"weighting must be 'vafa-dubowsky' or 'segment'; got {weighting!r}")
     n = model.dof
     masses = np.array([model.root_body.mass] + [b.mass for b in model.bodies])
     if model.floating:
@@ -445,7 +444,10 @@ def virtual_manipulator(
     """
     s = chain_state(model, q)
     local = virtual_link_vectors(model, weighting=weighting)
-    ground = system_com(model, q, s)
+    if model.floating:
+        ground = system_com(model, q, s)
+    else:  # m_0 -> inf: the ground is the base's own point, the virtual arm is the real one
+        ground = np.broadcast_to(model.root_body.com, s.batch_shape + (3,))
     vec_links = np.einsum("...nij,nj->...ni", s.rotations, local[1:])
     vec0 = np.broadcast_to(local[0], ground.shape)
     vectors = np.concatenate([vec0[..., None, :], vec_links], axis=-2)

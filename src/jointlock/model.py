@@ -26,13 +26,14 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .errors import ModelError
+from .errors import ConfigurationError, ModelError
 
 FloatArray = NDArray[np.float64]
 
 #: Relative tolerance on the symmetry of an inertia tensor [-].
 INERTIA_SYMMETRY_RTOL = 1e-9
-#: Smallest eigenvalue accepted for a non-zero inertia tensor, relative to its largest [-].
+#: Smallest eigenvalue accepted for a non-zero inertia tensor, relative to its largest [-]:
+#: positive semi-definite up to round-off (a merged pair of point masses has a zero moment).
 INERTIA_EIGEN_RTOL = -1e-12
 
 
@@ -111,9 +112,9 @@ class Body:
             raise ModelError(f"{label}: inertia must be symmetric; got {inertia.tolist()}")
         if np.any(inertia != 0):
             eig = np.linalg.eigvalsh(inertia)
-            if eig[0] <= INERTIA_EIGEN_RTOL * eig[-1] or eig[0] <= 0:
+            if eig[0] < INERTIA_EIGEN_RTOL * eig[-1]:
                 raise ModelError(
-                    f"{label}: inertia must be positive definite (or all zero for a point mass); "
+                    f"{label}: inertia must be positive semi-definite (all zero for a point mass); "
                     f"got eigenvalues {np.round(eig, 12).tolist()} [kg m^2]"
                 )
         object.__setattr__(self, "mass", mass)
@@ -335,7 +336,7 @@ class ArmModel:
         -------
         (..., n + n_locked) angles in full-arm order (joint numbers ascending) [rad].
         """
-        q = np.asarray(q, dtype=float)
+        q = as_joint_array(self, q)
         numbers = list(self.joint_numbers) + [lj.number for lj in self.locked]
         order = np.argsort(numbers)
         locked_vals = np.broadcast_to(
@@ -348,7 +349,7 @@ class ArmModel:
         q_full = np.asarray(q_full, dtype=float)
         numbers = sorted(list(self.joint_numbers) + [lj.number for lj in self.locked])
         if q_full.shape[-1] != len(numbers):
-            raise ModelError(
+            raise ConfigurationError(
                 f"q_full must have {len(numbers)} entries (joints {numbers}); got {q_full.shape[-1]}"
             )
         return q_full[..., [numbers.index(n) for n in self.joint_numbers]]

@@ -21,6 +21,12 @@ from .spatial import rot_x, translation
 
 BaseMode = Literal["fixed", "floating"]
 
+
+def _check_base(base: str) -> None:
+    if base not in ("fixed", "floating"):
+        raise ModelError(f"base must be 'fixed' or 'floating'; got {base!r}")
+
+
 # -- halt7 (seed 000, Tables 6-7) ----------------------------------------------------------
 
 #: Default spacecraft for ``halt7``.  000 gives no base: this one is ours, a 2000 kg body
@@ -53,6 +59,7 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
       DH frame.  The end effector is DH frame 7 (row 7's ``d_7 = 0.6`` m places it).
     * Base: 000 gives none; ``base="floating"`` attaches :data:`HALT7_SPACECRAFT` (ours).
     """
+    _check_base(base)
     deg = math.radians
     a = [0.0, 0.0, 0.0, 5.0, 5.0, 0.0, 0.0]
     alpha = [deg(v) for v in (0.0, 90.0, -90.0, 0.0, 0.0, 90.0, -90.0)]
@@ -123,6 +130,7 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
       formula (each segment of link i scaled by (m_0 + ... + m_i) / M) and reproduces its
       printed virtual lengths; the default ``"vafa-dubowsky"`` weighting is the exact one.
     """
+    _check_base(base)
     L = CANADARM7_LENGTHS
     deg = math.radians
     placements = [
@@ -204,6 +212,7 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
     * 002 gives no joint limits (+-180 deg here) and no masses: the link masses below are
       illustrative (ours), each link a slender rod between consecutive DH origins.
     """
+    _check_base(base)
     deg = math.radians
     a = [0.0, PUMA6_A2, 0.0, 0.0, 0.0, 0.0]
     alpha = [deg(v) for v in (-90.0, 0.0, 90.0, -90.0, 90.0, 0.0)]
@@ -254,8 +263,7 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         documented spacecraft; for a URDF, the root link's inertial; for a TOML file, its
         ``[base]`` table (``"fixed"`` drops it).
     """
-    if base not in ("fixed", "floating"):
-        raise ModelError(f"base must be 'fixed' or 'floating'; got {base!r}")
+    _check_base(base)
     text = str(name_or_path)
     factories = _builtin_factories()
     if text in factories:

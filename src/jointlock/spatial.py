@@ -99,12 +99,12 @@ def rotation_log(rotation: ArrayLike) -> FloatArray:
     """Log map SO(3) -> rotation vector (..., 3) [rad], robust near 0 and pi."""
     r = np.asarray(rotation, dtype=float)
     cos_angle = np.clip((np.trace(r, axis1=-2, axis2=-1) - 1.0) / 2.0, -1.0, 1.0)
-    angle = np.arccos(cos_angle)
     vee = np.stack(
         [r[..., 2, 1] - r[..., 1, 2], r[..., 0, 2] - r[..., 2, 0], r[..., 1, 0] - r[..., 0, 1]],
         axis=-1,
     )
-    sin_angle = np.sin(angle)
+    sin_angle = 0.5 * np.linalg.norm(vee, axis=-1)  # exact sin, not sin(arccos(.))
+    angle = np.arctan2(sin_angle, cos_angle)
     small = sin_angle < 1e-6
     scale = np.where(small, 0.5 + angle**2 / 12.0, angle / (2.0 * np.where(small, 1.0, sin_angle)))
     out = scale[..., None] * vee
