@@ -13,6 +13,7 @@ import jointlock as jl
 from jointlock.cli import main
 from jointlock.errors import ConfigurationError, InfeasibleError
 from jointlock.planning.halt_config import (
+    HaltReachability,
     ReachabilityBound,
     evaluate_cp,
     optimal_halt_configuration,
@@ -159,6 +160,105 @@ def test_reachability_infeasible_names_joint_and_time():
         bound.interval()
 
 
+# -- exact reachability (the halt polynomial) ------------------------------------------------------
+
+#: 000 §5.2's state at failure and limits (healthy joints 1, 2, 3, 5, 6, 7).
+STATE = (
+    np.radians([-180, -180, -100, -10, 20, 20]),
+    np.radians([20, 30, 15, 25, 40, 35]),
+    np.radians([8, 10, 12, 10, -8, 6]),
+)
+VMAX, AMAX = math.radians(40), math.radians(20)
+
+
+def _halt_problem(model, qf, T=10.0):
+    from jointlock.planning.halt_motion import HaltProblem
+
+    return HaltProblem(model, *STATE, qf, T, VMAX, AMAX)
+
+
+def _shared_k(model, qf, T=10.0):
+    from jointlock.planning.halt_motion import shared_k_interval
+
+    return shared_k_interval(_halt_problem(model, qf, T))
+
+
+@pytest.fixture(scope="module")
+def reach10():
+    return HaltReachability(*STATE, 10.0, VMAX, AMAX)
+
+
+def test_constrained_optimum_has_a_feasible_halt_motion(floating4, reach10):
+    from jointlock.planning.halt_motion import optimal_halt_motion
+
+    free = optimal_halt_configuration(floating4, samples=FEW, rng=0)
+    lo, hi = _shared_k(floating4, free.q_best)
+    assert lo > hi  # 000's way: the optimum cannot be reached in 10 s
+    res = optimal_halt_configuration(floating4, samples=FEW, rng=0, reachability=reach10)
+    assert 0 < res.reachable_samples <= FEW and res.reachable.sum() == res.reachable_samples
+    assert res.best.cp >= res.best_sample.cp
+    for cand in (res.best, res.best_sample, res.runner_up):
+        lo, hi = _shared_k(floating4, cand.q)
+        assert lo < hi
+    motion = optimal_halt_motion(_halt_problem(floating4, res.q_best), n_scan=41)
+    assert motion.feasible and not motion.violations
+    assert res.k_range[0] <= motion.k <= res.k_range[1]
+    data = res.to_dict()["reachability"]
+    assert data["kind"] == "exact" and data["reachable_samples"] == res.reachable_samples
+
+
+def test_masking_removes_unreachable_samples(floating4, reach10):
+    res = optimal_halt_configuration(floating4, samples=300, rng=0, reachability=reach10, refine=False)
+    np.testing.assert_array_equal(res.reachable, reach10.bind(floating4).contains(res.q_samples))
+    top = int(np.argmax(res.cp_samples))  # the best sample of the set is not reachable ...
+    assert not res.reachable[top]
+    lo, hi = _shared_k(floating4, res.q_samples[top])
+    assert lo > hi
+    # ... so the answer is the best *reachable* sample
+    assert res.best_sample.cp < res.cp_samples[top]
+    i = int(np.argmax(np.where(res.reachable, res.cp_samples, -np.inf)))
+    np.testing.assert_array_equal(res.best_sample.q, res.q_samples[i])
+    # the box is the reachable set's bounding box, inside the bang-bang one
+    b_lo, b_hi = reach10.bound().interval()
+    assert np.all(res.lower >= np.maximum(b_lo, -math.pi) - 1e-12)
+    assert np.all(res.upper <= np.minimum(b_hi, math.pi) + 1e-12)
+
+
+def test_exact_reachability_is_deterministic(floating4, reach10):
+    a = optimal_halt_configuration(floating4, samples=300, rng=5, reachability=reach10, refine_starts=2)
+    b = optimal_halt_configuration(floating4, samples=300, rng=5, reachability=reach10, refine_starts=2)
+    np.testing.assert_array_equal(a.q_samples, b.q_samples)
+    np.testing.assert_array_equal(a.reachable, b.reachable)
+    np.testing.assert_array_equal(a.q_best, b.q_best)
+    assert a.k_range == b.k_range and a.seed == 5
+
+
+def test_per_joint_reachability_contains_shared(floating4, rng):
+    shared = HaltReachability(*STATE, 8.0, VMAX, AMAX).bind(floating4)
+    per = HaltReachability(*STATE, 8.0, VMAX, AMAX, per_joint=True).bind(floating4)
+    q = rng.uniform(-math.pi, math.pi, size=(5000, 6))
+    a, b = shared.contains(q), per.contains(q)
+    assert np.all(b[a]) and b.sum() > a.sum()
+
+
+def test_unreachable_names_state_and_smallest_time(floating4):
+    # start at rest, 10 deg from the limits box [-20, 20] deg: nothing reachable in 0.5 s
+    q0 = np.radians([-40.0] * 6)
+    reach = HaltReachability(q0, np.zeros(6), np.zeros(6), 0.5, VMAX, AMAX)
+    lower, upper = np.radians([-20.0] * 6), np.radians([20.0] * 6)
+    with pytest.raises(InfeasibleError, match=r"T = 0.5 s from q0 = \[-40.*smallest halt time.*T = ") as info:
+        optimal_halt_configuration(
+            floating4, samples=100, rng=0, reachability=reach, lower=lower, upper=upper
+        )
+    t_min = float(str(info.value).rsplit("T = ", 1)[1].split()[0])
+    # a 20 deg move from rest to rest: the quintic's peak acceleration 10 h / (sqrt(3) T^2)
+    # reaches a_max at T = sqrt(10 / sqrt(3)) s (h = 20 deg, a_max = 20 deg/s^2)
+    assert t_min == pytest.approx(math.sqrt(10 / math.sqrt(3)), abs=0.01)
+    bound = reach.bind(floating4)
+    assert bound.search_box(lower, upper, t_min + 0.01) is not None
+    assert bound.search_box(lower, upper, t_min - 0.01) is None
+
+
 # -- plots, CLI ---------------------------------------------------------------------------------
 
 
@@ -231,3 +331,34 @@ def test_cp_at_paper_configurations(base):
 
 def kinematic_sigma_min(model, q):
     return np.linalg.svd(jl.jacobian(model, q), compute_uv=False)[..., -1]
+
+
+def test_cli_exact_reachability(capsys):
+    state = ["--from-q-deg", "-180", "-180", "-100", "-10", "20", "20"]
+    state += ["--from-dq-deg", "20", "30", "15", "25", "40", "35"]
+    state += ["--from-ddq-deg", "8", "10", "12", "10", "-8", "6", "--halt-time", "10"]
+    base = ["halt-config", "halt7", "--lock", "4=0", "--base", "floating", "--samples", "300", "--seed", "2"]
+    assert main(base + state + ["--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["reachability"]["kind"] == "exact" and 0 < data["reachability"]["reachable_samples"] <= 300
+    lo, hi = _shared_k(
+        jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0), np.radians(data["best"]["q_deg"])
+    )
+    assert lo < hi
+    assert main(base + state + ["--reachability", "bound", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["reachability"]["kind"] == "bang-bang bound"
+    assert main(base + state) == 0
+    assert "samples reachable" in capsys.readouterr().out
+
+
+def test_halt_pipeline_uses_exact_reachability(capsys):
+    """`jointlock halt halt7`: the optimal halt configuration is now reachable in 000's 10 s;
+    with --no-reachability (000's way) it is not."""
+    cmd = ["halt", "halt7", "--samples", "2000", "--n-samples", "101", "--json", "--quiet"]
+    assert main(cmd) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["feasible"] and not data["violations"] and data["reduction"] > 0
+    assert 0 < data["reachable_samples"] <= 2000 and "exact" in data["reachability"]
+    assert main(cmd + ["--no-reachability"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert not data["feasible"] and "reachability" not in data

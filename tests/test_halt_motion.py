@@ -10,8 +10,10 @@ import pytest
 import jointlock as jl
 from jointlock.planning.halt_motion import (
     K_UNIT_SCALE,
+    AffineKBounds,
     HaltProblem,
     constraint_violations,
+    feasible_k_interval_batch,
     feasible_k_intervals,
     global_base_torque,
     halt_coefficients,
@@ -164,3 +166,53 @@ def test_paper_numbers_under_each_reading():
         np.testing.assert_allclose(got, [t0, tk], rtol=1e-3)
         assert abs(got[0] - 22.25) / 22.25 > 5  # two orders of magnitude from 000's figure
     assert constraint_violations(_problem(), 0.0018 * K_DEG)
+
+
+# -- feasible k for a batch of halt configurations ------------------------------------------------
+
+
+def _candidates(rng, n=400):
+    """Halt configurations: half around 000's start (mostly reachable in 12 s), half anywhere."""
+    qf = np.vstack([Q0 + rng.uniform(-1.5, 2.5, size=(n // 2, 6)), rng.uniform(-3, 3, size=(n - n // 2, 6))])
+    return np.clip(qf, -math.pi, math.pi)
+
+
+def test_batched_intervals_equal_single_problems(rng):
+    p = _problem(T=12.0, theta_offsets=False)
+    qf = _candidates(rng)
+    args = (Q0, DQ0, DDQ0, qf, p.T, p.dq_max, p.ddq_max, p.q_min, p.q_max)
+    env = feasible_k_interval_batch(*args)
+    dense = feasible_k_interval_batch(*args, method="dense")
+    assert env.joint.shape == (qf.shape[0], 6, 2)
+    assert 0 < env.feasible.sum() < qf.shape[0]  # both kinds of candidate present
+    np.testing.assert_array_equal(env.feasible, dense.feasible)
+    np.testing.assert_array_equal(env.joint_feasible, dense.joint_feasible)
+    fin = np.isfinite(dense.joint)
+    np.testing.assert_array_equal(np.isfinite(env.joint), fin)
+    np.testing.assert_allclose(env.joint[fin], dense.joint[fin], rtol=1e-8, atol=1e-15)
+    picks = list(np.nonzero(env.feasible)[0][:3]) + list(np.nonzero(~env.feasible)[0][:3])
+    for i in picks:  # a loop over candidates, one HaltProblem each
+        single = HaltProblem(p.model, Q0, DQ0, DDQ0, qf[i], p.T, p.dq_max, p.ddq_max)
+        per = feasible_k_intervals(single)
+        lo, hi = shared_k_interval(single)
+        assert env.feasible[i] == (lo <= hi)
+        fin = np.isfinite(per)
+        np.testing.assert_array_equal(np.isfinite(env.joint[i]), fin)
+        np.testing.assert_allclose(env.joint[i][fin], per[fin], rtol=1e-9, atol=1e-15)
+        if lo <= hi:
+            assert env.lower[i] == pytest.approx(lo, rel=1e-9, abs=1e-15)
+            assert env.upper[i] == pytest.approx(hi, rel=1e-9, abs=1e-15)
+
+
+def test_configuration_box_holds_every_feasible_configuration(rng):
+    p = _problem(T=10.0, theta_offsets=False)
+    bounds = AffineKBounds.from_problem(p)
+    lo_box, hi_box, k_range, witness = bounds.configuration_box(np.full(6, -math.pi), np.full(6, math.pi))
+    assert bounds.intervals(witness).feasible and k_range[0] <= k_range[1]
+    qf = rng.uniform(-math.pi, math.pi, size=(20000, 6))
+    ok = bounds.intervals(qf).feasible
+    assert ok.any()
+    assert np.all(qf[ok] >= lo_box - 1e-9) and np.all(qf[ok] <= hi_box + 1e-9)
+    # the per-joint box (one k per joint) holds the shared-k box
+    lo_j, hi_j, none, _ = bounds.configuration_box(np.full(6, -math.pi), np.full(6, math.pi), per_joint=True)
+    assert none is None and np.all(lo_j <= lo_box + 1e-9) and np.all(hi_j >= hi_box - 1e-9)

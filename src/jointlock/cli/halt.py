@@ -85,7 +85,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--no-reachability",
         action="store_true",
         help="search the halt configuration over the whole joint ranges (000's way) instead of only "
-        "where each joint can come to rest within T under the limits",
+        "among configurations the halt polynomial reaches from the state within T under the limits "
+        "(exact constraint, the default)",
     )
     p.add_argument("--n-samples", type=int, default=501, help="time samples of the objective (odd)")
     p.add_argument("--generations", type=int, default=100, help="GA generations (default 100)")
@@ -150,28 +151,35 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
         notes["qf_source"] = "000's printed q_best"
     else:
         from ..errors import InfeasibleError
-        from ..planning.halt_config import ReachabilityBound, optimal_halt_configuration
+        from ..planning.halt_config import HaltReachability, optimal_halt_configuration
 
         reach = None
         if not getattr(args, "no_reachability", False):
-            # Only rest angles each joint can reach within T under the limits (a necessary
-            # condition for the halt motion): 000 samples the whole ranges, which can pick a
-            # configuration the halt cannot get to.
-            reach = ReachabilityBound(q0, dq0, float(T), vmax, amax, ddq0)
-            try:
-                reach.interval(model.joint_numbers)
-            except InfeasibleError as exc:
-                notes["reachability"] = f"not applied: {exc}"
-                reach = None
-        bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
-        hc = optimal_halt_configuration(
-            model, samples=args.samples, rng=args.seed, progress=bar, reachability=reach
-        )
-        bar.close()
-        if reach is not None:
-            notes["reachability"] = (
-                "halt configuration sampled within the rest angles reachable in T (bang-bang bound)"
+            # Only configurations the halt polynomial reaches from the state within T under
+            # the limits (exact, same grid as the halt motion): 000 samples the whole ranges,
+            # and its optimum can then have no feasible halt motion at all.
+            reach = HaltReachability(
+                q0, dq0, ddq0, float(T), vmax, amax, per_joint=getattr(args, "solver", "scan") == "vector"
             )
+        bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
+        try:
+            hc = optimal_halt_configuration(
+                model, samples=args.samples, rng=args.seed, progress=bar, reachability=reach
+            )
+        except InfeasibleError as exc:
+            if reach is None:
+                raise
+            notes["reachability"] = f"not met, searched the whole ranges instead (000's way): {exc}"
+            bar.close()
+            bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
+            hc = optimal_halt_configuration(model, samples=args.samples, rng=args.seed, progress=bar)
+        bar.close()
+        if reach is not None and hc.reachability is not None:
+            notes["reachability"] = (
+                f"exact: {hc.reachable_samples} of {args.samples} samples reachable by the halt polynomial "
+                f"within T = {float(T):g} s under the limits"
+            )
+            notes["reachable_samples"] = hc.reachable_samples
         qf = np.asarray(hc.q_best, dtype=float)
         notes["qf_source"] = (
             f"optimal halt configuration (Monte Carlo, {args.samples} samples, seed {args.seed})"
@@ -351,6 +359,8 @@ def run(args: argparse.Namespace) -> int:
         + ", ".join(f"{v:.2f}" for v in data["q_final_deg"])
         + " deg"
     )
+    if "reachability" in notes:
+        print(f"reachability: {notes['reachability']}")
     print(
         f"halt time T = {p.T:g} s; limits {np.degrees(p.dq_max[0]):g} deg/s, {np.degrees(p.ddq_max[0]):g} deg/s^2"
     )

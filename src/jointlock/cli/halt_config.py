@@ -13,7 +13,12 @@ import numpy as np
 
 from ..analysis.ability import INDEX_NAMES
 from ..errors import ScenarioError
-from ..planning.halt_config import ReachabilityBound, optimal_halt_configuration, write_section_plots
+from ..planning.halt_config import (
+    HaltReachability,
+    ReachabilityBound,
+    optimal_halt_configuration,
+    write_section_plots,
+)
 from ..progress import Progress
 from ..report import atomic_write_bytes, atomic_write_json
 from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json
@@ -65,10 +70,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--no-refine", action="store_true", help="plain Monte Carlo, as 000 (no local refinement)")
     reach = p.add_argument_group(
-        "reachability", "require the halt configuration to be reachable from a state within a halt time"
+        "reachability",
+        "require the halt configuration to be reachable from a state within a halt time: by default "
+        "exactly, by 000's halt polynomial (eq. 27) under the limits for some k",
     )
     reach.add_argument("--from-q-deg", type=float, nargs="+", metavar="DEG", help="start angles [deg]")
     reach.add_argument("--from-dq-deg", type=float, nargs="+", metavar="DEG", help="start rates [deg/s]")
+    reach.add_argument(
+        "--from-ddq-deg",
+        type=float,
+        nargs="+",
+        metavar="DEG",
+        help="start accelerations [deg/s^2] (default 0)",
+    )
     reach.add_argument("--halt-time", type=float, metavar="S", help="halt time T [s]")
     reach.add_argument(
         "--vmax-deg", type=float, default=40.0, help="speed limit [deg/s] (default 40, as 000)"
@@ -76,17 +90,29 @@ def register(sub: argparse._SubParsersAction) -> None:
     reach.add_argument(
         "--amax-deg", type=float, default=20.0, help="acceleration limit [deg/s^2] (default 20)"
     )
+    reach.add_argument(
+        "--reachability",
+        choices=("exact", "bound"),
+        default="exact",
+        help="exact: the halt polynomial must have a feasible k (default); bound: only the bang-bang "
+        "box of rest angles (necessary, not sufficient)",
+    )
+    reach.add_argument(
+        "--per-joint-k",
+        action="store_true",
+        help="exact reachability with one k per joint instead of a shared k",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write result.json, section plots and samples here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
 
 
-def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | None:
+def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltReachability | None:
     given = [args.from_q_deg is not None, args.halt_time is not None]
     if not any(given):
-        if args.from_dq_deg is not None:
-            raise ScenarioError("--from-dq-deg needs --from-q-deg and --halt-time")
+        if args.from_dq_deg is not None or getattr(args, "from_ddq_deg", None) is not None:
+            raise ScenarioError("--from-dq-deg/--from-ddq-deg need --from-q-deg and --halt-time")
         return None
     if not all(given):
         raise ScenarioError(
@@ -105,8 +131,16 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | None:
     ):
         if not (math.isfinite(value) and value > 0):
             raise ScenarioError(f"{name} must be a finite number > 0; got {value}")
-    return ReachabilityBound(
-        q0, dq0, args.halt_time, math.radians(args.vmax_deg), math.radians(args.amax_deg)
+    ddq0 = (
+        joint_vector_deg(model, args.from_ddq_deg, "--from-ddq-deg")
+        if getattr(args, "from_ddq_deg", None)
+        else np.zeros(model.dof)
+    )
+    vmax, amax = math.radians(args.vmax_deg), math.radians(args.amax_deg)
+    if getattr(args, "reachability", "exact") == "bound":
+        return ReachabilityBound(q0, dq0, args.halt_time, vmax, amax, ddq0)
+    return HaltReachability(
+        q0, dq0, ddq0, args.halt_time, vmax, amax, per_joint=getattr(args, "per_joint_k", False)
     )
 
 
@@ -198,9 +232,19 @@ def _print_text(model, result, reach) -> None:
     )
     if result.jacobian == "generalized" and result.base == "fixed":
         print("  (fixed base: the generalized Jacobian is the fixed-base one; --base floating for 000's J_F)")
-    print(
-        f"samples: {result.samples}, seed: {result.seed}" + (", reachability bound applied" if reach else "")
-    )
+    print(f"samples: {result.samples}, seed: {result.seed}")
+    if isinstance(reach, HaltReachability):
+        k_txt = ""
+        if result.k_range is not None:
+            lo, hi = np.degrees(result.k_range)
+            k_txt = f", shared k in [{lo:.4g}, {hi:.4g}] deg/s^6"
+        print(
+            f"reachability (exact, halt polynomial, {'one k per joint' if reach.per_joint else 'shared k'}, "
+            f"T = {reach.halt_time:g} s): {result.reachable_samples} of {result.samples} samples reachable"
+            f"{k_txt}; box {_fmt_q(result.lower)} .. {_fmt_q(result.upper)} deg"
+        )
+    elif reach is not None:
+        print(f"reachability: bang-bang bound, box {_fmt_q(result.lower)} .. {_fmt_q(result.upper)} deg")
     print(f"\n{'':<14}{'q [deg]':<62}{'CP':>9}{'sigma_min':>11}{'kappa':>11}{'w':>11}")
     rows = [("best", result.best), ("best sample", result.best_sample), ("runner-up", result.runner_up)]
     for label, c in rows:

@@ -18,7 +18,7 @@ from __future__ import annotations
 import logging
 import math
 import secrets
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Literal
 
@@ -40,6 +40,7 @@ from ..analysis.ability import (
 from ..errors import ConfigurationError, InfeasibleError
 from ..model import ArmModel, FloatArray, as_joint_array
 from ..progress import Progress
+from .halt_motion import AffineKBounds, KIntervalBatch
 
 logger = logging.getLogger(__name__)
 
@@ -181,6 +182,183 @@ def _max_rest_displacement(v0: FloatArray, vmax: FloatArray, amax: FloatArray, t
     return np.where(peak <= vmax, no_cruise, cruise)
 
 
+@dataclass(frozen=True)
+class HaltReachability:
+    """Exact reachability of a halt configuration by 000's halt polynomial (eq. 27): the
+    halt from the state ``(q0, dq0, ddq0)`` to ``qf`` in the halt time ``T`` must respect the
+    angle, speed and acceleration limits for some ``k`` (a shared ``k`` as 000, or one ``k``
+    per joint), checked on the same time grid as :class:`~jointlock.planning.halt_motion.HaltProblem`.
+
+    Unlike :class:`ReachabilityBound` (bang-bang, necessary only) a configuration that passes
+    has a feasible halt motion.  Every limit is affine in ``k`` and in ``qf``
+    (:class:`~jointlock.planning.halt_motion.AffineKBounds`), so whole sample sets are checked
+    in one batched call, the reachable set is convex, and its bounding box is computed
+    exactly (to a grid per joint) before sampling.
+
+    Attributes
+    ----------
+    q0, dq0, ddq0
+        (n,) healthy-joint angles [rad], rates [rad/s], accelerations [rad/s^2] at the start.
+    halt_time
+        ``T`` [s].
+    velocity_limit, acceleration_limit
+        (n,) ``v_max`` [rad/s] and ``a_max`` [rad/s^2] (symmetric limits).
+    per_joint
+        False (000): one shared ``k``; True: one ``k`` per joint (then the set is a box).
+    angle_lower, angle_upper
+        (n,) angle limits [rad] of the halt; None: the model's (filled in by
+        :func:`optimal_halt_configuration`, as ``HaltProblem`` does).
+    n_check
+        Time grid of the check (``HaltProblem.n_check``).
+    margin
+        Relative margin for the search [-]: a configuration is accepted when its feasible
+        ``k`` interval is at least this fraction of ``max(|k_min|, |k_max|)`` wide, so that
+        the halt-motion solver (same limits, other round-off) finds a non-degenerate interval.
+    n_grid
+        Grid points per joint of the bounding box.
+    """
+
+    q0: FloatArray
+    dq0: FloatArray
+    ddq0: FloatArray
+    halt_time: float
+    velocity_limit: FloatArray
+    acceleration_limit: FloatArray
+    per_joint: bool = False
+    angle_lower: FloatArray | None = None
+    angle_upper: FloatArray | None = None
+    n_check: int = 2001
+    margin: float = 1e-6
+    n_grid: int = 4001
+
+    def __post_init__(self) -> None:
+        b = ReachabilityBound(
+            self.q0, self.dq0, self.halt_time, self.velocity_limit, self.acceleration_limit, self.ddq0
+        )
+        if b.ddq0 is None:
+            raise ConfigurationError("ddq0 is required [rad/s^2] (zeros for a start without acceleration)")
+        if not np.all(np.isfinite(b.velocity_limit)):
+            raise ConfigurationError("velocity_limit must be finite [rad/s]")
+        for name in ("q0", "dq0", "ddq0", "halt_time", "velocity_limit", "acceleration_limit"):
+            object.__setattr__(self, name, getattr(b, name))
+        n = b.q0.size
+        for name in ("angle_lower", "angle_upper"):
+            v = getattr(self, name)
+            if v is not None:
+                arr = np.broadcast_to(np.asarray(v, dtype=float), (n,))
+                if not np.all(np.isfinite(arr)):
+                    raise ConfigurationError(f"{name} must be finite [rad]; got {arr.tolist()}")
+                object.__setattr__(self, name, _readonly(arr))
+        if not (isinstance(self.margin, (int, float)) and 0 <= self.margin < 0.1):
+            raise ConfigurationError(f"margin must be in [0, 0.1); got {self.margin!r}")
+        if int(self.n_check) < 3 or int(self.n_grid) < 3:
+            raise ConfigurationError("n_check and n_grid must be >= 3")
+        object.__setattr__(self, "per_joint", bool(self.per_joint))
+
+    def bound(self) -> ReachabilityBound:
+        """The bang-bang outer bound of the same state and limits."""
+        return ReachabilityBound(
+            self.q0, self.dq0, self.halt_time, self.velocity_limit, self.acceleration_limit, self.ddq0
+        )
+
+    def bind(self, model: ArmModel) -> HaltReachability:
+        """This constraint with the model's angle limits where none were given."""
+        if self.q0.shape != (model.dof,):
+            raise ConfigurationError(
+                f"reachability.q0 must have {model.dof} entries (joints {list(model.joint_numbers)}); "
+                f"got {self.q0.shape}"
+            )
+        lo = model.lower if self.angle_lower is None else self.angle_lower
+        hi = model.upper if self.angle_upper is None else self.angle_upper
+        return replace(self, angle_lower=lo, angle_upper=hi)
+
+    def bounds(self, T: float | None = None) -> AffineKBounds:
+        """The limits as bounds on ``k`` affine in ``qf`` (for ``T``, default :attr:`halt_time`)."""
+        return AffineKBounds(
+            self.q0,
+            self.dq0,
+            self.ddq0,
+            self.halt_time if T is None else T,
+            self.velocity_limit,
+            self.acceleration_limit,
+            self.angle_lower,
+            self.angle_upper,
+            n_check=self.n_check,
+        )
+
+    def intervals(self, q: ArrayLike) -> KIntervalBatch:
+        """Feasible ``k`` [rad/s^6] of the halt to each configuration (K, n) [rad]."""
+        return self.bounds().intervals(q)
+
+    def contains(self, q: ArrayLike) -> np.ndarray:
+        """(...) bool: configurations (..., n) [rad] reachable, with the :attr:`margin`."""
+        iv = self.intervals(q)
+        if self.per_joint:
+            lo, hi = iv.joint[..., 0], iv.joint[..., 1]
+            return np.all(hi - lo >= self.margin * np.maximum(np.abs(lo), np.abs(hi)), axis=-1)
+        width = iv.upper - iv.lower
+        return iv.feasible & (width >= self.margin * np.maximum(np.abs(iv.lower), np.abs(iv.upper)))
+
+    def search_box(
+        self, lower: ArrayLike, upper: ArrayLike, T: float | None = None
+    ) -> tuple[FloatArray, FloatArray, tuple[float, float] | None, FloatArray] | None:
+        """Bounding box of the reachable configurations within ``[lower, upper]`` (the
+        bang-bang bound narrows it first), the feasible shared ``k`` range and a reachable
+        configuration; None when none is reachable (see
+        :meth:`AffineKBounds.configuration_box`)."""
+        t = self.halt_time if T is None else float(T)
+        lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+        try:
+            r_lo, r_hi = replace(self.bound(), halt_time=t).interval()
+        except InfeasibleError:
+            return None
+        lo, hi = np.maximum(lo, r_lo), np.minimum(hi, r_hi)
+        if np.any(hi < lo):
+            return None
+        return self.bounds(t).configuration_box(lo, hi, per_joint=self.per_joint, n_grid=self.n_grid)
+
+    def minimum_halt_time(
+        self,
+        lower: ArrayLike,
+        upper: ArrayLike,
+        *,
+        step: float = 0.25,
+        t_max: float | None = None,
+        tol: float = 1e-3,
+    ) -> float | None:
+        """Smallest halt time [s] for which some configuration in ``[lower, upper]`` is
+        reachable: scan in ``step`` from the braking time ``max |dq0| / a_max``, then bisect
+        to ``tol`` (None when none up to ``t_max``, default ``max(10 T, 120 s)``)."""
+        t_stop = float(np.max(np.abs(self.dq0) / self.acceleration_limit))
+        t_max = max(10 * self.halt_time, 120.0) if t_max is None else t_max
+
+        def ok(t: float) -> bool:
+            return self.search_box(lower, upper, t) is not None
+
+        prev = t_stop
+        t = max(t_stop, step)
+        while t <= t_max + 1e-9:
+            if ok(t):
+                a, b = prev, t
+                while b - a > tol:
+                    mid = 0.5 * (a + b)
+                    a, b = (a, mid) if ok(mid) else (mid, b)
+                return b
+            prev, t = t, t + step
+        return None
+
+    def describe_state(self) -> str:
+        """The state and limits in degrees, for messages."""
+
+        def fmt(v: FloatArray) -> str:
+            return "[" + ", ".join(f"{x:.4g}" for x in np.degrees(v)) + "]"
+
+        return (
+            f"q0 = {fmt(self.q0)} deg, dq0 = {fmt(self.dq0)} deg/s, ddq0 = {fmt(self.ddq0)} deg/s^2, "
+            f"|dq| <= {fmt(self.velocity_limit)} deg/s, |ddq| <= {fmt(self.acceleration_limit)} deg/s^2"
+        )
+
+
 # -- result -----------------------------------------------------------------------------------
 
 
@@ -250,13 +428,22 @@ class HaltConfiguration:
     characteristic_length
         ``L`` [m] or None (raw Jacobian, as 000).
     reachability
-        The reachability bound applied, or None.
+        The reachability constraint applied (:class:`HaltReachability`, exact, or
+        :class:`ReachabilityBound`, bang-bang box only), or None.
     q_samples, cp_samples
         (K, n) [rad] and (K,): the sample set and its CP.
     indices_samples
         Indices of the sample set, arrays (K,).
     refine_evaluations
         Configurations evaluated by the refinement.
+    reachable
+        (K,) bool: samples whose halt motion is feasible (:class:`HaltReachability`), or
+        None.  Unreachable samples keep their CP (the normalisation and entropy weights are
+        fitted on the whole sample set) but can be neither the best nor the runner-up.
+    reachable_samples
+        How many samples are reachable (None without :class:`HaltReachability`).
+    k_range
+        Feasible shared ``k`` [rad/s^6] over the reachable set (shared-``k`` constraint only).
     """
 
     best: HaltCandidate
@@ -273,11 +460,14 @@ class HaltConfiguration:
     lower: FloatArray
     upper: FloatArray
     characteristic_length: float | None
-    reachability: ReachabilityBound | None
+    reachability: ReachabilityBound | HaltReachability | None
     q_samples: FloatArray = field(repr=False)
     cp_samples: FloatArray = field(repr=False)
     indices_samples: KinematicIndices = field(repr=False)
     refine_evaluations: int = 0
+    reachable: np.ndarray | None = field(default=None, repr=False)
+    reachable_samples: int | None = None
+    k_range: tuple[float, float] | None = None
 
     @property
     def q_best(self) -> FloatArray:
@@ -334,7 +524,30 @@ class HaltConfiguration:
             "locked_deg": {str(k): math.degrees(v) for k, v in self.locked.items()},
             "lower_deg": np.degrees(self.lower).tolist(),
             "upper_deg": np.degrees(self.upper).tolist(),
+            "reachability": self._reachability_dict(),
         }
+
+    def _reachability_dict(self) -> dict[str, Any] | None:
+        r = self.reachability
+        if r is None:
+            return None
+        out: dict[str, Any] = {
+            "kind": "exact" if isinstance(r, HaltReachability) else "bang-bang bound",
+            "halt_time_s": r.halt_time,
+            "q0_deg": np.degrees(r.q0).tolist(),
+            "dq0_deg": np.degrees(r.dq0).tolist(),
+            "ddq0_deg": None if r.ddq0 is None else np.degrees(r.ddq0).tolist(),
+            "velocity_limit_deg": np.degrees(r.velocity_limit).tolist(),
+            "acceleration_limit_deg": np.degrees(r.acceleration_limit).tolist(),
+        }
+        if isinstance(r, HaltReachability):
+            scale = math.pi / 180.0  # k in deg/s^6, 000's reading
+            out.update(
+                per_joint_k=r.per_joint,
+                reachable_samples=self.reachable_samples,
+                k_range_deg_s6=None if self.k_range is None else [v / scale for v in self.k_range],
+            )
+        return out
 
 
 # -- the search -------------------------------------------------------------------------------
@@ -413,7 +626,7 @@ def optimal_halt_configuration(
     characteristic_length: float | None = None,
     lower: ArrayLike | None = None,
     upper: ArrayLike | None = None,
-    reachability: ReachabilityBound | None = None,
+    reachability: ReachabilityBound | HaltReachability | None = None,
     runner_up_separation: float = RUNNER_UP_SEPARATION,
     batch_size: int = DEFAULT_BATCH,
     progress: Progress | None = None,
@@ -449,8 +662,14 @@ def optimal_halt_configuration(
     lower, upper
         (n,) sampling box [rad]; default the joint limits capped to +-pi (000: [-180, 180] deg).
     reachability
-        Keep only configurations where every joint can be at rest within the halt time
-        (:class:`ReachabilityBound`); the box is intersected with the reachable one.
+        :class:`HaltReachability` (exact): only configurations that 000's halt polynomial
+        reaches from the given state within ``T`` under the limits.  The sampling box is the
+        bounding box of the reachable set (within the bang-bang bound and ``lower``/``upper``);
+        samples outside the set are masked (they cannot be the best or the runner-up); the
+        refinement keeps the constraint (a refined point that leaves the set is pulled back
+        along the segment from its start, which is reachable, the set being convex).
+        :class:`ReachabilityBound` (bang-bang, necessary only): the box is intersected with
+        each joint's reachable rest angles.
     runner_up_separation
         Minimum largest-joint difference of the runner-up from the best [rad].
     batch_size
@@ -465,7 +684,10 @@ def optimal_halt_configuration(
     Raises
     ------
     InfeasibleError
-        When the reachability bound leaves no admissible angle for some joint.
+        When the reachability bound leaves no admissible angle for some joint, or no
+        configuration is reachable under :class:`HaltReachability` (the message gives the
+        state, ``T`` and the smallest halt time with a reachable configuration), or none of
+        the samples is.
     """
     from scipy.optimize import minimize
 
@@ -476,18 +698,37 @@ def optimal_halt_configuration(
     if int(refine_starts) < 1:
         raise ConfigurationError(f"refine_starts must be >= 1; got {refine_starts!r}")
     generator, seed = _resolve_rng(rng)
-    lo, hi = _sampling_box(model_locked, lower, upper, reachability)
+    exact_reach: HaltReachability | None = None
+    k_range = None
+    if isinstance(reachability, HaltReachability):
+        exact_reach = reachability = reachability.bind(model_locked)
+        lo, hi = _sampling_box(model_locked, lower, upper, None)
+        box = exact_reach.search_box(lo, hi)
+        if box is None:
+            raise InfeasibleError(_unreachable_message(exact_reach, lo, hi, model_locked.joint_numbers))
+        lo, hi, k_range, _ = box
+        lo, hi = _readonly(lo), _readonly(hi)
+    else:
+        lo, hi = _sampling_box(model_locked, lower, upper, reachability)
     n = model_locked.dof
     k = int(samples)
 
     q = lo + (hi - lo) * generator.random((k, n))  # 000 eq. (21)-(22), one row per sample
+    reachable = None if exact_reach is None else exact_reach.contains(q)
+    if reachable is not None and not reachable.any():
+        raise InfeasibleError(
+            f"none of the {k} samples is reachable within T = {exact_reach.halt_time:g} s, although "
+            f"reachable configurations exist in the box [{', '.join(f'{v:.4g}' for v in np.degrees(lo))}] .. "
+            f"[{', '.join(f'{v:.4g}' for v in np.degrees(hi))}] deg (a thin set): increase samples or T"
+        )
     opts = {"jacobian": jacobian, "characteristic_length": characteristic_length}
     ind = configuration_indices(
         model_locked, q, method="gram", batch_size=batch_size, progress=progress, **opts
     )
     ability = fit_ability_model(ind, judgment=judgment, assignment=assignment, renormalize=renormalize, ri=ri)
     cp = ability(ind)
-    order = np.argsort(-cp, kind="stable")
+    order = np.argsort(-cp if reachable is None else np.where(reachable, -cp, np.inf), kind="stable")
+    n_ok = k if reachable is None else int(reachable.sum())
 
     def exact(qs: FloatArray) -> tuple[FloatArray, KinematicIndices]:
         i = configuration_indices(model_locked, qs, method="svd", **opts)
@@ -511,9 +752,12 @@ def optimal_halt_configuration(
             grad = np.divide(val[1 : n + 1] - val[n + 1 :], h, out=np.zeros(n), where=h > 0)
             return -float(val[0]), -grad
 
-        for idx in order[: int(refine_starts)]:
+        for idx in order[: min(int(refine_starts), n_ok)]:
             res = minimize(fun, q[idx], jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)))
             x = np.clip(res.x, lo, hi)
+            if exact_reach is not None and not exact_reach.contains(x):
+                x = _pull_back(exact_reach, q[idx], x)
+                evaluations += 1
             refined_q.append(x)
             refined_cp.append(float(exact(x)[0]))
     best = best_sample
@@ -522,8 +766,10 @@ def optimal_halt_configuration(
         c, i = exact(refined_q[j])
         best = _candidate(refined_q[j], c, i)
 
-    pool_q = np.vstack([np.asarray(refined_q).reshape(-1, n), q])
-    pool_cp = np.concatenate([np.asarray(refined_cp, dtype=float), cp])
+    pool_q = np.vstack([np.asarray(refined_q).reshape(-1, n), q if reachable is None else q[reachable]])
+    pool_cp = np.concatenate(
+        [np.asarray(refined_cp, dtype=float), cp if reachable is None else cp[reachable]]
+    )
     # Runner-up: far from the best, and not an equivalent of it (same CP: e.g. joint 1 of a
     # fixed base, or a joint turning about the tool axis, leaves every index unchanged).
     far = (np.max(np.abs(pool_q - best.q), axis=-1) > runner_up_separation) & (
@@ -539,6 +785,8 @@ def optimal_halt_configuration(
     logger.info("HCOM: best sample CP %.6g, refined %.6g (gain %.3g)", best_sample.cp, best.cp, gain)
     q.setflags(write=False)
     cp.setflags(write=False)
+    if reachable is not None:
+        reachable.setflags(write=False)
     return HaltConfiguration(
         best=best,
         best_sample=best_sample,
@@ -559,7 +807,37 @@ def optimal_halt_configuration(
         cp_samples=cp,
         indices_samples=ind,
         refine_evaluations=evaluations,
+        reachable=reachable,
+        reachable_samples=None if reachable is None else n_ok,
+        k_range=k_range,
     )
+
+
+def _pull_back(reach: HaltReachability, start: FloatArray, x: FloatArray, rounds: int = 3) -> FloatArray:
+    """The farthest reachable point on the segment from ``start`` (reachable) to ``x``: the
+    reachable set is convex, so its part of the segment is ``[0, lam*]``; each round checks 65
+    points of the current bracket in one batched call."""
+    a, b = 0.0, 1.0
+    for _ in range(rounds):
+        lam = np.linspace(a, b, 65)
+        ok = reach.contains(start + lam[:, None] * (x - start))
+        i = int(np.nonzero(ok)[0].max()) if ok.any() else 0
+        a, b = float(lam[i]), float(lam[min(i + 1, lam.size - 1)])
+    return start + a * (x - start)
+
+
+def _unreachable_message(
+    reach: HaltReachability, lo: FloatArray, hi: FloatArray, joint_numbers: tuple[int, ...]
+) -> str:
+    t_min = reach.minimum_halt_time(lo, hi)
+    which = "one k per joint" if reach.per_joint else "a shared k (000)"
+    msg = (
+        f"no halt configuration is reachable by the halt polynomial with {which} within "
+        f"T = {reach.halt_time:g} s from {reach.describe_state()} (healthy joints {list(joint_numbers)})"
+    )
+    if t_min is None:
+        return msg + "; no halt time up to the search limit makes one reachable"
+    return msg + f"; the smallest halt time with a reachable configuration is T = {t_min:.3f} s"
 
 
 def evaluate_cp(result: HaltConfiguration, model_locked: ArmModel, q: ArrayLike) -> FloatArray:
@@ -578,6 +856,8 @@ def evaluate_cp(result: HaltConfiguration, model_locked: ArmModel, q: ArrayLike)
 def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
     """One matplotlib figure per healthy joint: joint angle [deg] vs CP over the sample set,
     with the upper envelope (max CP per angle bin), the best and the runner-up (000 Fig. 7).
+    Under :class:`HaltReachability` unreachable samples are grey and the envelope is over
+    the reachable ones.
 
     Returns
     -------
@@ -593,10 +873,21 @@ def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
     for j, number in enumerate(result.joint_numbers):
         fig = Figure(figsize=(5.0, 3.4))
         ax = fig.add_subplot()
-        ax.scatter(q_deg[:, j], result.cp_samples, s=1.5, alpha=0.25, color="tab:blue", rasterized=True)
-        which = np.clip(np.digitize(q_deg[:, j], edges) - 1, 0, bins - 1)
+        ok = np.ones(result.samples, bool) if result.reachable is None else result.reachable
+        if not ok.all():
+            ax.scatter(
+                q_deg[~ok, j],
+                result.cp_samples[~ok],
+                s=1.5,
+                alpha=0.2,
+                color="0.7",
+                rasterized=True,
+                label="unreachable",
+            )
+        ax.scatter(q_deg[ok, j], result.cp_samples[ok], s=1.5, alpha=0.25, color="tab:blue", rasterized=True)
+        which = np.clip(np.digitize(q_deg[ok, j], edges) - 1, 0, bins - 1)
         envelope = np.full(bins, np.nan)
-        np.fmax.at(envelope, which, result.cp_samples)
+        np.fmax.at(envelope, which, result.cp_samples[ok])
         centres = 0.5 * (edges[1:] + edges[:-1])
         ax.plot(centres, envelope, color="tab:blue", lw=1.2, label="max CP per bin")
         ax.plot(math.degrees(result.best.q[j]), result.best.cp, "r*", ms=12, label="best")
