@@ -70,3 +70,22 @@ def test_ga_rejects_bad_fitness():
     with pytest.raises(jl.ScenarioError, match="fitness"):
         adaptive_ga(lambda x: -np.ones(len(x)), 0.0, 1.0, settings=GASettings(n_pop=4, n_gen=1), rng=0)
     assert math.isfinite(bits_for_precision(0, 1, 0.5))
+
+
+def test_ga_default_seed_is_0_and_a_fresh_seed_is_recorded():
+    st = GASettings(n_pop=10, n_gen=5, n_bits=8)
+
+    def fitness(x):
+        return 1.0 / (1.0 + (x[:, 0] - 0.3) ** 2)
+
+    a = adaptive_ga(fitness, -1.0, 1.0, settings=st)
+    b = adaptive_ga(fitness, -1.0, 1.0, settings=st)
+    assert a.seed == 0
+    np.testing.assert_array_equal(a.best_history, b.best_history)
+    np.testing.assert_array_equal(
+        a.mean_history, adaptive_ga(fitness, -1.0, 1.0, settings=st, rng=0).mean_history
+    )
+    fresh = adaptive_ga(fitness, -1.0, 1.0, settings=st, rng=None)
+    assert isinstance(fresh.seed, int) and fresh.seed >= 0  # repeatable from the result
+    again = adaptive_ga(fitness, -1.0, 1.0, settings=st, rng=fresh.seed)
+    np.testing.assert_array_equal(fresh.mean_history, again.mean_history)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import warnings
 
 import numpy as np
 import pytest
@@ -18,6 +19,7 @@ from jointlock.planning.jump import (
     find_breaks,
     fit_kappa,
     fit_pieces,
+    jump_reduction,
     jump_table,
     load_scenario,
     ramp_schedule,
@@ -290,3 +292,74 @@ def test_multistart_search_finds_narrow_valley(halt7_search):
     assert 0 < multi.kappa_opt[0] < 5e-4
     assert multi.objective_opt[0] < 0.3 * s.objective_opt[i]
     assert multi.interval[0, 0] <= multi.kappa_opt[0] <= multi.interval[0, 1]
+
+
+# -- review fixes ---------------------------------------------------------------------------------
+
+
+def _ramp_loop(kappa, max_step):
+    """The step-by-step ramp_schedule this module used to have (reference)."""
+    kap = np.asarray(kappa, dtype=float)
+    parts = []
+    for part in (np.maximum(kap, 0.0), np.maximum(-kap, 0.0)):
+        env = part.copy()
+        for k in range(1, env.size):
+            env[k] = min(env[k], env[k - 1] + 0.5 * max_step)
+        for k in range(env.size - 2, -1, -1):
+            env[k] = min(env[k], env[k + 1] + 0.5 * max_step)
+        parts.append(env)
+    return parts[0] - parts[1]
+
+
+def test_ramp_schedule_closed_form_equals_the_loop(rng):
+    for _ in range(200):
+        n = int(rng.integers(1, 400))
+        scale = float(rng.choice([1e-4, 1.0, 1e3]))
+        k = rng.normal(size=n) * scale
+        k[rng.random(n) < 0.3] = 0.0
+        step = float(rng.choice([0.0, 1e-3, 0.1, 1.0, 10.0, np.inf])) * scale
+        r = ramp_schedule(k, step)
+        np.testing.assert_allclose(r, _ramp_loop(k, step), rtol=1e-12, atol=1e-12 * scale)
+        assert np.all(np.abs(r) <= np.abs(k))  # exact, despite round-off
+    batch = rng.normal(size=(3, 50))
+    np.testing.assert_allclose(
+        ramp_schedule(batch, 0.2), np.stack([_ramp_loop(b, 0.2) for b in batch]), rtol=1e-12, atol=1e-14
+    )
+    assert float(ramp_schedule(2.5, 0.1)) == 2.5
+
+
+def test_ramp_schedule_does_not_loop_in_python(monkeypatch):
+    import builtins
+
+    calls = []
+    real_min = builtins.min
+
+    def counting_min(*a, **kw):
+        calls.append(1)
+        return real_min(*a, **kw)
+
+    monkeypatch.setattr(builtins, "min", counting_min)
+    ramp_schedule(np.linspace(-1, 1, 1000), 0.01)
+    assert not calls
+
+
+def test_reduction_is_undefined_without_a_jump(arm):
+    still = JumpScenario(duration=1.0, blend=0.25, dx=(0.0, 0.0, 0.0))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        r = jl.planning.jump.jump_at_time(arm, still, 0.5, kappa=0.0)
+        assert r.jump_before == 0.0 and math.isnan(r.reduction)
+        v = verify_kappa(arm, still, 0.0)
+        assert math.isnan(v.mean_reduction) and v.share_improved == 0.0
+    assert jump_reduction(2.0, 0.5) == 0.75 and math.isnan(jump_reduction(0.0, 0.0))
+    assert math.isnan(jump_reduction(0.0, 1.0))  # a jump the compensation made: no ratio
+    np.testing.assert_array_equal(jump_reduction([1.0, 0.0], [0.5, 0.0]), [0.5, np.nan])
+
+
+def test_load_scenario_unreadable_files(tmp_path):
+    with pytest.raises(jl.ScenarioError, match="cannot read scenario file .*: Is a directory"):
+        load_scenario(tmp_path)
+    bad = tmp_path / "latin1.toml"
+    bad.write_bytes("kp = 1.5 # \xe9\n".encode("latin-1"))
+    with pytest.raises(jl.ScenarioError, match="is not UTF-8 text"):
+        load_scenario(bad)

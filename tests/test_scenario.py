@@ -127,3 +127,32 @@ def test_jobs_list_selects_and_orders(tmp_path):
     )
     assert sc.jobs == ("workspace",)
     assert math.isclose(sc.lock[1], 60.0)
+
+
+def test_full_arm_rates_need_a_zero_locked_entry(tmp_path):
+    head = 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 30\n[halt]\n[state]\n'
+    q0 = "q0_deg = [-180, -180, -100, 30, -10, 20, 20]\n"
+    ok = write(
+        tmp_path, head + q0 + "dq0_deg = [20, 30, 15, 0, 25, 40, 35]\nddq0_deg = [8, 10, 12, 0, 10, -8, 6]\n"
+    )
+    sc = load_scenario(ok)  # rates of every joint, the locked one 0: a correct scenario
+    assert sc.data["state"]["dq0_deg"][3] == 0
+    for key, values in (
+        ("dq0_deg", "[20, 30, 15, 30, 25, 40, 35]"),
+        ("ddq0_deg", "[8, 10, 12, 5, 10, -8, 6]"),
+    ):
+        other = (
+            "ddq0_deg = [8, 10, 12, 10, -8, 6]" if key == "dq0_deg" else "dq0_deg = [20, 30, 15, 25, 40, 35]"
+        )
+        path = write(tmp_path, head + q0 + f"{key} = {values}\n{other}\n", name=f"{key}.toml")
+        with pytest.raises(ScenarioError) as err:
+            load_scenario(path)
+        msg = str(err.value)
+        assert f"state.{key}: entry 4 (the locked joint) must be 0" in msg
+        assert "failure.angle_deg" not in msg
+    # angles keep their rule
+    bad_q = write(tmp_path, head + "q0_deg = [-180, -180, -100, 0, -10, 20, 20]\n", name="q.toml")
+    with pytest.raises(
+        ScenarioError, match=r"state.q0_deg: entry 4 \(the locked joint\) must equal failure.angle_deg"
+    ):
+        load_scenario(bad_q)

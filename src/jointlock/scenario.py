@@ -544,7 +544,12 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
         locked = lock(model, fail["joint"], math.radians(fail["angle_deg"]))
     _defaults_000(out, jobs, model)
 
-    def vector(where: str, values: list[float] | None, *, full_only: bool = False) -> None:
+    def vector(
+        where: str, values: list[float] | None, *, full_only: bool = False, rates: bool = False
+    ) -> None:
+        """Check a joint vector's length; with every joint given (and a lock), the locked
+        joint's entry must equal its lock angle (angles) or be 0 (``rates``: rates and
+        accelerations, as a locked joint does not move)."""
         if values is None:
             return
         sizes = {n} if full_only or locked is None else {locked.dof, n}
@@ -558,6 +563,13 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
             )
         if locked is not None and not full_only and len(values) == n:
             j = fail["joint"] - 1
+            if rates:
+                if not math.isclose(values[j], 0.0, abs_tol=1e-9):
+                    raise ScenarioError(
+                        f"{source}: {where}: entry {j + 1} (the locked joint) must be 0, as a locked "
+                        f"joint does not move; got {values[j]:g} (or give only the healthy joints)"
+                    )
+                return
             if not math.isclose(values[j], fail["angle_deg"], abs_tol=1e-9):
                 raise ScenarioError(
                     f"{source}: {where}: entry {j + 1} (the locked joint) must equal failure.angle_deg = "
@@ -565,7 +577,7 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
                 )
 
     for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
-        vector(f"state.{key}", out["state"][key])
+        vector(f"state.{key}", out["state"][key], rates=key != "q0_deg")
     if "halt" in jobs:
         h = out["halt"]
         vector("halt.qf_deg", h["qf_deg"])

@@ -51,8 +51,20 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _os_error_text(exc: OSError) -> str:
+    """One line naming the path(s) and the reason of an :class:`OSError`."""
+    reason = exc.strerror or type(exc).__name__
+    if exc.filename is None:
+        return str(exc) or reason
+    paths = repr(str(exc.filename))
+    if exc.filename2 is not None:
+        paths += f" -> {str(exc.filename2)!r}"
+    return f"{paths}: {reason}"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the process exit code (0 ok, 2 usage or input error)."""
+    """Run the CLI; returns the process exit code (0 ok, 2 usage or input error, including a
+    file or folder that cannot be read or written; tracebacks only with ``--debug``)."""
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -64,6 +76,11 @@ def main(argv: Sequence[str] | None = None) -> int:
         if args.debug:
             raise
         print(f"jointlock {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except OSError as exc:  # a file or folder that cannot be read or written (e.g. --out)
+        if args.debug:
+            raise
+        print(f"jointlock {args.command}: error: {_os_error_text(exc)}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("jointlock: interrupted", file=sys.stderr)

@@ -1,11 +1,14 @@
-"""Helpers shared by the subcommands: robot/lock options, degree conversion, JSON output."""
+"""Helpers shared by the subcommands: robot/lock options, degree conversion, option checks,
+output folders, JSON output and atomic figure files."""
 
 from __future__ import annotations
 
 import argparse
+import io
 import json
 import math
 import sys
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -28,6 +31,56 @@ def parse_lock(text: str) -> tuple[int, float]:
     if not math.isfinite(angle):
         raise argparse.ArgumentTypeError(f"--lock angle must be finite; got {text!r}")
     return joint, math.radians(angle)
+
+
+def seed_arg(text: str) -> int:
+    """argparse type of every ``--seed``: an integer >= 0 (numpy refuses negative seeds)."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0; got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 0; got {text!r}")
+    return value
+
+
+def require_finite(args: argparse.Namespace, *names: str) -> None:
+    """Raise :class:`ScenarioError` naming the option when one of ``args.<name>`` (if given)
+    is NaN or infinite; ``names`` are attribute names (``"length_scale"`` -> ``--length-scale``)."""
+    for name in names:
+        value = getattr(args, name, None)
+        if value is None:
+            continue
+        values = value if isinstance(value, (list, tuple)) else [value]
+        if not all(math.isfinite(float(v)) for v in values):
+            option = "--" + name.replace("_", "-")
+            raise ScenarioError(f"{option} must be a finite number; got {value}")
+
+
+def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None:
+    """Check, before any work, that ``path`` can be the output folder: it is a folder or does
+    not exist yet, and its nearest existing ancestor is a folder.  Returns it as a Path."""
+    if path is None:
+        return None
+    out = Path(path)
+    if out.exists() and not out.is_dir():
+        raise ScenarioError(f"{option} {str(out)!r} exists and is not a folder")
+    for parent in out.parents:
+        if parent.exists():
+            if not parent.is_dir():
+                raise ScenarioError(f"{option} {str(out)!r}: {str(parent)!r} is not a folder")
+            break
+    return out
+
+
+def write_png(fig: Any, path: str | Path, *, dpi: int = 110) -> None:
+    """``fig.savefig(path, dpi=dpi)`` as PNG, written atomically (in-memory buffer, then
+    :func:`jointlock.report.atomic_write_bytes`).  The figure is left open."""
+    from ..report import atomic_write_bytes
+
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def add_robot_arguments(
@@ -72,9 +125,23 @@ def single_lock(args: argparse.Namespace) -> tuple[int, float]:
     return args.lock[0]
 
 
+def lock_map(locks: list[tuple[int, float]] | None) -> dict[int, float]:
+    """``{joint: angle [rad]}`` from the repeated ``--lock J=DEG`` options; a joint given
+    twice is refused (rather than keeping the last angle)."""
+    out: dict[int, float] = {}
+    for joint, angle in locks or []:
+        if joint in out:
+            raise ScenarioError(
+                f"--lock: joint {joint} given twice ({math.degrees(out[joint]):g} and "
+                f"{math.degrees(angle):g} deg); give each locked joint once"
+            )
+        out[joint] = angle
+    return out
+
+
 def model_from_args(args: argparse.Namespace) -> ArmModel:
     model = load_robot(args.robot, base=args.base)
-    locks = dict(getattr(args, "lock", []) or [])
+    locks = lock_map(getattr(args, "lock", []))
     return lock_joints(model, locks) if locks else model
 
 
@@ -88,11 +155,15 @@ def locked_text(locked: dict[str, float]) -> str:
     return ", ".join(f"joint {k} at {v:g} deg" for k, v in locked.items()) or "none"
 
 
-def joint_vector_deg(model: ArmModel, values: list[float] | None, option: str) -> np.ndarray:
-    """Angles [rad] of the movable joints from a ``--*-deg`` option.
+def joint_vector_deg(
+    model: ArmModel, values: list[float] | None, option: str, *, rates: bool = False
+) -> np.ndarray:
+    """Angles [rad] of the movable joints from a ``--*-deg`` option (or, with ``rates=True``,
+    rates [rad/s] or accelerations [rad/s^2] from a ``--*dq*-deg`` option).
 
-    Accepts either one value per movable joint, or one per joint of the full arm (the locked
-    joints' entries must then equal their lock angles).
+    Accepts either one value per movable joint, or one per joint of the full arm: the locked
+    joints' entries must then equal their lock angles (angles) or be 0 (``rates=True``: a
+    locked joint does not move).
     """
     if values is None:
         return np.zeros(model.dof)
@@ -101,6 +172,14 @@ def joint_vector_deg(model: ArmModel, values: list[float] | None, option: str) -
         raise ScenarioError(f"{option} must be finite numbers [deg]; got {values}")
     if arr.size == model.dof:
         return arr
+    if arr.size == model.full_dof and model.locked and rates:
+        bad = [lj.number for lj in model.locked if not abs(arr[lj.number - 1]) <= 1e-9]
+        if bad:
+            raise ScenarioError(
+                f"{option}: the entries of locked joints {bad} must be 0 (a locked joint does not "
+                "move; or give only the movable joints)"
+            )
+        return model.healthy(arr)
     if arr.size == model.full_dof and model.locked:
         full_locked = model.expand(model.healthy(arr))
         if not np.allclose(full_locked, arr, atol=1e-9):

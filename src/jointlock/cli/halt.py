@@ -29,7 +29,16 @@ from ..planning.halt_motion import (
 )
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import add_robot_arguments, joint_vector_deg, locked_deg, locked_text, print_json
+from ._common import (
+    add_robot_arguments,
+    check_out_dir,
+    joint_vector_deg,
+    lock_map,
+    locked_deg,
+    locked_text,
+    print_json,
+    seed_arg,
+)
 
 #: 000 §5.1-5.2 scenario on halt7 (healthy joints 1, 2, 3, 5, 6, 7) [deg, deg/s, deg/s^2, s].
 PAPER_SCENARIO: dict[str, Any] = {
@@ -76,7 +85,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--solver", choices=("scan", "ga", "vector"), default="scan", help="default scan (exact)")
     p.add_argument(
-        "--seed", type=int, default=0, help="seed of the GA and the Monte Carlo search (default 0)"
+        "--seed", type=seed_arg, default=0, help="seed of the GA and the Monte Carlo search (default 0)"
     )
     p.add_argument(
         "--samples", type=int, default=36000, help="Monte Carlo samples for the halt configuration"
@@ -102,7 +111,7 @@ def _deg_vec(model, values, default, option) -> np.ndarray:
         if default is None:
             raise ScenarioError(f"{option} is required for this robot (000's defaults apply to halt7 only)")
         values = default
-    return joint_vector_deg(model, list(values), option)
+    return joint_vector_deg(model, list(values), option, rates=option != "--q0-deg")
 
 
 def _limit(values, default, option, n) -> np.ndarray:
@@ -121,7 +130,9 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
     paper = args.robot == "halt7"
     defaults = PAPER_SCENARIO if paper else {}
     locks = (
-        dict(args.lock) if args.lock else {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
+        lock_map(args.lock)
+        if args.lock
+        else {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
     )
     # moment point of the base torque: the spacecraft's centre of mass (000 eq. 30), so the
     # model carries the spacecraft even when the base is held fixed.
@@ -333,6 +344,7 @@ def write_outputs(res: HaltMotion, out: Path, data: dict) -> list[str]:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out_dir(args.out)
     show = not args.quiet and sys.stderr.isatty()
     problem, notes = build_problem(args, show)
     bar = Progress(args.generations, "GA generations", enabled=show) if args.solver == "ga" else None

@@ -21,7 +21,7 @@ from ..planning.halt_config import (
 )
 from ..progress import Progress
 from ..report import atomic_write_bytes, atomic_write_json
-from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json
+from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
 PROGRESS_MIN_SAMPLES = 20000
@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_arguments(p)
     p.add_argument("--samples", type=int, default=36000, help="Monte Carlo samples K (default 36000, as 000)")
-    p.add_argument("--seed", type=int, default=None, help="random seed (default: fresh, printed)")
+    p.add_argument("--seed", type=seed_arg, default=None, help="random seed (default: fresh, printed)")
     p.add_argument(
         "--jacobian",
         choices=("generalized", "fixed"),
@@ -120,7 +120,7 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltRe
         )
     q0 = joint_vector_deg(model, args.from_q_deg, "--from-q-deg")
     dq0 = (
-        joint_vector_deg(model, args.from_dq_deg, "--from-dq-deg")
+        joint_vector_deg(model, args.from_dq_deg, "--from-dq-deg", rates=True)
         if args.from_dq_deg
         else np.zeros(model.dof)
     )
@@ -132,7 +132,7 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltRe
         if not (math.isfinite(value) and value > 0):
             raise ScenarioError(f"{name} must be a finite number > 0; got {value}")
     ddq0 = (
-        joint_vector_deg(model, args.from_ddq_deg, "--from-ddq-deg")
+        joint_vector_deg(model, args.from_ddq_deg, "--from-ddq-deg", rates=True)
         if getattr(args, "from_ddq_deg", None)
         else np.zeros(model.dof)
     )
@@ -179,8 +179,6 @@ def _samples_npz(result) -> bytes:
 def run(args: argparse.Namespace) -> int:
     if args.samples < 2:
         raise ScenarioError(f"--samples must be an integer >= 2; got {args.samples}")
-    if args.seed is not None and args.seed < 0:
-        raise ScenarioError(f"--seed must be >= 0; got {args.seed}")
     if args.length is not None and not (math.isfinite(args.length) and args.length > 0):
         raise ScenarioError(f"--length must be a finite length > 0 [m]; got {args.length}")
     model = model_from_args(args)

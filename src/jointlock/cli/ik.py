@@ -9,7 +9,16 @@ import numpy as np
 
 from ..errors import ScenarioError
 from ..ik import pose_from_zyx, solve_ik, zyx_angles
-from ._common import add_robot_arguments, format_matrix, locked_deg, locked_text, model_from_args, print_json
+from ._common import (
+    add_robot_arguments,
+    format_matrix,
+    locked_deg,
+    locked_text,
+    model_from_args,
+    print_json,
+    require_finite,
+    seed_arg,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -34,9 +43,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     target.add_argument("--matrix", type=float, nargs=16, metavar="M", help="4x4 pose, row-major [m]")
     p.add_argument("--method", choices=("auto", "closed-form", "numeric"), default="auto")
     p.add_argument(
-        "--length-scale", type=float, default=1.0, metavar="M", help="L [m] of the nearest-pose metric"
+        "--length-scale", type=float, default=1.0, metavar="M", help="L [m] of the nearest-pose metric (> 0)"
     )
-    p.add_argument("--seed", type=int, default=0, help="seed of the numerical starts")
+    p.add_argument("--seed", type=seed_arg, default=0, help="seed of the numerical starts (integer >= 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
 
@@ -74,6 +83,9 @@ def _solution(sol) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    require_finite(args, "length_scale")
+    if not args.length_scale > 0:
+        raise ScenarioError(f"--length-scale must be > 0 [m]; got {args.length_scale}")
     model = model_from_args(args)
     target = _target(args)
     res = solve_ik(model, target, method=args.method, rng=args.seed, length_scale=args.length_scale)

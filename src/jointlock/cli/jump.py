@@ -3,13 +3,18 @@
 At one failure time (``--fail-at S``): the velocity jump with and without compensation, the
 optimal kappa and its feasible interval, the limits kept.  Over sampled failure times
 (``--sweep N``, the default with N = 40): optimal kappa per time, the fitted piecewise
-kappa(t), and its verification with the failure injected at every control step.
+kappa(t), and its verification with the failure injected at every control step.  The optimal
+kappa is searched by default (``--optimize`` says so explicitly); ``--kappa K`` uses a
+constant instead.  Options that the chosen mode does not use (``--order``, ``--single``,
+``--fix`` with ``--fail-at`` or ``--kappa``; ``--sweep`` with ``--kappa``) are reported on
+stderr as ignored.
 """
 
 from __future__ import annotations
 
 import argparse
 import math
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -30,7 +35,10 @@ from ..planning.jump import (
 from ..progress import Progress
 from ..report import atomic_write_bytes, atomic_write_json, atomic_write_text, figure_png
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json
+from ._common import add_robot_arguments, check_out_dir, print_json, require_finite
+
+#: Largest polynomial order of kappa(t) (the scenario schema's ``jump.order`` cap).
+MAX_ORDER = 9
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -43,7 +51,13 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Jumps are 2-norms of joint-rate changes [rad/s]."
         ),
     )
-    add_robot_arguments(p, lock=False)
+    add_robot_arguments(
+        p,
+        lock=False,
+        base_default=None,
+        base_help="fixed base, or free-floating spacecraft (generalized Jacobian); "
+        "default: the scenario file's base, else fixed",
+    )
     p.add_argument("--scenario", metavar="FILE", help="scenario TOML (q0_deg, dx_m, duration_s, ...)")
     p.add_argument("--lock-joint", type=int, metavar="J", help="joint that locks (from 1; default 2)")
     when = p.add_mutually_exclusive_group()
@@ -51,8 +65,17 @@ def register(sub: argparse._SubParsersAction) -> None:
     when.add_argument("--sweep", type=int, metavar="N", help="N sampled failure times (default 40)")
     how = p.add_mutually_exclusive_group()
     how.add_argument("--kappa", type=float, metavar="K", help="use this constant kappa (no search)")
-    how.add_argument("--optimize", action="store_true", help="search the optimal kappa (default)")
-    p.add_argument("--order", type=int, default=5, help="polynomial order of kappa(t) (default 5)")
+    how.add_argument(
+        "--optimize",
+        action="store_true",
+        help="search the optimal kappa: the default mode, this flag only makes it explicit",
+    )
+    p.add_argument(
+        "--order",
+        type=int,
+        default=None,
+        help=f"polynomial order of kappa(t), 1..{MAX_ORDER} (default 5; sweep with the search only)",
+    )
     p.add_argument(
         "--single",
         action="store_true",
@@ -61,8 +84,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--fix",
         choices=("auto", "clip", "ramp", "clip+ramp", "none"),
-        default="auto",
-        help="fix of kappa(t) verified as well (auto: clip+ramp only when a limit breaks)",
+        default=None,
+        help="fix of kappa(t) verified as well (default auto: clip+ramp only when a limit breaks; "
+        "sweep with the search only)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write results.json, CSV and figures (PNG) here")
@@ -75,7 +99,8 @@ def _scenario(args: argparse.Namespace) -> JumpScenario:
     fields = sc.to_fields()
     if args.lock_joint is not None:
         fields["lock_joint"] = args.lock_joint
-    fields["base"] = args.base
+    if args.base is not None:  # the file's base (else the default, fixed) unless --base is given
+        fields["base"] = args.base
     from ..planning.jump import scenario_from_mapping
 
     return scenario_from_mapping(fields, source="command line")
@@ -120,19 +145,48 @@ def _ver_series_json(v: Verification) -> dict:
     }
 
 
+def _warn_ignored(args: argparse.Namespace) -> None:
+    """Say on stderr which given options the chosen mode does not use."""
+    if args.fail_at is not None or args.kappa is not None:
+        mode = "--fail-at" if args.fail_at is not None else "--kappa"
+        ignored = [
+            opt
+            for opt, given in (
+                ("--order", args.order is not None),
+                ("--single", args.single),
+                ("--fix", args.fix is not None),
+                ("--sweep", mode == "--kappa" and args.sweep is not None),
+            )
+            if given
+        ]
+        if ignored:
+            what = (
+                "one failure time, no kappa(t) fit"
+                if mode == "--fail-at"
+                else "a constant kappa verified at every step, no sampling or fit"
+            )
+            print(
+                f"jointlock jump: warning: {', '.join(ignored)} ignored with {mode} ({what})",
+                file=sys.stderr,
+            )
+
+
 def run(args: argparse.Namespace) -> int:
-    sc = _scenario(args)
-    model = load_robot(args.robot, base=args.base)
+    require_finite(args, "kappa", "fail_at")
     if args.sweep is not None and args.sweep < 1:
         raise ScenarioError(f"--sweep must be >= 1; got {args.sweep}")
-    if args.order < 1:
-        raise ScenarioError(f"--order must be >= 1; got {args.order}")
+    if args.order is not None and not 1 <= args.order <= MAX_ORDER:
+        raise ScenarioError(f"--order must be 1..{MAX_ORDER}; got {args.order}")
+    out_dir = check_out_dir(args.out)
+    sc = _scenario(args)
+    model = load_robot(args.robot, base=sc.base)
+    _warn_ignored(args)
+    order = 5 if args.order is None else args.order
     show = not args.quiet
 
     def bar(total: int, desc: str) -> Progress:
         return Progress(total, desc, enabled=None if show else False)
 
-    out_dir = Path(args.out) if args.out else None
     if args.fail_at is not None:
         p = bar(2 * sc.n_steps, "kappa search")
         res = jump_at_time(model, sc, args.fail_at, kappa=args.kappa, progress=p)
@@ -142,7 +196,7 @@ def run(args: argparse.Namespace) -> int:
             _single_files(out_dir, model, sc, res, result)
     else:
         n = 40 if args.sweep is None else args.sweep
-        fix = None if args.fix == "none" else args.fix
+        fix = {None: "auto", "none": None}.get(args.fix, args.fix)
         if args.kappa is not None:
             study = None
             ver = verify_kappa(model, sc, args.kappa)
@@ -152,7 +206,7 @@ def run(args: argparse.Namespace) -> int:
                 model,
                 sc,
                 n_samples=n,
-                order=args.order,
+                order=order,
                 fix=fix,
                 fit_options={"piecewise": not args.single},
                 progress_factory=bar if show else None,
@@ -254,6 +308,13 @@ def _constant_json(robot: str, sc: JumpScenario, kappa: float, v: Verification) 
     }
 
 
+def _less(reduction: float | None) -> str:
+    """``"12.3 % less"``, or ``"reduction n/a"`` when it is undefined (no jump before)."""
+    if reduction is None or not math.isfinite(reduction):
+        return "reduction n/a: no jump without compensation"
+    return f"{100 * reduction:.1f} % less"
+
+
 def _print_text(r: dict) -> None:
     sc = r["scenario"]
     print(
@@ -266,7 +327,7 @@ def _print_text(r: dict) -> None:
         print(f"failure at {r['fail_time_s']:g} s, kappa = {r['kappa']:.6g} (feasible [{lo:.4g}, {hi:.4g}])")
         print(
             f"joint jump ||dq||: {r['jump_before']:.5g} -> {r['jump_after']:.5g} rad/s "
-            f"({100 * r['mean_reduction']:.1f} % less)"
+            f"({_less(r['mean_reduction'])})"
         )
         print(
             f"without re-planning: locked joint stops from {r['joint_jump_noreplan_before']:.5g} / "
@@ -309,7 +370,7 @@ def _print_text(r: dict) -> None:
         label = "kappa(t)" if v["fix"] is None else f"kappa(t) with fix {v['fix']}"
         print(
             f"{label}, failure at every step: mean jump {v['mean_jump_before']:.5g} -> {v['mean_jump_after']:.5g} "
-            f"rad/s ({100 * v['mean_reduction']:.1f} % less), improved at {100 * v['share_improved']:.1f} % of steps, "
+            f"rad/s ({_less(v['mean_reduction'])}), improved at {100 * v['share_improved']:.1f} % of steps, "
             f"limits kept: {v['limits_ok']}"
         )
         if not v["limits_ok"]:

@@ -14,7 +14,7 @@ from ..kinematics import ee_pose
 from ..locking import lock
 from ..planning.replan import DEFAULT_STEP_WEIGHT, replan_line
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json, single_lock
+from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, single_lock, write_png
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -67,6 +67,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    require_finite(args, "cycle", "tolerance_deg", "step_weight", "jump_deg")
+    check_out_dir(args.out)
     joint, angle = single_lock(args)
     full = load_robot(args.robot, base=args.base)
     for opt, vals in (("--from-deg", args.from_deg), ("--to-deg", args.to_deg)):
@@ -205,7 +207,7 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
             ax.legend(fontsize=8)
             ax.grid(alpha=0.3)
         fig.tight_layout()
-        fig.savefig(out_dir / name, dpi=110)
+        write_png(fig, out_dir / name, dpi=110)
         plt.close(fig)
         files.append(str(out_dir / name))
 

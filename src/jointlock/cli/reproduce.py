@@ -55,7 +55,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Runs the experiments of seeds 000 (halt configuration and halt motion), 001 (velocity-jump "
             "compensation; no published numbers survived), 002 (worked examples, tolerance angle) and 004 "
             "(virtual lengths, eq. 15, Table 3, Cond1-Cond5) with the documented readings and prints one "
-            "table: quantity, paper's value, ours, agreement. About 20 s for all four."
+            "table: quantity, paper's value, ours, agreement. About 5 s for all four."
         ),
     )
     p.add_argument("--paper", choices=PAPERS, action="append", help="only this paper (repeatable)")

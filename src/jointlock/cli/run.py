@@ -30,7 +30,6 @@ import json
 import math
 import platform
 import shlex
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -39,7 +38,7 @@ import numpy as np
 from .. import __version__
 from ..errors import JointlockError, ScenarioError
 from ..scenario import JOB_ORDER, JOB_PAPER, Scenario, job_lock_args, jump_fields, load_scenario, parse_set
-from ._common import parse_lock, print_json
+from ._common import check_out_dir, parse_lock, print_json, seed_arg
 
 #: Subcommand module of each job.
 JOB_MODULE = {
@@ -72,7 +71,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--robot", help="override robot (built-in name or .toml/.urdf model file)")
     p.add_argument("--base", choices=("fixed", "floating"), help="override base")
-    p.add_argument("--seed", type=int, help="override seed (integer >= 0)")
+    p.add_argument("--seed", type=seed_arg, help="override seed (integer >= 0)")
     p.add_argument(
         "--lock", metavar="J=DEG", type=parse_lock, help="override the failure: joint J locked at DEG degrees"
     )
@@ -117,6 +116,7 @@ def default_out(scenario: Scenario) -> Path:
 def run(args: argparse.Namespace) -> int:
     scenario = load_scenario(args.scenario, overrides_from_args(args))
     out = default_out(scenario)
+    check_out_dir(out, "--out" if args.out is not None else "output folder (out)")
     results = run_scenario(scenario, out, quiet=args.quiet or args.json)
     if args.json:
         print_json(results)
@@ -176,6 +176,18 @@ def call_subcommand(module: str, argv: list[str]) -> tuple[dict, int]:
     return (json.loads(text) if text.strip() else {}), code
 
 
+def _rates(scenario: Scenario, values: list[float]) -> list[float]:
+    """A rate or acceleration vector of the state for the command line: the healthy joints'
+    entries (a full-arm vector's locked entry is 0, checked when the scenario was loaded)."""
+    lk = scenario.lock
+    if lk is None:
+        return values
+    full, _ = _model(scenario)
+    if len(values) != full.dof:
+        return values
+    return [v for i, v in enumerate(values) if i + 1 != lk[0]]
+
+
 def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict], *, quiet: bool) -> list[str]:
     """The command line of ``job`` formed from the resolved scenario."""
     d = scenario.data
@@ -193,7 +205,7 @@ def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict],
         argv += ["--length", _num(t["length"])] if t["length"] is not None else []
         if t["reachable"]:
             argv += ["--from-q-deg", *_nums(st["q0_deg"])]
-            argv += ["--from-dq-deg", *_nums(st["dq0_deg"])] if st["dq0_deg"] else []
+            argv += ["--from-dq-deg", *_nums(_rates(scenario, st["dq0_deg"]))] if st["dq0_deg"] else []
             halt_time = t["halt_time"] if t["halt_time"] is not None else d["halt"]["T"]
             argv += ["--halt-time", _num(halt_time)]
         for key in ("vmax_deg", "amax_deg"):
@@ -203,7 +215,8 @@ def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict],
     elif job == "halt":
         argv += job_lock_args(scenario) + ["--base", t["base"] or d["base"]]
         for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
-            argv += [f"--{key.replace('_', '-')}", *_nums(st[key])]
+            values = st[key] if key == "q0_deg" else _rates(scenario, st[key])
+            argv += [f"--{key.replace('_', '-')}", *_nums(values)]
         argv += ["--T", _num(t["T"])]
         if t["qf_deg"] is not None:
             argv += ["--qf-deg", *_nums(t["qf_deg"])]
@@ -227,11 +240,16 @@ def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict],
         argv += ["--base", fields["base"], "--scenario", str(task)]
         if "lock_joint" in fields:
             argv += ["--lock-joint", str(fields["lock_joint"])]
-        argv += (
-            ["--fail-at", _num(t["fail_at"])] if t["fail_at"] is not None else ["--sweep", str(t["sweep"])]
-        )
-        argv += ["--kappa", _num(t["kappa"])] if t["kappa"] is not None else []
-        argv += ["--order", str(t["order"]), "--fix", t["fix"], "--json", "--out", job_out]
+        # only the options the mode uses (the command warns about the others)
+        if t["fail_at"] is not None:
+            argv += ["--fail-at", _num(t["fail_at"])]
+        elif t["kappa"] is None:
+            argv += ["--sweep", str(t["sweep"])]
+        if t["kappa"] is not None:
+            argv += ["--kappa", _num(t["kappa"])]
+        elif t["fail_at"] is None:
+            argv += ["--order", str(t["order"]), "--fix", t["fix"]]
+        argv += ["--json", "--out", job_out]
         argv += ["--quiet"] if quiet else []
     elif job == "tolerance_angle":
         argv += job_lock_args(scenario) + ["--base", d["base"], "--q-target-deg", *_nums(t["q_target_deg"])]
@@ -900,7 +918,3 @@ def assumptions(scenario: Scenario, model: Any) -> list[str]:
         )
     notes.append(f"Seed {d['seed']} drives every stochastic step (Monte Carlo, GA, sampling).")
     return notes
-
-
-if __name__ == "__main__":  # pragma: no cover
-    sys.exit(0)

@@ -16,7 +16,18 @@ from ..locking import lock_joints
 from ..model import ArmModel
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import add_robot_arguments, format_matrix, joint_vector_deg, locked_deg, locked_text, print_json
+from ._common import (
+    add_robot_arguments,
+    check_out_dir,
+    format_matrix,
+    joint_vector_deg,
+    lock_map,
+    locked_deg,
+    locked_text,
+    print_json,
+    require_finite,
+    seed_arg,
+)
 
 TWIST = ("vx", "vy", "vz", "wx", "wy", "wz")
 
@@ -71,7 +82,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--samples", type=int, default=None, help="samples per condition (2000) or search starts (512)"
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0)")
     p.add_argument(
         "--out", type=Path, default=None, metavar="DIR", help="--search: write search.json and plots here"
     )
@@ -82,7 +93,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def _model(args: argparse.Namespace, base: str) -> ArmModel:
     model = load_robot(args.robot, base="fixed" if base == "fixed" else "floating")
-    locks = dict(args.lock or [])
+    locks = lock_map(args.lock)
     return lock_joints(model, locks) if locks else model
 
 
@@ -98,6 +109,8 @@ def _lengths_or_none(model: ArmModel, base: str, weighting: str) -> sg.ArmLength
 def run(args: argparse.Namespace) -> int:
     if args.samples is not None and args.samples < 1:
         raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
+    require_finite(args, "tol", "length")
+    check_out_dir(args.out)
     if args.verify_conditions:
         return _verify(args)
     if args.search:

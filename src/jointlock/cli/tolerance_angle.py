@@ -12,7 +12,11 @@ from ..errors import ScenarioError
 from ..kinematics import ee_pose
 from ..planning.replan import absorbable_range, gamma_sweep, gammas_for_lock
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json, single_lock
+from ._common import add_robot_arguments, check_out_dir, print_json, single_lock, write_png
+
+#: Most gamma samples of one sweep (steps of about 0.0018 deg over +-180 deg; some 1.5 GB and
+#: 15 s): each is an IK solution, and a tiny --step-deg would otherwise try to allocate many GiB.
+MAX_GAMMA_SAMPLES = 200_000
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -38,6 +42,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    check_out_dir(args.out)
     joint, angle = single_lock(args)
     model = load_robot(args.robot, base=args.base)
     if not 1 <= joint <= model.dof:
@@ -52,6 +57,12 @@ def run(args: argparse.Namespace) -> int:
     target = ee_pose(model, q_target)
     limit, zoom, step = (math.radians(v) for v in (args.gamma_limit_deg, args.zoom_deg, args.step_deg))
     count = int(round(2 * limit / step)) + 1
+    if count > MAX_GAMMA_SAMPLES:
+        raise ScenarioError(
+            f"--step-deg {args.step_deg:g} gives {count} gamma samples over +-{args.gamma_limit_deg:g} deg; "
+            f"at most {MAX_GAMMA_SAMPLES} are allowed: use --step-deg >= "
+            f"{2 * args.gamma_limit_deg / (MAX_GAMMA_SAMPLES - 1):.2g} or a smaller --gamma-limit-deg"
+        )
     sweep = gamma_sweep(model, target, np.linspace(-limit, limit, count), q_ref=q_target)
     wide = absorbable_range(sweep, joint, limit)
     narrow = absorbable_range(sweep, joint, min(zoom, limit))
@@ -128,7 +139,7 @@ def _write(out_dir: Path, sweep, joint, angle, roots, zoom, summary) -> list[str
         for ax in axes[1]:
             ax.set_xlabel("gamma (rotation about tool x) [deg]")
         fig.tight_layout()
-        fig.savefig(out_dir / name, dpi=110)
+        write_png(fig, out_dir / name, dpi=110)
         plt.close(fig)
         files.append(str(out_dir / name))
     fig, ax = plt.subplots(figsize=(6, 4))
@@ -138,7 +149,7 @@ def _write(out_dir: Path, sweep, joint, angle, roots, zoom, summary) -> list[str
     ax.set_ylabel(f"joint {joint} [deg]")
     ax.grid(alpha=0.3)
     fig.tight_layout()
-    fig.savefig(out_dir / "locked_joint_vs_gamma.png", dpi=110)
+    write_png(fig, out_dir / "locked_joint_vs_gamma.png", dpi=110)
     plt.close(fig)
     files.append(str(out_dir / "locked_joint_vs_gamma.png"))
     atomic_write_json(out_dir / "sweep.json", {**summary, "gamma_deg": g, "q_deg": q})

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import io
 import math
 from pathlib import Path
 
@@ -12,7 +13,7 @@ from ..analysis.workspace import compare_workspaces, projection_extent, sample_w
 from ..errors import ScenarioError
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import add_robot_arguments, print_json
+from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, seed_arg, write_png
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -25,7 +26,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--voxel", type=float, default=None, metavar="M", help="voxel side [m] (default: automatic)"
     )
-    p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", type=Path, metavar="DIR", help="write projections, clouds (NPZ) and summary here")
     p.set_defaults(func=run)
@@ -34,6 +35,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.samples < 1:
         raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
+    require_finite(args, "voxel")
+    check_out_dir(args.out)
     if args.voxel is not None and not (args.voxel > 0):
         raise ScenarioError(f"--voxel must be > 0 [m]; got {args.voxel}")
     if len(args.lock) > 1:
@@ -99,7 +102,7 @@ def _write(out_dir: Path, full: np.ndarray, locked: np.ndarray | None, summary: 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from ..report import atomic_write_json
+    from ..report import atomic_write_bytes, atomic_write_json
 
     out_dir.mkdir(parents=True, exist_ok=True)
     files = []
@@ -117,7 +120,7 @@ def _write(out_dir: Path, full: np.ndarray, locked: np.ndarray | None, summary: 
         ax.set_title(f"{name} projection")
     axes[0].legend(markerscale=20)
     fig.tight_layout()
-    fig.savefig(out_dir / "projections.png", dpi=110)
+    write_png(fig, out_dir / "projections.png", dpi=110)
     plt.close(fig)
     files.append(str(out_dir / "projections.png"))
     fig = plt.figure(figsize=(11, 5))
@@ -132,11 +135,13 @@ def _write(out_dir: Path, full: np.ndarray, locked: np.ndarray | None, summary: 
         ax.set_ylabel("y [m]")
         ax.set_zlabel("z [m]")
     fig.tight_layout()
-    fig.savefig(out_dir / "clouds.png", dpi=110)
+    write_png(fig, out_dir / "clouds.png", dpi=110)
     plt.close(fig)
     files.append(str(out_dir / "clouds.png"))
     arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
-    np.savez_compressed(out_dir / "points.npz", **arrays)
+    buf = io.BytesIO()
+    np.savez_compressed(buf, **arrays)
+    atomic_write_bytes(out_dir / "points.npz", buf.getvalue())
     files.append(str(out_dir / "points.npz"))
     atomic_write_json(out_dir / "workspace.json", summary)
     files.append(str(out_dir / "workspace.json"))

@@ -112,7 +112,7 @@ def adaptive_ga(
     upper: ArrayLike,
     *,
     settings: GASettings | None = None,
-    rng: int | np.random.Generator | None = None,
+    rng: int | np.random.Generator | None = 0,
     progress: Any = None,
 ) -> GAResult:
     """Maximise ``fitness`` over a box with 000's adaptive GA.
@@ -128,7 +128,9 @@ def adaptive_ga(
         Population size, generations, bits per gene and the constants ``g1..g4`` of eqs.
         37-38 (``pc``: ``g1``, ``g2``; ``pm``, per bit: ``g3``, ``g4``).
     rng
-        Seed or generator (recorded in the result).
+        Seed or generator, recorded in the result (default 0: the same run every time).
+        ``None`` draws a fresh seed from the operating system and records that seed, so
+        the run can still be repeated.
     progress
         Optional :class:`jointlock.progress.Progress`-like object (``update()`` per generation).
 
@@ -144,6 +146,8 @@ def adaptive_ga(
     hi = np.atleast_1d(np.asarray(upper, dtype=float))
     if lo.shape != hi.shape or not np.all(lo <= hi):
         raise ScenarioError(f"GA bounds must satisfy lower <= upper; got {lo.tolist()}, {hi.tolist()}")
+    if rng is None:  # fresh entropy, but a recorded, repeatable seed
+        rng = int(np.random.SeedSequence().entropy)
     seed = rng if not isinstance(rng, np.random.Generator) else "Generator"
     gen = np.random.default_rng(rng)
     n_genes = lo.size

@@ -289,6 +289,11 @@ def load_scenario(path: str | Path) -> JumpScenario:
         data = tomllib.loads(path.read_text(encoding="utf-8"))
     except FileNotFoundError:
         raise ScenarioError(f"scenario file {str(path)!r} does not exist") from None
+    except UnicodeDecodeError as exc:
+        raise ScenarioError(f"scenario file {str(path)!r} is not UTF-8 text: {exc}") from None
+    except OSError as exc:  # a folder, no permission, ...
+        reason = exc.strerror or type(exc).__name__
+        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {reason}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
     return scenario_from_mapping(data, source=str(path))
@@ -983,8 +988,24 @@ class KappaSearch:
 
     @property
     def reduction(self) -> FloatArray:
-        """(F,) relative jump reduction ``1 - obj_opt / obj_zero``."""
-        return 1.0 - self.objective_opt / self.objective_zero
+        """(F,) relative jump reduction ``1 - obj_opt / obj_zero``; NaN (undefined) where
+        ``obj_zero`` is 0 (no jump to reduce), see :func:`jump_reduction`."""
+        return jump_reduction(self.objective_zero, self.objective_opt)
+
+
+def jump_reduction(before: ArrayLike, after: ArrayLike) -> Any:
+    """Relative jump reduction ``1 - after / before``.
+
+    Undefined -- NaN, written ``null`` in JSON and ``n/a`` in text -- where ``before`` is 0:
+    without compensation there is no jump to reduce (e.g. a task that does not move,
+    ``dx_m = [0, 0, 0]``), and a ratio would be 0/0 or hide a jump the compensation made.
+    A float for scalar inputs, an array otherwise; never warns or raises.
+    """
+    b = np.asarray(before, dtype=float)
+    a = np.asarray(after, dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        out = np.where(b != 0.0, 1.0 - a / np.where(b != 0.0, b, 1.0), np.nan)
+    return float(out) if out.ndim == 0 else out
 
 
 def sample_failure_times(scenario: JumpScenario, n: int) -> FloatArray:
@@ -1783,7 +1804,8 @@ class Verification:
     task_jump_replan_max
         Largest ``||J dqdot||`` with re-planning [m/s] (round-off when ``J_r`` keeps full rank).
     mean_reduction
-        ``1 - mean(after) / mean(before)``.
+        ``1 - mean(after) / mean(before)``; NaN (undefined) when every ``before`` is 0
+        (:func:`jump_reduction`).
     share_improved
         Fraction of failure steps with ``after < before``.
     limits
@@ -1841,17 +1863,27 @@ def feasible_band(search: KappaSearch, t: ArrayLike) -> FloatArray:
 def ramp_schedule(kappa: ArrayLike, max_step: float) -> FloatArray:
     """Rate-limit a schedule: ``|kappa_{k+1} - kappa_k| <= max_step`` and ``|kappa'| <= |kappa|``
     (forward/backward min-envelope of the positive and negative parts, so a drop to 0 at a
-    segment point starts early instead of happening in one step)."""
+    segment point starts early instead of happening in one step).
+
+    The envelope of each part is computed in closed form (cumulative minima, no loop over the
+    steps); ``kappa`` may carry leading batch axes, the steps run along the last one."""
     kap = np.asarray(kappa, dtype=float)
+    shape = kap.shape
+    kap = np.atleast_1d(kap)
+    c = 0.5 * float(max_step)
     parts = []
     for part in (np.maximum(kap, 0.0), np.maximum(-kap, 0.0)):
-        env = part.copy()
-        for k in range(1, env.size):  # loop over the N steps of one schedule (1-D, cheap)
-            env[k] = min(env[k], env[k - 1] + 0.5 * max_step)
-        for k in range(env.size - 2, -1, -1):
-            env[k] = min(env[k], env[k + 1] + 0.5 * max_step)
-        parts.append(env)
-    return parts[0] - parts[1]
+        if math.isnan(c) or c == math.inf:  # no rate limit (as the step-by-step recursion)
+            parts.append(part)
+            continue
+        # closed form of env[k] = min(part[k], env[k-1] + c) (forward) and then
+        # env[k] = min(env[k], env[k+1] + c) (backward): cumulative minima of part[j] -+ c j;
+        # the outer minimum keeps env <= part exactly despite round-off
+        ramp = c * np.arange(kap.shape[-1])
+        env = np.minimum(part, ramp + np.minimum.accumulate(part - ramp, axis=-1))
+        back = np.flip(np.minimum.accumulate(np.flip(env + ramp, -1), axis=-1), -1) - ramp
+        parts.append(np.minimum(env, back))
+    return (parts[0] - parts[1]).reshape(shape)
 
 
 def _step_limits(prob: _Problem, out: _RunOut) -> np.ndarray:
@@ -1947,7 +1979,7 @@ def verify_kappa(
         table.task_jump_noreplan[0],
         table.task_jump_noreplan[1],
         float(table.task_jump_replan.max()),
-        float(1.0 - after.mean() / before.mean()),
+        jump_reduction(before.mean(), after.mean()),
         float(np.mean(after < before)),
         limits,
         h_ok,
@@ -2012,8 +2044,9 @@ class JumpAtTime:
 
     @property
     def reduction(self) -> float:
-        """``1 - jump_after / jump_before``."""
-        return 1.0 - self.jump_after / self.jump_before
+        """``1 - jump_after / jump_before``; NaN (undefined) when ``jump_before`` is 0, i.e.
+        there is no jump to reduce (:func:`jump_reduction`)."""
+        return jump_reduction(self.jump_before, self.jump_after)
 
 
 def jump_at_time(

@@ -1,0 +1,362 @@
+"""Command-line errors and edge cases: a bad option or an unusable path gives exit code 2 and
+one line naming it (no traceback), options mean what they say, files are written atomically."""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.cli import build_parser, main
+from jointlock.cli._common import check_out_dir, joint_vector_deg, lock_map, seed_arg
+
+#: A short task for ``jump`` (the NOTES-001 law on 20 control steps).
+SHORT_JUMP = "duration_s = 1.0\nblend_s = 0.25\ndx_m = [0.05, -0.05, 0.03]\n"
+
+
+def err_line(capsys) -> str:
+    """The stderr of the last command: exactly one line, no traceback."""
+    err = capsys.readouterr().err.strip()
+    assert "Traceback" not in err
+    assert len(err.splitlines()) == 1, err
+    return err
+
+
+def jump_json(capsys, *argv: str) -> dict:
+    assert main(["jump", *argv, "--json", "--quiet"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+# -- 1. jump --scenario FILE keeps the file's base ------------------------------------------------
+
+
+def test_jump_uses_the_scenario_files_base_unless_base_is_given(tmp_path, capsys):
+    f = tmp_path / "floating.toml"
+    f.write_text(SHORT_JUMP + 'base = "floating"\n')
+    common = ["canadarm7", "--scenario", str(f), "--fail-at", "0.5", "--kappa", "0.001"]
+    out = jump_json(capsys, *common)
+    assert out["scenario"]["base"] == "floating"
+    model = jl.load_robot("canadarm7", base="floating")
+    sc = jl.planning.jump.load_scenario(f)
+    ref = jl.planning.jump.jump_at_time(model, sc, 0.5, kappa=0.001)
+    assert out["jump_after"] == pytest.approx(ref.jump_after, rel=1e-12)
+    assert jump_json(capsys, *common, "--base", "fixed")["scenario"]["base"] == "fixed"
+
+
+# -- 2. full-arm rate vectors: the locked joint's rate is 0 ---------------------------------------
+
+
+def test_joint_vector_deg_rates_need_a_zero_locked_entry():
+    model = jl.lock(jl.load_robot("halt7"), 4, math.radians(30.0))
+    full = [20.0, 30.0, 15.0, 0.0, 25.0, 40.0, 35.0]
+    np.testing.assert_allclose(
+        joint_vector_deg(model, full, "--dq0-deg", rates=True), np.radians([20, 30, 15, 25, 40, 35])
+    )
+    with pytest.raises(jl.ScenarioError, match=r"--dq0-deg: the entries of locked joints \[4\] must be 0"):
+        joint_vector_deg(model, [20.0, 30.0, 15.0, 5.0, 25.0, 40.0, 35.0], "--dq0-deg", rates=True)
+    # angles keep their rule: the locked entry is the lock angle
+    q = joint_vector_deg(model, [0, 0, 0, 30, 0, 0, 0], "--q0-deg")
+    np.testing.assert_allclose(q, np.zeros(6))
+
+
+def test_run_passes_the_healthy_rates_of_a_full_arm_state(tmp_path):
+    from jointlock.cli.run import job_argv
+    from jointlock.scenario import load_scenario
+
+    f = tmp_path / "s.toml"
+    f.write_text(
+        'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0\n[state]\n'
+        "q0_deg = [-180, -180, -100, 0, -10, 20, 20]\n"
+        "dq0_deg = [20, 30, 15, 0, 25, 40, 35]\nddq0_deg = [8, 10, 12, 0, 10, -8, 6]\n"
+        "[halt]\nT = 10\n"
+    )
+    sc = load_scenario(f)
+    argv = job_argv("halt", sc, tmp_path / "out", {}, quiet=True)
+
+    def values(option: str) -> list[float]:
+        i = argv.index(option) + 1
+        vals = []
+        while i < len(argv) and not argv[i].startswith("--"):
+            vals.append(float(argv[i]))
+            i += 1
+        return vals
+
+    assert values("--dq0-deg") == [20, 30, 15, 25, 40, 35]
+    assert values("--ddq0-deg") == [8, 10, 12, 10, -8, 6]
+    assert values("--q0-deg") == [-180, -180, -100, 0, -10, 20, 20]
+
+
+# -- 3. no jump to reduce: the reduction is n/a ---------------------------------------------------
+
+
+@pytest.mark.parametrize("mode", [["--fail-at", "0.5"], ["--kappa", "0"]])
+def test_jump_reduction_is_na_when_there_is_no_jump(tmp_path, capsys, mode):
+    f = tmp_path / "still.toml"
+    f.write_text("duration_s = 1.0\nblend_s = 0.25\ndx_m = [0, 0, 0]\n")
+    assert main(["jump", "canadarm7", "--scenario", str(f), *mode, "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert "reduction n/a" in text and "nan" not in text
+    out = jump_json(capsys, "canadarm7", "--scenario", str(f), *mode)
+    assert out["mean_reduction"] is None
+
+
+# -- 4. --out that cannot be a folder; OSError at the CLI boundary -------------------------------
+
+
+def _out_commands(out: str, scenario: Path) -> list[list[str]]:
+    return [
+        ["workspace", "halt7", "--samples", "10", "--out", out],
+        ["replan", "puma6", "--lock", "2=0", "--from-deg", *"0 0 0 0 0 0".split()]
+        + ["--to-deg", *"10 0 0 0 0 0".split(), "--steps", "2", "--out", out],
+        ["tolerance-angle", "puma6", "--lock", "2=0", "--q-target-deg", *"0 10 0 0 0 0".split()]
+        + ["--out", out],
+        ["singular", "halt7", "--search", "--samples", "2", "--out", out],
+        ["jump", "canadarm7", "--fail-at", "0.5", "--kappa", "0", "--quiet", "--out", out],
+        ["run", str(scenario), "--out", out, "--quiet"],
+    ]
+
+
+@pytest.mark.parametrize(
+    "index", range(6), ids=["workspace", "replan", "tolerance-angle", "singular", "jump", "run"]
+)
+def test_out_pointing_at_a_file_is_refused_up_front(tmp_path, capsys, index):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('robot = "halt7"\n[workspace]\nsamples = 10\n')
+    existing = tmp_path / "results"
+    existing.write_text("not a folder")
+    argv = _out_commands(str(existing), scenario)[index]
+    assert main(argv) == 2
+    line = err_line(capsys)
+    assert str(existing) in line and "not a folder" in line
+    assert existing.read_text() == "not a folder"
+    # below a file, too
+    argv = _out_commands(str(existing / "sub"), scenario)[index]
+    assert main(argv) == 2
+    assert "not a folder" in err_line(capsys)
+
+
+def test_check_out_dir():
+    assert check_out_dir(None) is None
+    assert check_out_dir("does/not/exist/yet") == Path("does/not/exist/yet")
+
+
+def _run_with_blocked_job_folder(tmp_path: Path) -> tuple[list[str], Path]:
+    scenario = tmp_path / "s.toml"
+    scenario.write_text('robot = "canadarm7"\n[jump]\nfail_at = 0.5\nkappa = 0.0\n')
+    out = tmp_path / "res"
+    out.mkdir()
+    (out / "jump").write_text("a file where the job's folder goes")
+    return ["run", str(scenario), "--out", str(out), "--quiet"], out / "jump"
+
+
+def test_os_error_is_one_line_with_the_path(tmp_path, capsys):
+    argv, blocked = _run_with_blocked_job_folder(tmp_path)
+    assert main(argv) == 2
+    line = err_line(capsys)
+    assert line.startswith("jointlock run: error: ") and str(blocked) in line
+
+
+def test_os_error_traceback_with_debug(tmp_path):
+    argv, _ = _run_with_blocked_job_folder(tmp_path)
+    with pytest.raises(OSError):
+        main(["--debug", *argv])
+
+
+# -- 5. --seed must be >= 0 -----------------------------------------------------------------------
+
+
+def test_seed_arg():
+    assert seed_arg("0") == 0 and seed_arg("42") == 42
+    for bad in ("-1", "1.5", "x"):
+        with pytest.raises(argparse.ArgumentTypeError, match="integer >= 0"):
+            seed_arg(bad)
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["workspace", "halt7", "--samples", "10", "--seed", "-1"],
+        ["singular", "halt7", "--search", "--samples", "2", "--seed", "-1"],
+        ["ik", "halt7", "--pose", "1", "0", "0", "0", "0", "0", "--method", "numeric", "--seed", "-1"],
+        ["run", "s.toml", "--seed", "-1"],
+        ["halt", "halt7", "--seed", "-1"],
+        ["halt-config", "halt7", "--lock", "4=0", "--seed", "-1"],
+    ],
+    ids=lambda a: a[0],
+)
+def test_negative_seed_is_a_usage_error(capsys, argv):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    assert "--seed: must be an integer >= 0; got '-1'" in capsys.readouterr().err
+
+
+def test_every_seed_option_uses_seed_arg():
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    checked = []
+    for name, p in sub.choices.items():
+        for action in p._actions:
+            if "--seed" in action.option_strings:
+                assert action.type is seed_arg, name
+                checked.append(name)
+    assert {"workspace", "singular", "ik", "run"} <= set(checked)
+
+
+# -- 8. a joint locked twice ----------------------------------------------------------------------
+
+
+def test_lock_map_refuses_a_joint_given_twice():
+    assert lock_map([(2, 0.5), (4, 0.1)]) == {2: 0.5, 4: 0.1}
+    assert lock_map(None) == {}
+    with pytest.raises(jl.ScenarioError, match="joint 2 given twice"):
+        lock_map([(2, math.radians(30)), (2, math.radians(50))])
+
+
+@pytest.mark.parametrize("command", ["kinematics", "singular", "ik"])
+def test_a_joint_locked_twice_is_refused(capsys, command):
+    argv = [command, "halt7", "--lock", "2=30", "--lock", "2=50"]
+    if command == "ik":
+        argv += ["--pose", "1", "0", "0", "0", "0", "0"]
+    assert main(argv) == 2
+    line = err_line(capsys)
+    assert "--lock: joint 2 given twice (30 and 50 deg)" in line
+
+
+# -- 9. non-finite option values ------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "argv, words",
+    [
+        (["jump", "canadarm7", "--fail-at", "0.5", "--kappa", "nan"], "--kappa must be a finite number"),
+        (["jump", "canadarm7", "--kappa", "inf"], "--kappa must be a finite number"),
+        (
+            ["ik", "halt7", "--pose", "1", "0", "0", "0", "0", "0", "--length-scale", "nan"],
+            "--length-scale must be a finite number",
+        ),
+        (
+            ["ik", "halt7", "--pose", "1", "0", "0", "0", "0", "0", "--length-scale", "-1"],
+            "--length-scale must be > 0",
+        ),
+        (
+            ["replan", "puma6", "--lock", "2=0", "--from-deg", *"0 0 0 0 0 0".split()]
+            + ["--to-deg", *"10 0 0 0 0 0".split(), "--cycle", "inf"],
+            "--cycle must be a finite number",
+        ),
+        (["workspace", "halt7", "--samples", "10", "--voxel", "inf"], "--voxel must be a finite number"),
+    ],
+)
+def test_non_finite_options_are_refused(capsys, argv, words):
+    assert main(argv) == 2
+    assert words in err_line(capsys)
+
+
+# -- 7. tolerance-angle grid size -----------------------------------------------------------------
+
+
+def test_tolerance_angle_bounds_the_grid(capsys, monkeypatch):
+    from jointlock.cli import tolerance_angle
+
+    argv = ["tolerance-angle", "puma6", "--lock", "2=0", "--q-target-deg", *"0 10 0 0 0 0".split()]
+    with monkeypatch.context() as m:  # first with a small cap (the old code had none)
+        m.setattr(tolerance_angle, "MAX_GAMMA_SAMPLES", 1000)
+        assert main([*argv, "--json"]) == 2  # 3601 samples at the default 0.1 deg
+        assert "3601 gamma samples" in err_line(capsys)
+        assert main([*argv, "--step-deg", "0.5", "--json"]) == 0  # 721 samples
+        capsys.readouterr()
+    assert main([*argv, "--step-deg", "1e-7"]) == 2  # 3.6e9 samples: refused before allocating
+    line = err_line(capsys)
+    assert "--step-deg 1e-07 gives 3600000001 gamma samples" in line and "--step-deg >=" in line
+
+
+# -- 10. result files are written atomically ------------------------------------------------------
+
+
+@pytest.mark.parametrize("command", ["workspace", "replan", "tolerance-angle"])
+def test_result_files_are_written_atomically(tmp_path, monkeypatch, command):
+    import jointlock.report as report
+
+    written: list[str] = []
+    real = report.atomic_write_bytes
+
+    def spy(path, data):
+        written.append(Path(path).name)
+        real(path, data)
+
+    monkeypatch.setattr(report, "atomic_write_bytes", spy)
+    out = tmp_path / "out"
+    argv = {
+        "workspace": ["workspace", "halt7", "--lock", "2=0", "--samples", "50", "--json"],
+        "replan": ["replan", "puma6", "--lock", "2=0", "--from-deg", *"0 0 0 0 0 0".split()]
+        + ["--to-deg", *"10 0 0 0 0 0".split(), "--steps", "2", "--json"],
+        "tolerance-angle": ["tolerance-angle", "puma6", "--lock", "2=0"]
+        + ["--q-target-deg", *"0 10 0 0 0 0".split(), "--step-deg", "1", "--json"],
+    }[command]
+    assert main([*argv, "--out", str(out)]) == 0
+    files = sorted(p.name for p in out.iterdir())
+    assert files and sorted(written) == files
+    for name in files:
+        if name.endswith(".png"):
+            assert (out / name).read_bytes().startswith(b"\x89PNG")
+    if command == "workspace":
+        with np.load(out / "points.npz") as z:
+            assert z["full"].shape == (50, 3) and z["locked"].shape == (50, 3)
+
+
+# -- 13. small things -----------------------------------------------------------------------------
+
+
+def test_jump_order_is_capped_at_9(capsys):
+    assert main(["jump", "canadarm7", "--order", "10", "--scenario", "missing.toml"]) == 2
+    assert "--order must be 1..9; got 10" in err_line(capsys)
+    assert main(["jump", "canadarm7", "--order", "0"]) == 2
+    assert "--order must be 1..9; got 0" in err_line(capsys)
+
+
+@pytest.mark.parametrize(
+    "extra, ignored",
+    [
+        (
+            ["--fail-at", "0.5", "--kappa", "0", "--order", "3", "--fix", "clip"],
+            "--order, --fix ignored with --fail-at",
+        ),
+        (["--fail-at", "0.5", "--kappa", "0", "--single"], "--single ignored with --fail-at"),
+        (["--kappa", "0", "--fix", "ramp", "--sweep", "4"], "--fix, --sweep ignored with --kappa"),
+    ],
+)
+def test_jump_warns_about_ignored_options(tmp_path, capsys, extra, ignored):
+    f = tmp_path / "s.toml"
+    f.write_text(SHORT_JUMP)
+    assert main(["jump", "canadarm7", "--scenario", str(f), *extra, "--json", "--quiet"]) == 0
+    err = capsys.readouterr().err
+    assert f"jointlock jump: warning: {ignored}" in err
+
+
+def test_jump_no_warning_for_the_default_mode_options(tmp_path, capsys):
+    from jointlock.cli.run import job_argv
+    from jointlock.scenario import load_scenario
+
+    f = tmp_path / "s.toml"
+    f.write_text('robot = "canadarm7"\n[jump]\nkappa = 0.0\norder = 3\nfix = "clip"\n')
+    argv = job_argv("jump", load_scenario(f), tmp_path / "out", {}, quiet=True)
+    assert "--kappa" in argv and not {"--order", "--fix", "--sweep"} & set(argv)
+    f.write_text('robot = "canadarm7"\n[jump]\nsweep = 4\norder = 3\n')
+    argv = job_argv("jump", load_scenario(f), tmp_path / "out", {}, quiet=True)
+    assert argv[argv.index("--order") + 1] == "3" and "--sweep" in argv and "--fix" in argv
+
+
+def test_help_texts(capsys):
+    with pytest.raises(SystemExit):
+        main(["jump", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "--optimize" in text and "the default mode" in text and "1..9" in text
+    with pytest.raises(SystemExit):
+        main(["reproduce", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "About 5 s" in text and "20 s" not in text
