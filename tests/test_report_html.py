@@ -35,7 +35,12 @@ def report(tmp_path_factory) -> Path:
     from jointlock.cli.run import run_scenario
 
     out = tmp_path_factory.mktemp("run")
-    sc = load_scenario(EXAMPLES / "halt_000.toml", {"halt_config.samples": 2000, "halt.n_samples": 101})
+    # 000's own, unconstrained halt-configuration search: its halt breaks limits, so the
+    # report's "broken" rendering is exercised too
+    sc = load_scenario(
+        EXAMPLES / "halt_000.toml",
+        {"halt_config.samples": 2000, "halt.n_samples": 101, "halt_config.reachable": False},
+    )
     run_scenario(sc, out, quiet=True)
     return out / "report.html"
 

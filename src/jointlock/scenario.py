@@ -173,7 +173,11 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "length": _pos("m", "characteristic length dividing the linear rows"),
         "no_refine": Field("bool", False, help="plain Monte Carlo, as 000"),
         "reachable": Field(
-            "bool", False, help="require reachability from [state] within halt.T (or halt_time)"
+            "bool",
+            None,
+            help="require the halt configuration to be reachable by the halt polynomial from [state] "
+            "within halt.T (or halt_time) under the limits; default: yes when the state and a halt "
+            "time are given",
         ),
         "halt_time": _pos("s", "halt time of the reachability bound (default: halt.T)"),
         "base": Field("choice", None, choices=_BASE2, help="overrides the top-level base"),
@@ -594,6 +598,10 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
                 raise ScenarioError(f"{source}: job [halt] needs state.{key} (the state at failure)")
         if h["T"] is None:
             raise ScenarioError(f"{source}: job [halt] needs halt.T (halt time [s], 000: 10)")
+    if "halt_config" in jobs and out["halt_config"]["reachable"] is None:
+        hc = out["halt_config"]
+        has_time = hc["halt_time"] is not None or out.get("halt", {}).get("T") is not None
+        hc["reachable"] = out["state"]["q0_deg"] is not None and has_time
     if "halt_config" in jobs and out["halt_config"]["reachable"]:
         hc = out["halt_config"]
         if out["state"]["q0_deg"] is None:

@@ -206,6 +206,7 @@ def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict],
         if t["reachable"]:
             argv += ["--from-q-deg", *_nums(st["q0_deg"])]
             argv += ["--from-dq-deg", *_nums(_rates(scenario, st["dq0_deg"]))] if st["dq0_deg"] else []
+            argv += ["--from-ddq-deg", *_nums(_rates(scenario, st["ddq0_deg"]))] if st["ddq0_deg"] else []
             halt_time = t["halt_time"] if t["halt_time"] is not None else d["halt"]["T"]
             argv += ["--halt-time", _num(halt_time)]
         for key in ("vmax_deg", "amax_deg"):
