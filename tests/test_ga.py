@@ -89,3 +89,25 @@ def test_ga_default_seed_is_0_and_a_fresh_seed_is_recorded():
     assert isinstance(fresh.seed, int) and fresh.seed >= 0  # repeatable from the result
     again = adaptive_ga(fitness, -1.0, 1.0, settings=st, rng=fresh.seed)
     np.testing.assert_array_equal(fresh.mean_history, again.mean_history)
+
+
+def test_bits_are_capped_at_52():
+    from jointlock.planning.ga import MAX_BITS
+
+    assert MAX_BITS == 52
+    f = lambda x: np.ones(x.shape[0])  # noqa: E731
+    with pytest.raises(jl.ScenarioError, match=r"n_bits must be an integer in \[1, 52\]"):
+        adaptive_ga(f, 0.0, 1.0, settings=GASettings(n_bits=2000))  # was OverflowError
+    with pytest.raises(jl.ScenarioError, match="n_bits"):
+        decode(np.zeros((1, 60), bool), 0.0, 1.0, 60)
+    with pytest.raises(jl.ScenarioError, match="precision"):
+        bits_for_precision(0.0, 1.0, 1e-300)
+    assert adaptive_ga(f, 0.0, 1.0, settings=GASettings(n_pop=4, n_gen=2, n_bits=52)).x.shape == (1,)
+    with pytest.raises(jl.ScenarioError, match="finite"):
+        adaptive_ga(f, -np.inf, np.inf)
+
+
+def test_mutation_reading_of_eq_38_is_documented():
+    import jointlock.planning.ga as ga
+
+    assert "pre-crossover parent" in ga.__doc__ and "pre-crossover parent" in ga.adaptive_ga.__doc__

@@ -362,3 +362,101 @@ def test_halt_pipeline_uses_exact_reachability(capsys):
     assert main(cmd + ["--no-reachability"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert not data["feasible"] and "reachability" not in data
+
+
+# -- review fixes: impossible starts, cached bounds, the halt CLI's Jacobian -------------------------
+
+
+@pytest.mark.parametrize(
+    ("which", "joint", "value", "words"),
+    [
+        (
+            "ddq0",
+            2,
+            30.0,
+            r"joint 3 starts with acceleration 30 deg/s\^2, outside its allowed range \[-20, 20\]",
+        ),
+        ("q0", 5, 200.0, r"joint 7 starts with angle 200 deg, outside its allowed range \[-180, 180\] deg"),
+        ("dq0", 4, -50.0, r"joint 6 starts with velocity -50 deg/s, outside its allowed range \[-40, 40\]"),
+    ],
+)
+def test_impossible_start_is_rejected_up_front(floating4, which, joint, value, words):
+    import time
+
+    q0, dq0, ddq0 = (np.array(v) for v in STATE)
+    state = {"q0": q0, "dq0": dq0, "ddq0": ddq0}
+    state[which][joint] = math.radians(value)
+    reach = HaltReachability(state["q0"], state["dq0"], state["ddq0"], 10.0, VMAX, AMAX)
+    t0 = time.perf_counter()
+    with pytest.raises(InfeasibleError, match="no halt time or k helps") as info:
+        optimal_halt_configuration(floating4, samples=100, rng=0, reachability=reach)
+    assert time.perf_counter() - t0 < 2.0  # was 18-57 s (a scan of T up to 120 s)
+    assert info.match(words)
+    bound = reach.bind(floating4)
+    assert bound.search_box(floating4.lower, floating4.upper) is None
+    assert bound.minimum_halt_time(floating4.lower, floating4.upper) is None
+
+
+def test_cannot_stop_keeps_the_precise_message(floating4):
+    # joint 6 at 40 deg/s needs 2 s to brake at 20 deg/s^2: the bound's own words, and the
+    # halt polynomial's smallest T (>= the bang-bang one)
+    reach = HaltReachability(*STATE, 1.0, VMAX, AMAX)
+    with pytest.raises(InfeasibleError, match=r"joint 6 cannot stop within the halt time T = 1 s") as info:
+        optimal_halt_configuration(floating4, samples=100, rng=0, reachability=reach)
+    t_min = float(str(info.value).rsplit("T = ", 1)[1].split()[0])
+    assert t_min >= 2.0
+
+
+def test_reachability_builds_its_bounds_once(floating4, monkeypatch, rng):
+    import dataclasses
+
+    import jointlock.planning.halt_config as hc
+
+    built = []
+    real = hc.AffineKBounds
+
+    def counting(*a, **kw):
+        built.append(a[3])
+        return real(*a, **kw)
+
+    monkeypatch.setattr(hc, "AffineKBounds", counting)
+    reach = HaltReachability(*STATE, 10.0, VMAX, AMAX).bind(floating4)
+    before = repr(reach)
+    q = rng.uniform(-math.pi, math.pi, size=(50, 6))
+    first = reach.contains(q)
+    for _ in range(3):
+        np.testing.assert_array_equal(reach.contains(q), first)
+        reach.intervals(q)
+    assert built == [10.0] and reach.bounds() is reach.bounds(10.0)
+    reach.bounds(12.0)  # another T: built anew, not cached
+    assert built == [10.0, 12.0]
+    # the cache is no field: repr, fields and equality unchanged; replace() starts without it
+    assert repr(reach) == before and reach == reach
+    assert "_bounds_at_halt_time" not in {f.name for f in dataclasses.fields(reach)}
+    other = dataclasses.replace(reach, halt_time=8.0)
+    other.contains(q)
+    assert built[-1] == 8.0
+
+
+def test_halt_cli_records_the_search_jacobian(capsys, monkeypatch):
+    import jointlock.planning.halt_config as hc
+
+    seen = []
+    real = hc.optimal_halt_configuration
+
+    def spy(*a, **kw):
+        seen.append(kw.get("jacobian"))
+        return real(*a, **kw)
+
+    monkeypatch.setattr(hc, "optimal_halt_configuration", spy)
+    cmd = ["halt", "halt7", "--base", "fixed", "--samples", "300", "--n-samples", "101", "--quiet"]
+    assert main(cmd + ["--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert seen == ["generalized"]  # passed explicitly: J_F (000 §3.1.2) whatever --base
+    assert data["hcom_jacobian"] == "generalized" and data["hcom_base"] == "floating"
+    assert data["base"] == "fixed"
+    assert main(cmd) == 0
+    assert "generalized Jacobian J_F" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["halt", "--help"])
+    assert "J_F" in capsys.readouterr().out

@@ -216,3 +216,114 @@ def test_configuration_box_holds_every_feasible_configuration(rng):
     # the per-joint box (one k per joint) holds the shared-k box
     lo_j, hi_j, none, _ = bounds.configuration_box(np.full(6, -math.pi), np.full(6, math.pi), per_joint=True)
     assert none is None and np.all(lo_j <= lo_box + 1e-9) and np.all(hi_j >= hi_box - 1e-9)
+
+
+# -- review fixes: degenerate torque, argument checks, docs -----------------------------------
+
+
+def _at_rest(**kw):
+    """A halt from rest at 0 to 0: no motion, no base torque at any k = 0."""
+    model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
+    z = np.zeros(6)
+    return HaltProblem(model, z, z, z, z, 10.0, 40 * DEG, 20 * DEG, n_samples=101, n_check=201, **kw)
+
+
+def test_reduction_is_nan_without_torque_at_k0():
+    from jointlock.planning.ga import GASettings
+
+    p = _at_rest()
+    res = optimal_halt_motion(p, n_scan=21)
+    assert res.feasible and res.global_torque_k0 == 0.0
+    assert math.isnan(res.reduction)  # was ZeroDivisionError
+    # the GA's fitness 1 / tau_bar stays finite where the torque vanishes (was inf -> error)
+    ga = optimal_halt_motion(p, solver="ga", ga_settings=GASettings(n_pop=6, n_gen=3))
+    assert ga.feasible and math.isfinite(ga.ga.fitness) and math.isnan(ga.reduction)
+
+
+def test_cli_reduction_na_without_torque_at_k0(capsys):
+    from jointlock.cli import main
+
+    zeros = ["0"] * 6
+    argv = ["halt", "halt7", "--quiet", "--n-samples", "101"]
+    for opt in ("--q0-deg", "--dq0-deg", "--ddq0-deg", "--qf-deg"):
+        argv += [opt, *zeros]
+    assert main(argv) == 0
+    assert "reduction n/a: no torque at k = 0" in capsys.readouterr().out
+    assert main(argv + ["--json"]) == 0
+    import json
+
+    assert json.loads(capsys.readouterr().out)["reduction"] is None
+
+
+def test_k_bounds_and_n_scan_are_checked():
+    p = _problem(T=12.0, n_samples=101, n_check=401)
+    lo, hi = shared_k_interval(p)
+    assert lo < hi
+    for bad in ((math.nan, 1.0), (1.0, 0.0), (0.0,), "ab"):
+        with pytest.raises(jl.ScenarioError, match="k_bounds"):
+            optimal_halt_motion(p, k_bounds=bad, n_scan=11)
+    # bounds that miss the (non-empty) feasible interval: said so, not a false "infeasible"
+    with pytest.raises(jl.ScenarioError, match="k_bounds .* miss the feasible interval"):
+        optimal_halt_motion(p, k_bounds=(hi + 1.0, hi + 2.0), n_scan=11)
+    for bad in (0, -3, 2.5, True):
+        with pytest.raises(jl.ScenarioError, match="n_scan"):
+            optimal_halt_motion(p, n_scan=bad)
+    # bounds that meet it: the answer lies within both, and one-sided bounds are allowed
+    res = optimal_halt_motion(p, k_bounds=(lo, 0.5 * (lo + hi)), n_scan=11)
+    assert res.feasible and lo <= res.k <= 0.5 * (lo + hi)
+    assert optimal_halt_motion(p, k_bounds=(-math.inf, math.inf), n_scan=11).feasible
+
+
+def test_public_functions_name_bad_arguments():
+    with pytest.raises(jl.ScenarioError, match="halt_coefficients"):
+        halt_coefficients(np.zeros(3), 0.0, 0.0, np.zeros(4), 1.0, 0.0)
+    p = _at_rest()
+    with pytest.raises(jl.ScenarioError, match=r"per_joint=True must have shape \(\.\.\., 6\)"):
+        global_base_torque(p, np.zeros(3), per_joint=True)
+    with pytest.raises(jl.ScenarioError, match="n_samples must be an integer"):
+        _at_rest().__class__(p.model, p.q0, p.dq0, p.ddq0, p.qf, 10.0, 1.0, 1.0, n_samples=101.5)
+
+
+def test_impossible_start_has_no_minimum_halt_time_at_once():
+    ddq0 = DDQ0.copy()
+    ddq0[2] = 30 * DEG  # above the 20 deg/s^2 limit at t = 0, whatever T and k
+    model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
+    p = HaltProblem(model, Q0, DQ0, ddq0, QF_PAPER, 10.0, 40 * DEG, 20 * DEG, n_samples=101, n_check=401)
+    import time
+
+    t0 = time.perf_counter()
+    assert minimum_halt_time(p) is None
+    assert time.perf_counter() - t0 < 0.5
+    res = optimal_halt_motion(p, n_scan=11)
+    assert not res.feasible
+    from jointlock.planning.halt_motion import infeasibility_message
+
+    assert "no halt time or k helps" in infeasibility_message(res)
+
+
+def test_k_part_extremum_sign_in_the_docs():
+    import jointlock.planning.halt_motion as hm
+    from jointlock.planning.halt_motion import k_shape
+
+    T = 3.0
+    phi = k_shape(np.array([T / 2]), T)[0][0]
+    assert phi == pytest.approx(-(T**6) / 64)
+    assert "-k T^6 / 64" in hm.__doc__
+
+
+def test_vector_solver_reports_per_joint_intervals(capsys):
+    import json
+
+    from jointlock.cli import main
+
+    argv = ["halt", "halt7", "--paper-qf", "--T", "20", "--solver", "vector", "--n-samples", "101", "--quiet"]
+    assert main(argv + ["--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    iv = np.asarray(data["joint_k_intervals_deg"])
+    k = np.asarray(data["k"])
+    assert iv.shape == (6, 2) and np.all((iv[:, 0] <= k + 1e-12) & (k <= iv[:, 1] + 1e-12))
+    assert main(argv) == 0
+    out = capsys.readouterr().out
+    assert "feasible k per joint" in out and "feasible k: [" not in out
+    for num in (1, 2, 3, 5, 6, 7):
+        assert f"joint {num}: [" in out

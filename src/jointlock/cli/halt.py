@@ -55,6 +55,16 @@ PAPER_SCENARIO: dict[str, Any] = {
 PAPER_RESULTS = {"k": 0.0018, "global_torque_k0_Nm": 22.25, "global_torque_Nm": 15.55, "reduction": 0.301}
 
 
+#: Jacobian of the halt-configuration search (CP): 000 §3.1.2's generalized Jacobian J_F of
+#: the free-floating arm, whatever --base (which sets the base of the disturbance torque only).
+HCOM_JACOBIAN = "generalized"
+BASE_HELP = (
+    "base of the disturbance torque: fixed (000, default) or free-floating spacecraft; the halt "
+    "configuration is searched with the free-floating arm's generalized Jacobian J_F either way "
+    "(000 §3.1.2)"
+)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "halt",
@@ -67,7 +77,7 @@ def register(sub: argparse._SubParsersAction) -> None:
             "000 §5's scenario."
         ),
     )
-    add_robot_arguments(p)
+    add_robot_arguments(p, base_help=BASE_HELP)
     p.add_argument("--q0-deg", type=float, nargs="+", metavar="DEG", help="angles at failure [deg]")
     p.add_argument("--dq0-deg", type=float, nargs="+", metavar="DEG", help="rates at failure [deg/s]")
     p.add_argument(
@@ -175,7 +185,12 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
         bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
         try:
             hc = optimal_halt_configuration(
-                model, samples=args.samples, rng=args.seed, progress=bar, reachability=reach
+                model,
+                samples=args.samples,
+                rng=args.seed,
+                jacobian=HCOM_JACOBIAN,
+                progress=bar,
+                reachability=reach,
             )
         except InfeasibleError as exc:
             if reach is None:
@@ -183,7 +198,9 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
             notes["reachability"] = f"not met, searched the whole ranges instead (000's way): {exc}"
             bar.close()
             bar = Progress(args.samples, "halt configuration", enabled=progress_enabled)
-            hc = optimal_halt_configuration(model, samples=args.samples, rng=args.seed, progress=bar)
+            hc = optimal_halt_configuration(
+                model, samples=args.samples, rng=args.seed, jacobian=HCOM_JACOBIAN, progress=bar
+            )
         bar.close()
         if reach is not None and hc.reachability is not None:
             notes["reachability"] = (
@@ -196,10 +213,18 @@ def build_problem(args: argparse.Namespace, progress_enabled: bool) -> tuple[Hal
             f"optimal halt configuration (Monte Carlo, {args.samples} samples, seed {args.seed})"
         )
         notes["cp_best"] = float(getattr(hc, "cp_best", float("nan")))
+        notes["hcom_jacobian"] = hc.jacobian
+        notes["hcom_base"] = hc.base
     problem = HaltProblem(
         model, q0, dq0, ddq0, qf, float(T), vmax, amax, base=args.base, n_samples=args.n_samples
     )
     return problem, notes
+
+
+def _jacobian_text(notes: dict) -> str:
+    if notes.get("hcom_base") == "fixed":  # a robot without a spacecraft: J_F is the fixed-base one
+        return "generalized Jacobian, which for this fixed-base model is the fixed-base Jacobian"
+    return "free-floating arm's generalized Jacobian J_F (000 §3.1.2)"
 
 
 def result_dict(res: HaltMotion, notes: dict) -> dict:
@@ -217,11 +242,12 @@ def result_dict(res: HaltMotion, notes: dict) -> dict:
         "k_rad": res.k,
         "global_torque_Nm": res.global_torque,
         "global_torque_k0_Nm": res.global_torque_k0,
-        "reduction": res.reduction,
+        "reduction": None if math.isnan(res.reduction) else res.reduction,
         "feasible": res.feasible,
         "violations": [_violation(v) for v in res.violations],
         "violations_k0": [_violation(v) for v in res.violations_k0],
         "k_interval_deg": res.k_interval / scale,
+        **({"joint_k_intervals_deg": res.joint_intervals / scale} if res.per_joint else {}),
         "minimum_T_s": res.minimum_T,
         "q_initial_deg": np.degrees(p.q0),
         "q_final_deg": np.degrees(p.qf),
@@ -371,6 +397,8 @@ def run(args: argparse.Namespace) -> int:
         + ", ".join(f"{v:.2f}" for v in data["q_final_deg"])
         + " deg"
     )
+    if "hcom_jacobian" in notes:
+        print(f"  (CP with the {_jacobian_text(notes)}; --base sets the base of the disturbance torque only)")
     if "reachability" in notes:
         print(f"reachability: {notes['reachability']}")
     print(
@@ -380,13 +408,23 @@ def run(args: argparse.Namespace) -> int:
         print("\nINFEASIBLE: " + infeasibility_message(res))
     else:
         kd = np.asarray(res.k) / K_UNIT_SCALE["deg/s^6"]
-        lo, hi = res.k_interval / K_UNIT_SCALE["deg/s^6"]
-        print(f"\nfeasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}")
-        print(f"k* = {np.array2string(kd, precision=6)} deg/s^6")
+        if res.per_joint:  # one k per joint: each within its own joint's interval
+            print(f"\nfeasible k per joint [deg/s^6]; solver {res.solver}")
+            for num, (lo, hi), kj in zip(nums, res.joint_intervals / K_UNIT_SCALE["deg/s^6"], kd):
+                print(f"  joint {num}: [{lo:.6g}, {hi:.6g}], k* = {kj:.6g}")
+        else:
+            lo, hi = res.k_interval / K_UNIT_SCALE["deg/s^6"]
+            print(f"\nfeasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}")
+            print(f"k* = {np.array2string(kd, precision=6)} deg/s^6")
     at = "k*" if res.feasible else "least-violating k (infeasible)"
+    change = (
+        "reduction n/a: no torque at k = 0"
+        if math.isnan(res.reduction)
+        else f"{100 * res.reduction:.1f} % lower"
+    )
     print(
         f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
-        f"({100 * res.reduction:.1f} % lower)"
+        f"({change})"
     )
     print("000 printed: k = 0.0018, 22.25 -> 15.55 N m (30.1 %) -- not reproduced, see docs/halt-motion.md")
     print("\njoint   peak |dq| [deg/s] (limit)   peak |ddq| [deg/s^2] (limit)")

@@ -3,8 +3,10 @@
 Binary coding of each gene on ``[lower, upper]`` with a resolution of ``precision``, an
 elite kept unchanged, fitness-proportional (roulette) selection (eq. 36), single-point
 crossover with the adaptive probability of eq. 37, bit-flip mutation with the adaptive
-probability of eq. 38 (Srinivas & Patnaik's adaptive GA, which 000 follows; their
-recommended constants ``g1 = g2 = 1.0``, ``g3 = g4 = 0.5`` are the defaults).  The whole
+probability of eq. 38, whose ``f'`` is read as the fitness of the pre-crossover parent
+(children are not scored before mutation).  This is Srinivas & Patnaik's adaptive GA, which
+000 follows; their recommended constants ``g1 = g2 = 1.0``, ``g3 = g4 = 0.5`` are the
+defaults.  The whole
 population is scored in one call ``(n_pop, n_genes) -> (n_pop,)``; chromosomes already
 scored are not scored again (the GA converges onto a few codes, so this saves most calls
 without changing the result).
@@ -30,9 +32,15 @@ from ..model import FloatArray
 FitnessFn = Callable[[FloatArray], FloatArray]
 
 
+#: Most bits per gene: a double's 52-bit mantissa resolves no finer grid on a gene's range
+#: (and ``2 ** n_bits`` must stay a finite float).
+MAX_BITS = 52
+
+
 @dataclass(frozen=True)
 class GASettings:
-    """Settings of :func:`adaptive_ga` (see there)."""
+    """Settings of :func:`adaptive_ga` (see there): ``n_pop >= 2``, ``n_gen >= 0`` and
+    ``1 <= n_bits <=`` :data:`MAX_BITS`, checked when the GA starts."""
 
     n_pop: int = 50
     n_gen: int = 100
@@ -83,12 +91,24 @@ def bits_for_precision(lower: float, upper: float, precision: float) -> int:
     (000 Step 1: "according to the accuracy of the solution and the solution space")."""
     if not precision > 0:
         raise ScenarioError(f"precision must be > 0; got {precision}")
-    return max(1, math.ceil(math.log2((upper - lower) / precision + 1.0)))
+    bits = max(1, math.ceil(math.log2((upper - lower) / precision + 1.0)))
+    if bits > MAX_BITS:
+        raise ScenarioError(
+            f"precision {precision:g} on [{lower:g}, {upper:g}] needs {bits} bits per gene, more than "
+            f"the {MAX_BITS} a float resolves; give a precision >= {(upper - lower) / (2.0**MAX_BITS - 1):.3g}"
+        )
+    return bits
+
+
+def _check_bits(n_bits: Any) -> None:
+    if isinstance(n_bits, bool) or not isinstance(n_bits, (int, np.integer)) or not 1 <= n_bits <= MAX_BITS:
+        raise ScenarioError(f"n_bits must be an integer in [1, {MAX_BITS}] (bits per gene); got {n_bits!r}")
 
 
 def decode(chromosomes: ArrayLike, lower: ArrayLike, upper: ArrayLike, n_bits: int) -> FloatArray:
     """Binary chromosomes (n_pop, n_genes * n_bits) -> genes (n_pop, n_genes), linear map of
     the unsigned integer (most significant bit first) onto ``[lower, upper]``."""
+    _check_bits(n_bits)
     bits = np.asarray(chromosomes, dtype=bool)
     lower = np.atleast_1d(np.asarray(lower, dtype=float))
     upper = np.atleast_1d(np.asarray(upper, dtype=float))
@@ -126,7 +146,8 @@ def adaptive_ga(
         (n_genes,) bounds of the genes (scalars for one gene).
     settings
         Population size, generations, bits per gene and the constants ``g1..g4`` of eqs.
-        37-38 (``pc``: ``g1``, ``g2``; ``pm``, per bit: ``g3``, ``g4``).
+        37-38 (``pc``: ``g1``, ``g2``; ``pm``, per bit: ``g3``, ``g4``).  Eq. 38's ``f'``
+        is the fitness of the pre-crossover parent (a child is not scored before mutation).
     rng
         Seed or generator, recorded in the result (default 0: the same run every time).
         ``None`` draws a fresh seed from the operating system and records that seed, so
@@ -142,10 +163,13 @@ def adaptive_ga(
     st = settings or GASettings()
     if st.n_pop < 2 or st.n_gen < 0 or st.n_bits < 1:
         raise ScenarioError(f"GA needs n_pop >= 2, n_gen >= 0, n_bits >= 1; got {st}")
+    _check_bits(st.n_bits)
     lo = np.atleast_1d(np.asarray(lower, dtype=float))
     hi = np.atleast_1d(np.asarray(upper, dtype=float))
     if lo.shape != hi.shape or not np.all(lo <= hi):
         raise ScenarioError(f"GA bounds must satisfy lower <= upper; got {lo.tolist()}, {hi.tolist()}")
+    if not (np.all(np.isfinite(lo)) and np.all(np.isfinite(hi))):
+        raise ScenarioError(f"GA bounds must be finite; got {lo.tolist()}, {hi.tolist()}")
     if rng is None:  # fresh entropy, but a recorded, repeatable seed
         rng = int(np.random.SeedSequence().entropy)
     seed = rng if not isinstance(rng, np.random.Generator) else "Generator"
@@ -191,7 +215,11 @@ def adaptive_ga(
         tmp = children[a].copy()
         children[a] = np.where(swap, children[b], children[a])
         children[b] = np.where(swap, tmp, children[b])
-        # Step 3 (3): bit-flip mutation, pm of eq. 38 with the individual's fitness
+        # Step 3 (3): bit-flip mutation, pm of eq. 38.  Eq. 38's f' (the fitness of the
+        # individual to be mutated) is read as the fitness of the selected parent before
+        # crossover: the child is not evaluated between crossover and mutation (that would
+        # cost a second fitness call per generation), so a crossed-over child is mutated with
+        # the probability of the parent whose slot it holds.
         pm = _adaptive_probability(child_fit, f_max, f_avg, st.g3, st.g4)
         children ^= gen.random((st.n_pop, length)) < pm[:, None]
         # elitism: the best individual survives unchanged (replaces the first child)

@@ -15,6 +15,7 @@ batched call).  The result is never worse than the best sample, and the gain is 
 
 from __future__ import annotations
 
+import functools
 import logging
 import math
 import secrets
@@ -40,7 +41,7 @@ from ..analysis.ability import (
 from ..errors import ConfigurationError, InfeasibleError
 from ..model import ArmModel, FloatArray, as_joint_array
 from ..progress import Progress
-from .halt_motion import AffineKBounds, KIntervalBatch
+from .halt_motion import LIMIT_RTOL, AffineKBounds, KIntervalBatch
 
 logger = logging.getLogger(__name__)
 
@@ -273,18 +274,69 @@ class HaltReachability:
         return replace(self, angle_lower=lo, angle_upper=hi)
 
     def bounds(self, T: float | None = None) -> AffineKBounds:
-        """The limits as bounds on ``k`` affine in ``qf`` (for ``T``, default :attr:`halt_time`)."""
+        """The limits as bounds on ``k`` affine in ``qf`` (for ``T``, default :attr:`halt_time`).
+
+        The bounds of :attr:`halt_time` are built once per instance and shared (treat them as
+        read-only); another ``T`` builds new ones.
+        """
+        if T is None or float(T) == self.halt_time:
+            return self._bounds_at_halt_time
+        return self._build_bounds(float(T))
+
+    def _build_bounds(self, T: float) -> AffineKBounds:
         return AffineKBounds(
             self.q0,
             self.dq0,
             self.ddq0,
-            self.halt_time if T is None else T,
+            T,
             self.velocity_limit,
             self.acceleration_limit,
             self.angle_lower,
             self.angle_upper,
             n_check=self.n_check,
         )
+
+    @functools.cached_property
+    def _bounds_at_halt_time(self) -> AffineKBounds:
+        # a cache in the instance __dict__, not a field: equality, hash and repr are unchanged,
+        # and dataclasses.replace (e.g. bind) builds a fresh instance without it
+        return self._build_bounds(self.halt_time)
+
+    def start_violations(self, joint_numbers: tuple[int, ...] | None = None) -> list[str]:
+        """Limits the state at failure itself breaks (angle, velocity or acceleration outside its
+        range at ``t = 0``), one plain-language line each; empty when none.
+
+        The halt polynomial starts from that state whatever ``T`` and ``k`` (the ``k``-part
+        and its first two derivatives vanish at ``t = 0``), so any such line means no halt
+        time or ``k`` helps.  The angle is checked only once angle limits are known
+        (:meth:`bind`).  Same slack as the halt-motion check (``LIMIT_RTOL``).
+        """
+        numbers = joint_numbers or tuple(range(1, self.q0.size + 1))
+        checks = [
+            ("velocity", "deg/s", self.dq0, -self.velocity_limit, self.velocity_limit),
+            ("acceleration", "deg/s^2", self.ddq0, -self.acceleration_limit, self.acceleration_limit),
+        ]
+        if self.angle_lower is not None and self.angle_upper is not None:
+            checks.insert(0, ("angle", "deg", self.q0, self.angle_lower, self.angle_upper))
+        out = []
+        for quantity, unit, value, lo, hi in checks:
+            slack = LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1.0)
+            for i in np.nonzero((value < lo - slack) | (value > hi + slack))[0]:
+                out.append(
+                    f"joint {numbers[i]} starts with {quantity} {math.degrees(value[i]):.6g} {unit}, "
+                    f"outside its allowed range [{math.degrees(lo[i]):.6g}, {math.degrees(hi[i]):.6g}] {unit}"
+                )
+        return out
+
+    def check_start(self, joint_numbers: tuple[int, ...] | None = None) -> None:
+        """Raise :class:`~jointlock.errors.InfeasibleError` when the state at failure itself
+        breaks a limit (:meth:`start_violations`): no halt time or ``k`` helps then."""
+        bad = self.start_violations(joint_numbers)
+        if bad:
+            raise InfeasibleError(
+                "the state at failure already breaks a limit, and every halt starts from it, so no "
+                "halt time or k helps: " + "; ".join(bad)
+            )
 
     def intervals(self, q: ArrayLike) -> KIntervalBatch:
         """Feasible ``k`` [rad/s^6] of the halt to each configuration (K, n) [rad]."""
@@ -308,6 +360,8 @@ class HaltReachability:
         :meth:`AffineKBounds.configuration_box`)."""
         t = self.halt_time if T is None else float(T)
         lo, hi = np.asarray(lower, dtype=float), np.asarray(upper, dtype=float)
+        if self.start_violations():  # no T or k helps (see check_start)
+            return None
         try:
             r_lo, r_hi = replace(self.bound(), halt_time=t).interval()
         except InfeasibleError:
@@ -329,6 +383,8 @@ class HaltReachability:
         """Smallest halt time [s] for which some configuration in ``[lower, upper]`` is
         reachable: scan in ``step`` from the braking time ``max |dq0| / a_max``, then bisect
         to ``tol`` (None when none up to ``t_max``, default ``max(10 T, 120 s)``)."""
+        if self.start_violations():  # the start breaks a limit: no T helps (see check_start)
+            return None
         t_stop = float(np.max(np.abs(self.dq0) / self.acceleration_limit))
         t_max = max(10 * self.halt_time, 120.0) if t_max is None else t_max
 
@@ -702,7 +758,14 @@ def optimal_halt_configuration(
     k_range = None
     if isinstance(reachability, HaltReachability):
         exact_reach = reachability = reachability.bind(model_locked)
+        exact_reach.check_start(model_locked.joint_numbers)  # impossible starts, up front
         lo, hi = _sampling_box(model_locked, lower, upper, None)
+        try:  # the bang-bang bound's own verdict (a joint cannot stop within T) is precise
+            exact_reach.bound().interval(model_locked.joint_numbers)
+        except InfeasibleError as exc:
+            raise InfeasibleError(
+                _unreachable_message(exact_reach, lo, hi, model_locked.joint_numbers, reason=str(exc))
+            ) from None
         box = exact_reach.search_box(lo, hi)
         if box is None:
             raise InfeasibleError(_unreachable_message(exact_reach, lo, hi, model_locked.joint_numbers))
@@ -827,7 +890,12 @@ def _pull_back(reach: HaltReachability, start: FloatArray, x: FloatArray, rounds
 
 
 def _unreachable_message(
-    reach: HaltReachability, lo: FloatArray, hi: FloatArray, joint_numbers: tuple[int, ...]
+    reach: HaltReachability,
+    lo: FloatArray,
+    hi: FloatArray,
+    joint_numbers: tuple[int, ...],
+    *,
+    reason: str | None = None,
 ) -> str:
     t_min = reach.minimum_halt_time(lo, hi)
     which = "one k per joint" if reach.per_joint else "a shared k (000)"
@@ -835,6 +903,8 @@ def _unreachable_message(
         f"no halt configuration is reachable by the halt polynomial with {which} within "
         f"T = {reach.halt_time:g} s from {reach.describe_state()} (healthy joints {list(joint_numbers)})"
     )
+    if reason is not None:
+        msg += f": {reason} (bang-bang bound, necessary only)"
     if t_min is None:
         return msg + "; no halt time up to the search limit makes one reachable"
     return msg + f"; the smallest halt time with a reachable configuration is T = {t_min:.3f} s"

@@ -10,7 +10,7 @@ configuration ``qf`` at rest (``dqf = ddqf = 0``) in the halt time ``T`` along
 
 The ``k``-part of eq. 27 is ``k t^3 (t - T)^3``: a triple root at both ends, so it leaves
 all six boundary conditions untouched and ``q(t; k) = q_quintic(t) + k t^3 (t - T)^3``.
-Its peak, at ``t = T/2``, is ``k T^6 / 64``.
+Its extremum, at ``t = T/2``, is ``-k T^6 / 64`` (``t^3 (t - T)^3 <= 0`` on ``[0, T]``).
 
 The objective is the time average of the 2-norm of the base disturbance torque (eq. 32),
 ``tau_bar(k) = 1/T int_0^T ||n_d(t; k)|| dt`` with ``n_d`` from :func:`jointlock.dynamics.rnea`
@@ -58,6 +58,9 @@ LIMIT_RTOL = 1e-9
 MIN_SAMPLES = 11
 #: Largest number of (candidate, time) samples passed to one :func:`rnea` call.
 CHUNK_SAMPLES = 60_000
+#: Floor of the global torque in the GA's fitness ``1 / tau_bar`` (eq. 35) [N m]: a halt
+#: without base torque scores ``1e300``, finite, and a population's sum stays finite too.
+TORQUE_FLOOR = 1e-300
 
 Solver = Literal["scan", "ga", "vector"]
 LimitKind = Literal["angle", "velocity", "acceleration"]
@@ -94,6 +97,16 @@ def halt_coefficients(
     (..., n, 7) coefficients ``a0 .. a6`` in SI units (``a_j`` in rad/s^j).
     """
     q0, dq0, ddq0, qf, dqf, ddqf, k = (np.asarray(x, dtype=float) for x in (q0, dq0, ddq0, qf, dqf, ddqf, k))
+    names = ("q0", "dq0", "ddq0", "qf", "dqf", "ddqf", "k")
+    shapes = [x.shape for x in (q0, dq0, ddq0, qf, dqf, ddqf, k)]
+    try:
+        np.broadcast_shapes(*shapes)
+    except ValueError:
+        got = ", ".join(f"{n} {sh}" for n, sh in zip(names, shapes))
+        raise ScenarioError(
+            f"halt_coefficients: the states must broadcast to one shape (..., n) and k against them "
+            f"((...) with a trailing 1, or (..., n)); got {got}"
+        ) from None
     T = float(T)
     if not T > 0:
         raise ScenarioError(f"halt time T must be > 0 [s]; got {T}")
@@ -218,6 +231,10 @@ class HaltProblem:
             raise ScenarioError(
                 "base='floating' needs a model with a spacecraft (load it with base='floating')"
             )
+        for name in ("n_samples", "n_check"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise ScenarioError(f"{name} must be an integer; got {v!r}")
         if self.n_samples < MIN_SAMPLES or self.n_samples % 2 == 0:
             raise ScenarioError(f"n_samples must be odd and >= {MIN_SAMPLES}; got {self.n_samples}")
         if self.n_check < 3:
@@ -316,6 +333,11 @@ def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = 
     (...) [N m].
     """
     k = np.asarray(k, dtype=float)
+    if per_joint and (k.ndim == 0 or k.shape[-1] != problem.dof):
+        raise ScenarioError(
+            f"k with per_joint=True must have shape (..., {problem.dof}) (one k per healthy joint "
+            f"{list(problem.model.joint_numbers)}) [rad/s^6]; got shape {k.shape}"
+        )
     batch = k.shape[:-1] if per_joint else k.shape
     flat = k.reshape((-1, problem.dof) if per_joint else (-1,))
     t = problem.times()
@@ -813,6 +835,15 @@ def least_violating_k(problem: HaltProblem) -> float:
     return float(res.x) if res.fun <= viol[i] else float(grid[i])
 
 
+def _start_breaks_limits(problem: HaltProblem) -> bool:
+    """The state at failure itself is outside a limit (beyond the round-off slack): the halt
+    starts from it (the ``k``-part and its first two derivatives vanish at ``t = 0``)."""
+    lo, hi = _limits(problem)
+    start = np.stack([problem.q0, problem.dq0, problem.ddq0])
+    sl = _slack(lo, hi)
+    return bool(np.any((start < lo - sl) | (start > hi + sl)))
+
+
 def minimum_halt_time(
     problem: HaltProblem, *, t_min: float = 0.5, t_max: float | None = None, tol: float = 1e-3
 ) -> float | None:
@@ -820,8 +851,11 @@ def minimum_halt_time(
 
     Scans ``T`` on a grid of 0.25 s steps from ``t_min`` to ``t_max`` (default
     ``max(10 T, 120 s)``), then bisects the first infeasible-to-feasible bracket to
-    ``tol`` [s].  Returns None when no ``T`` in the range is feasible.
+    ``tol`` [s].  Returns None when no ``T`` in the range is feasible, at once when the state
+    at failure itself breaks a limit (every halt starts from it, whatever ``T`` and ``k``).
     """
+    if _start_breaks_limits(problem):
+        return None  # the halt starts from this state whatever T and k: no T helps
     t_max = max(10 * problem.T, 120.0) if t_max is None else t_max
     grid = np.arange(t_min, t_max + 1e-9, 0.25)
 
@@ -898,7 +932,13 @@ class HaltMotion:
 
     @property
     def reduction(self) -> float:
-        """Relative reduction of the global torque against ``k = 0`` [-] (000: 30.1 %)."""
+        """Relative reduction of the global torque against ``k = 0`` [-] (000: 30.1 %).
+
+        NaN when there is no torque at ``k = 0`` (``global_torque_k0 == 0``, e.g. a halt
+        from rest to the start configuration): no relative reduction is defined then.
+        """
+        if self.global_torque_k0 == 0.0:
+            return math.nan
         return 1.0 - self.global_torque / self.global_torque_k0
 
     @property
@@ -926,6 +966,22 @@ def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[floa
         if res.fun < values[i]:
             best = float(res.x)
     return best, grid, values
+
+
+def _check_k_bounds(k_bounds: Sequence[float] | None) -> tuple[float, float] | None:
+    """``k_bounds`` as ``(lo, hi)`` [rad/s^6]: two numbers, not NaN, ``lo <= hi`` (infinite
+    ends allowed: one-sided bounds)."""
+    if k_bounds is None:
+        return None
+    try:
+        arr = np.asarray(k_bounds, dtype=float)
+    except (TypeError, ValueError):
+        raise ScenarioError(f"k_bounds must be two numbers (lo, hi) [rad/s^6]; got {k_bounds!r}") from None
+    if arr.shape != (2,) or np.any(np.isnan(arr)):
+        raise ScenarioError(f"k_bounds must be two numbers (lo, hi) [rad/s^6], not NaN; got {k_bounds!r}")
+    if not arr[0] <= arr[1]:
+        raise ScenarioError(f"k_bounds must satisfy lo <= hi [rad/s^6]; got {arr.tolist()}")
+    return float(arr[0]), float(arr[1])
 
 
 def optimal_halt_motion(
@@ -956,9 +1012,12 @@ def optimal_halt_motion(
         interval) started from the shared-``k`` optimum.
     k_bounds
         ``(lo, hi)`` [rad/s^6] to intersect with the feasible interval (e.g. 000's
-        Fig. 8 range ``[0, 0.1]`` deg/s^6).  Default: the feasible interval itself.
+        Fig. 8 range ``[0, 0.1]`` deg/s^6); ``lo <= hi``, not NaN (an infinite end leaves
+        that side open).  Default: the feasible interval itself.  Bounds that miss a
+        non-empty feasible interval raise :class:`~jointlock.errors.ScenarioError` (giving
+        both intervals); for an infeasible problem they do not change the report.
     n_scan
-        Grid points of the scan.
+        Grid points of the scan, an integer >= 1.
     ga_settings, ga_precision
         GA settings; ``ga_precision`` [rad/s^6] sets the bits per gene (default: 1/1000 of
         the interval, 10 bits).
@@ -977,10 +1036,21 @@ def optimal_halt_motion(
     """
     if solver not in ("scan", "ga", "vector"):
         raise ScenarioError(f"solver must be 'scan', 'ga' or 'vector'; got {solver!r}")
+    if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 1:
+        raise ScenarioError(f"n_scan must be an integer >= 1 (grid points of the scan); got {n_scan!r}")
+    bounds_k = _check_k_bounds(k_bounds)
     per = feasible_k_intervals(problem)
     lo, hi = float(per[:, 0].max()), float(per[:, 1].min())
-    if k_bounds is not None:
-        lo, hi = max(lo, float(k_bounds[0])), min(hi, float(k_bounds[1]))
+    if bounds_k is not None:
+        if lo <= hi and not (bounds_k[0] <= hi and bounds_k[1] >= lo):
+            scale = K_UNIT_SCALE["deg/s^6"]
+            raise ScenarioError(
+                f"k_bounds [{bounds_k[0]:.6g}, {bounds_k[1]:.6g}] rad/s^6 "
+                f"([{bounds_k[0] / scale:.6g}, {bounds_k[1] / scale:.6g}] deg/s^6) miss the feasible "
+                f"interval of k [{lo:.6g}, {hi:.6g}] rad/s^6 ([{lo / scale:.6g}, {hi / scale:.6g}] "
+                "deg/s^6): no k within the bounds respects the limits; widen k_bounds or leave them out"
+            )
+        lo, hi = max(lo, bounds_k[0]), min(hi, bounds_k[1])
     tau0 = float(global_base_torque(problem, 0.0))
     viol0 = constraint_violations(problem, 0.0)
     settings: dict[str, Any] = {"n_scan": n_scan, "n_samples": problem.n_samples, "n_check": problem.n_check}
@@ -1016,7 +1086,8 @@ def optimal_halt_motion(
         if ga_precision is not None and hi > lo:
             st = replace(st, n_bits=bits_for_precision(lo, hi, ga_precision))
         ga_result = adaptive_ga(
-            lambda x: 1.0 / global_base_torque(problem, x[:, 0]),
+            # eq. 35; the floor keeps the fitness finite where the torque vanishes
+            lambda x: 1.0 / np.maximum(global_base_torque(problem, x[:, 0]), TORQUE_FLOOR),
             lo,
             hi,
             settings=st,
@@ -1079,6 +1150,8 @@ def infeasibility_message(result: HaltMotion, *, k_unit: str = "deg/s^6") -> str
     lines += ["  " + v.describe() for v in result.violations[:6]]
     if result.minimum_T is not None:
         lines.append(f"smallest halt time with a feasible k: T = {result.minimum_T:.3f} s")
+    elif _start_breaks_limits(p):
+        lines.append("the state at failure already breaks a limit (at t = 0): no halt time or k helps")
     else:
         lines.append("no halt time up to the search limit has a feasible k")
     return "\n".join(lines)
