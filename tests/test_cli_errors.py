@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 from pathlib import Path
 
 import numpy as np
@@ -110,7 +111,7 @@ def test_jump_reduction_is_na_when_there_is_no_jump(tmp_path, capsys, mode):
 
 def _out_commands(out: str, scenario: Path) -> list[list[str]]:
     return [
-        ["workspace", "halt7", "--samples", "10", "--out", out],
+        ["workspace", "halt7", "--samples", "1000", "--out", out],
         ["replan", "puma6", "--lock", "2=0", "--from-deg", *"0 0 0 0 0 0".split()]
         + ["--to-deg", *"10 0 0 0 0 0".split(), "--steps", "2", "--out", out],
         ["tolerance-angle", "puma6", "--lock", "2=0", "--q-target-deg", *"0 10 0 0 0 0".split()]
@@ -126,7 +127,7 @@ def _out_commands(out: str, scenario: Path) -> list[list[str]]:
 )
 def test_out_pointing_at_a_file_is_refused_up_front(tmp_path, capsys, index):
     scenario = tmp_path / "s.toml"
-    scenario.write_text('robot = "halt7"\n[workspace]\nsamples = 10\n')
+    scenario.write_text('robot = "halt7"\n[workspace]\nsamples = 1000\n')
     existing = tmp_path / "results"
     existing.write_text("not a folder")
     argv = _out_commands(str(existing), scenario)[index]
@@ -180,7 +181,7 @@ def test_seed_arg():
 @pytest.mark.parametrize(
     "argv",
     [
-        ["workspace", "halt7", "--samples", "10", "--seed", "-1"],
+        ["workspace", "halt7", "--samples", "1000", "--seed", "-1"],
         ["singular", "halt7", "--search", "--samples", "2", "--seed", "-1"],
         ["ik", "halt7", "--pose", "1", "0", "0", "0", "0", "0", "--method", "numeric", "--seed", "-1"],
         ["run", "s.toml", "--seed", "-1"],
@@ -249,7 +250,7 @@ def test_a_joint_locked_twice_is_refused(capsys, command):
             + ["--to-deg", *"10 0 0 0 0 0".split(), "--cycle", "inf"],
             "--cycle must be a finite number",
         ),
-        (["workspace", "halt7", "--samples", "10", "--voxel", "inf"], "--voxel must be a finite number"),
+        (["workspace", "halt7", "--samples", "1000", "--voxel", "inf"], "--voxel must be a finite number"),
     ],
 )
 def test_non_finite_options_are_refused(capsys, argv, words):
@@ -292,7 +293,7 @@ def test_result_files_are_written_atomically(tmp_path, monkeypatch, command):
     monkeypatch.setattr(report, "atomic_write_bytes", spy)
     out = tmp_path / "out"
     argv = {
-        "workspace": ["workspace", "halt7", "--lock", "2=0", "--samples", "50", "--json"],
+        "workspace": ["workspace", "halt7", "--lock", "2=0", "--samples", "1000", "--json"],
         "replan": ["replan", "puma6", "--lock", "2=0", "--from-deg", *"0 0 0 0 0 0".split()]
         + ["--to-deg", *"10 0 0 0 0 0".split(), "--steps", "2", "--json"],
         "tolerance-angle": ["tolerance-angle", "puma6", "--lock", "2=0"]
@@ -306,7 +307,7 @@ def test_result_files_are_written_atomically(tmp_path, monkeypatch, command):
             assert (out / name).read_bytes().startswith(b"\x89PNG")
     if command == "workspace":
         with np.load(out / "points.npz") as z:
-            assert z["full"].shape == (50, 3) and z["locked"].shape == (50, 3)
+            assert z["full"].shape == (1000, 3) and z["locked"].shape == (1000, 3)
 
 
 # -- 13. small things -----------------------------------------------------------------------------
@@ -360,3 +361,186 @@ def test_help_texts(capsys):
         main(["reproduce", "--help"])
     text = " ".join(capsys.readouterr().out.split())
     assert "About 5 s" in text and "20 s" not in text
+
+
+# -- UX review: usage errors, --debug, broken pipes, help texts -----------------------------------
+
+
+@pytest.mark.parametrize(
+    "argv, prog",
+    [
+        (["workspace"], "jointlock workspace"),  # a required argument missing
+        (["replan", "puma6", "--steps", "x"], "jointlock replan"),  # a bad value
+        (["robots", "--bogus"], "jointlock robots"),  # an unknown option after the subcommand
+        (["nope"], "jointlock"),  # an unknown subcommand
+        ([], "jointlock"),
+    ],
+)
+def test_usage_errors_are_one_line_pointing_to_help(capsys, argv, prog):
+    with pytest.raises(SystemExit) as exc:
+        main(argv)
+    assert exc.value.code == 2
+    line = err_line(capsys)
+    assert line.startswith(f"{prog}: error: ") and line.endswith(f"(see '{prog} --help')")
+    assert "usage:" not in line
+
+
+def test_every_subparser_has_the_one_line_error():
+    from jointlock.cli import Parser
+
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    assert sub.choices and all(isinstance(p, Parser) for p in sub.choices.values())
+
+
+@pytest.mark.parametrize("where", ["before", "after"])
+def test_debug_is_accepted_before_and_after_the_subcommand(tmp_path, where):
+    argv, _ = _run_with_blocked_job_folder(tmp_path)
+    argv = ["--debug", *argv] if where == "before" else [*argv, "--debug"]
+    with pytest.raises(OSError):  # --debug: the traceback, not the one-line error
+        main(argv)
+    args = build_parser().parse_args(["robots", "--debug"])
+    assert args.debug is True
+    assert build_parser().parse_args(["robots"]).debug is False
+
+
+def test_broken_pipe_exits_quietly():
+    import subprocess
+    import sys
+
+    code = "import sys\nfrom jointlock.cli import main\nsys.exit(main(['robots']))\n"
+    proc = subprocess.Popen(
+        [sys.executable, "-c", code],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        env={**os.environ, "MPLBACKEND": "Agg"},
+    )
+    proc.stdout.close()  # the reader has left before the first line (as `| head -0`)
+    err = proc.stderr.read().decode()
+    proc.wait(timeout=120)
+    assert "Broken pipe" not in err and "Traceback" not in err and "Exception ignored" not in err, err
+    assert proc.returncode == 141
+
+
+def _help(command: str) -> str:
+    parser = build_parser()
+    sub = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction))
+    return " ".join(sub.choices[command].format_help().split())
+
+
+@pytest.mark.parametrize(
+    "command, words",
+    [
+        ("tolerance-angle", ["--gamma-limit-deg DEG", "this [deg]", "--zoom-deg DEG", "--step-deg DEG"]),
+        ("tolerance-angle", ["--q-target-deg DEG", "every joint of the arm [deg]", "puma6-family arms only"]),
+        ("replan", ["start configuration, every joint of the arm [deg]", "goal configuration"]),
+        ("replan", ["puma6-family arms only", ">= 1"]),
+        ("ik", ["closed-form: 002's analytic IK", "numeric: Levenberg", "auto (default)"]),
+        ("workspace", ["voxel occupancy", "from half the samples", ">= 1000"]),
+        ("jump", ["--kappa K", "rad^2/(s m^3)", "deg/s", "q0_deg"]),
+    ],
+)
+def test_help_texts_give_units_and_scope(command, words):
+    text = _help(command)
+    for w in words:
+        assert w in text, (command, w)
+
+
+def test_readme_row_says_which_arms_tolerance_angle_and_replan_take():
+    readme = (Path(__file__).resolve().parents[1] / "README.md").read_text()
+    row = next(line for line in readme.splitlines() if line.startswith("| re-plan a 6-DOF arm"))
+    assert "puma6-family arms only" in row
+
+
+# -- UX review: jump errors and output --------------------------------------------------------------
+
+
+def test_jump_on_another_robot_asks_for_a_task_with_q0(capsys, tmp_path):
+    assert main(["jump", "puma6", "--quiet"]) == 2
+    line = err_line(capsys)
+    assert "other than canadarm7 needs --scenario FILE with q0_deg (6 values [deg])" in line
+    assert "q0_deg = [10, 40, -70, 100, -60, 30]" in line and "has 7 angles" not in line
+    f = tmp_path / "t.toml"
+    f.write_text("dx_m = [0.1, 0, 0]\n")
+    assert main(["jump", "puma6", "--scenario", str(f), "--quiet"]) == 2
+    assert "gives no q0_deg" in err_line(capsys)
+
+
+def test_jump_refuses_a_run_scenario_file_with_advice(capsys):
+    example = Path(__file__).resolve().parents[1] / "examples" / "jump_001.toml"
+    assert main(["jump", "canadarm7", "--scenario", str(example), "--quiet"]) == 2
+    line = err_line(capsys)
+    assert "is a `jointlock run` scenario file" in line and f"jointlock run {example}" in line
+    assert "unknown field" not in line
+
+
+def test_jump_text_output_units_and_words(capsys, tmp_path):
+    f = tmp_path / "t.toml"
+    f.write_text(SHORT_JUMP)
+    assert (
+        main(["jump", "canadarm7", "--scenario", str(f), "--fail-at", "0.5", "--kappa", "0.5", "--quiet"])
+        == 0
+    )
+    text = capsys.readouterr().out
+    assert "nan" not in text
+    assert "kappa = 0.5 rad^2/(s m^3) (given, feasible interval not searched)" in text
+    jump_line = next(line for line in text.splitlines() if line.startswith("joint jump"))
+    assert "deg/s" in jump_line and "rad/s" not in jump_line
+    out = jump_json(capsys, "canadarm7", "--scenario", str(f), "--fail-at", "0.5", "--kappa", "0.5")
+    assert out["kappa_unit"] == "rad^2/(s m^3)"
+    if out["jump_after"] > out["jump_before"]:
+        assert "x larger" in jump_line or "% larger" in jump_line
+
+
+def test_jump_text_helpers():
+    from jointlock.cli.jump import _interval_text, _less, _points_text
+
+    assert _less(0.25) == "25.0 % less"
+    assert _less(-33.405) == "34.4x larger"
+    assert _less(-0.05) == "5.0 % larger"
+    assert _less(None).startswith("reduction n/a")
+    assert _interval_text({"kappa_interval": [None, None]}, given=False) == "no feasible kappa"
+    assert _interval_text({"kappa_interval": [-1e-3, 2e-3]}, given=False) == "feasible [-0.001, 0.002]"
+    assert _points_text([None, None]) == "none (kappa = 0 everywhere)"
+    assert _points_text([float("nan"), float("nan")]) == "none (kappa = 0 everywhere)"
+    assert _points_text([0.0, 12.0]) == "0 s, 12 s"
+
+
+# -- halt: errors name the options, missing options all at once ------------------------------------
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--T", "0"], "--T must be a finite halt time > 0 [s]; got 0"),  # was "halt_time must be"
+        (["--T", "nan"], "--T must be a finite halt time > 0 [s]; got nan"),
+        (["--n-samples", "10"], "--n-samples must be an odd integer >= 11"),  # was "n_samples must be odd"
+        (["--n-samples", "5"], "--n-samples must be an odd integer >= 11"),
+        (["--solver", "ga", "--population", "1"], "--population must be >= 2 (GA population); got 1"),
+        (["--solver", "ga", "--generations", "-1"], "--generations must be >= 0 (GA generations); got -1"),
+        (["--vmax-deg", "40", "30"], "--vmax-deg needs one value or 6 values, finite and > 0"),
+    ],
+)
+def test_halt_errors_name_the_option(capsys, extra, words):
+    assert main(["halt", "halt7", "--paper-qf", "--quiet", *extra]) == 2
+    err = err_line(capsys)
+    assert words in err
+    assert "GASettings" not in err and "halt_time" not in err and "n_samples" not in err
+
+
+def test_halt_lists_every_missing_option_at_once(capsys):
+    assert main(["halt", "canadarm7", "--lock", "4=0", "--dq0-deg", *["0"] * 6, "--quiet"]) == 2
+    err = err_line(capsys)
+    assert "this robot needs --q0-deg, --ddq0-deg, --T " in err  # was one per run
+    assert main(["halt", "canadarm7", "--lock", "4=0", "--quiet"]) == 2
+    assert "needs --q0-deg, --dq0-deg, --ddq0-deg, --T " in err_line(capsys)
+
+
+def test_halt_continuous_joint_error_names_options_in_degrees(capsys):
+    urdf = str(Path(__file__).parent / "data" / "arm5.urdf")
+    argv = ["halt", urdf, "--lock", "2=20", "--q0-deg", "0", "10", "20", "30", "--dq0-deg", *["0"] * 4]
+    argv += ["--ddq0-deg", "0", "0", "30", "0", "--T", "5", "--quiet"]
+    assert main(argv) == 2  # an impossible start: named by option, in degrees, no search
+    err = err_line(capsys)
+    assert "--ddq0-deg" in err and "joint 4 starts with acceleration 30 deg/s^2" in err
+    assert "[rad]" not in err and "angle_lower" not in err and "q_min" not in err

@@ -460,3 +460,54 @@ def test_halt_cli_records_the_search_jacobian(capsys, monkeypatch):
     with pytest.raises(SystemExit):
         main(["halt", "--help"])
     assert "J_F" in capsys.readouterr().out
+
+
+# -- first-time user findings: section-plot legend, unlimited joints, the model's limits -------------
+
+
+def test_section_plot_legend_shows_reachable_and_unreachable(floating4, reach10):
+    res = optimal_halt_configuration(floating4, samples=300, rng=0, reachability=reach10, refine=False)
+    n_bad = int((~res.reachable).sum())
+    assert n_bad > 0
+    fig = section_figures(res)[0]
+    legend = fig.axes[0].get_legend()
+    texts = [t.get_text() for t in legend.get_texts()]
+    assert f"unreachable samples ({n_bad})" in texts
+    assert f"reachable samples ({300 - n_bad})" in texts  # the blue cloud had no entry
+    handles = getattr(legend, "legend_handles", None) or legend.legendHandles
+    for h, text in zip(handles, texts):
+        if "samples" in text:  # opaque, readable keys (was alpha 0.2, size 1.5: invisible)
+            assert h.get_alpha() == 1.0 and h.get_sizes()[0] >= 20
+    plain = section_figures(optimal_halt_configuration(floating4, samples=300, rng=0, refine=False))[0]
+    assert "samples" in [t.get_text() for t in plain.axes[0].get_legend().get_texts()]
+
+
+def test_reachability_with_an_unlimited_joint(floating4):
+    lo, hi = np.array(floating4.lower), np.array(floating4.upper)
+    lo[0], hi[0] = -math.inf, math.inf  # joint 1 continuous
+    reach = HaltReachability(*STATE, 10.0, VMAX, AMAX, angle_lower=lo, angle_upper=hi)
+    assert reach.start_violations() == []
+    res = optimal_halt_configuration(floating4, samples=300, rng=0, reachability=reach, refine=False)
+    assert res.lower[0] >= -math.pi and res.upper[0] <= math.pi  # sampled within +-180 deg
+    assert res.reachable_samples > 0
+    with pytest.raises(ConfigurationError, match="not NaN"):
+        HaltReachability(*STATE, 10.0, VMAX, AMAX, angle_lower=np.full(6, np.nan))
+
+
+def test_halt_config_cli_uses_the_models_speed_limits(capsys):
+    state = ["--from-q-deg", "-180", "-180", "-100", "-10", "20", "20", "--halt-time", "10"]
+    base = ["halt-config", "halt7", "--lock", "4=0", "--samples", "200", "--seed", "2", "--quiet"]
+    assert main(base + state + ["--json"]) == 0
+    r = json.loads(capsys.readouterr().out)["reachability"]
+    assert r["velocity_limit_deg"] == pytest.approx([40.0] * 6)  # halt7's own limit
+    assert r["velocity_limit_source"] == ["model's limit"] * 6
+    assert main(base + state + ["--vmax-deg", "50", "30", "40", "40", "40", "40", "--json"]) == 0
+    r = json.loads(capsys.readouterr().out)["reachability"]
+    assert r["velocity_limit_deg"] == pytest.approx([40.0, 30.0, 40.0, 40.0, 40.0, 40.0])
+    assert r["velocity_limit_source"][0] == "model's limit, below --vmax-deg 50"
+    assert main(base + state + ["--amax-deg", "10"]) == 0
+    out = capsys.readouterr().out
+    assert (
+        "speed limits: 40 deg/s (model's limit)" in out
+        and "acceleration limits: 10 deg/s^2 (--amax-deg)" in out
+    )

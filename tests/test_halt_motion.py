@@ -327,3 +327,269 @@ def test_vector_solver_reports_per_joint_intervals(capsys):
     assert "feasible k per joint" in out and "feasible k: [" not in out
     for num in (1, 2, 3, 5, 6, 7):
         assert f"joint {num}: [" in out
+
+
+# -- first-time user findings: limits from the model, unlimited joints, labels, output ---------------
+
+ARM_TOML = """name = "sat4"
+convention = "dh_standard"
+
+[[joint]]
+alpha_deg = 90.0
+d_m = 0.4
+mass_kg = 10.0
+com_m = [0.0, -0.2, 0.0]
+inertia_kgm2 = [0.2, 0.2, 0.1]
+velocity_limit_deg_s = 10.0
+
+[[joint]]
+a_m = 1.5
+mass_kg = 20.0
+com_m = [-0.75, 0.0, 0.0]
+inertia_kgm2 = [0.1, 4.0, 4.0]
+velocity_limit_deg_s = 10.0
+
+[[joint]]
+a_m = 1.0
+mass_kg = 10.0
+com_m = [-0.5, 0.0, 0.0]
+inertia_kgm2 = [0.1, 1.0, 1.0]
+
+[[joint]]
+d_m = 0.3
+mass_kg = 3.0
+inertia_kgm2 = [0.02, 0.02, 0.02]
+"""
+
+
+def _halt_json(capsys, argv):
+    import json
+
+    from jointlock.cli import main
+
+    assert main(argv + ["--json", "--quiet"]) == 0
+    return json.loads(capsys.readouterr().out)
+
+
+def test_resolve_limits_rule():
+    """Speed: the option capped by the model's limit; else the model's where finite; else 000's
+    40 deg/s. Acceleration: the option, else 000's 20 deg/s^2. Each with its source."""
+    from dataclasses import replace
+
+    from jointlock.cli.halt import resolve_limits
+
+    model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
+    limits = [10.0, math.inf, 30.0, math.inf, 40.0, 40.0]
+    model = replace(
+        model, joints=tuple(replace(j, velocity_limit=v * DEG) for j, v in zip(model.joints, limits))
+    )
+    v, a, vs, as_ = resolve_limits(model, None, None)
+    np.testing.assert_allclose(np.degrees(v), [10, 40, 30, 40, 40, 40])
+    np.testing.assert_allclose(np.degrees(a), 20.0)
+    assert vs[0] == "model's limit" and vs[1].startswith("000's default") and as_[0] == "000's default"
+    v, a, vs, as_ = resolve_limits(model, [20.0], [5.0])
+    np.testing.assert_allclose(np.degrees(v), [10, 20, 20, 20, 20, 20])
+    assert vs[0] == "model's limit, below --vmax-deg 20" and vs[1] == "--vmax-deg" and as_[0] == "--amax-deg"
+    with pytest.raises(jl.ScenarioError, match="--vmax-deg needs one value or 6 values"):
+        resolve_limits(model, [1.0, 2.0], None)
+
+
+def test_halt_uses_the_models_speed_limits(tmp_path, capsys):
+    from jointlock.cli import main
+
+    arm = tmp_path / "sat4.toml"
+    arm.write_text(ARM_TOML)
+    argv = ["halt", str(arm), "--lock", "3=30", "--q0-deg", "0", "10", "20", "--dq0-deg", "2", "2", "2"]
+    argv += ["--ddq0-deg", "0", "0", "0", "--T", "6", "--samples", "300", "--n-samples", "101"]
+    data = _halt_json(capsys, argv)
+    assert data["velocity_limit_deg_s"] == pytest.approx([10.0, 10.0, 40.0])  # was 40 for all
+    assert data["velocity_limit_source"] == ["model's limit"] * 2 + ["000's default; the model gives none"]
+    assert max(data["peak_velocity_deg_s"][:2]) <= 10.0 + 1e-6
+    data = _halt_json(capsys, argv + ["--vmax-deg", "8", "30", "20"])
+    assert data["velocity_limit_deg_s"] == pytest.approx([8.0, 10.0, 20.0])  # the smaller one
+    assert data["velocity_limit_source"][1] == "model's limit, below --vmax-deg 30"
+    assert main(argv + ["--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "speed limits: joints 1, 2: 10 deg/s (model's limit); joint 4: 40 deg/s (000's default" in out
+    assert "acceleration limits: 20 deg/s^2 (000's default)" in out
+    with pytest.raises(SystemExit):
+        main(["halt", "--help"])
+    text = " ".join(capsys.readouterr().out.split())
+    assert "capped by the model's own velocity limit" in text
+
+
+def test_halt7_limits_and_result_unchanged(capsys):
+    """halt7's model limit is 000's 40 deg/s: the same halt as before the rule."""
+    data = _halt_json(capsys, ["halt", "halt7", "--paper-qf", "--n-samples", "101"])
+    assert data["velocity_limit_deg_s"] == pytest.approx([40.0] * 6)
+    assert data["acceleration_limit_deg_s2"] == pytest.approx([20.0] * 6)
+    assert data["velocity_limit_source"] == ["model's limit"] * 6
+    assert not data["feasible"] and data["paper"]["k"] == 0.0018
+
+
+def test_unlimited_joint_has_no_angle_constraint():
+    model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
+    q_min, q_max = np.array(model.lower), np.array(model.upper)
+    q_min[1], q_max[1] = -math.inf, math.inf
+    qf = np.radians([-170, -90, 40, -158, 90, -62])
+    p = HaltProblem(
+        model, Q0, DQ0, DDQ0, qf, 12.0, 40 * DEG, 20 * DEG, q_min=q_min, q_max=q_max, n_samples=101
+    )
+    per = feasible_k_intervals(p)
+    assert not np.any(np.isnan(per))
+    from jointlock.planning.halt_motion import relative_violation
+
+    assert np.all(np.isfinite(relative_violation(p, np.linspace(-1e-4, 1e-4, 5))))
+    res = optimal_halt_motion(p, n_scan=21)
+    assert all(not (v.joint == 2 and v.kind == "angle") for v in res.violations)
+    with pytest.raises(jl.ScenarioError, match="not NaN"):
+        HaltProblem(model, Q0, DQ0, DDQ0, qf, 12.0, 40 * DEG, 20 * DEG, q_min=np.full(6, np.nan))
+
+
+def test_halt_of_a_model_with_a_continuous_joint(capsys):
+    from pathlib import Path
+
+    urdf = str(Path(__file__).parent / "data" / "arm5.urdf")
+    argv = [
+        "halt",
+        urdf,
+        "--lock",
+        "2=20",
+        "--q0-deg",
+        "0",
+        "10",
+        "20",
+        "30",
+        "--dq0-deg",
+        "5",
+        "5",
+        "5",
+        "5",
+    ]
+    argv += ["--ddq0-deg", "0", "0", "0", "0", "--T", "5", "--samples", "300", "--n-samples", "101"]
+    data = _halt_json(capsys, argv)  # was: "q_min must be one finite value ... [rad]"
+    assert data["joint_numbers"] == [1, 3, 4, 5] and data["feasible"]
+    assert -180.0 <= data["q_final_deg"][1] <= 180.0  # the continuous elbow: sampled within +-180
+    data = _halt_json(capsys, argv + ["--qf-deg", "5", "200", "20", "30"])  # beyond 180: no angle limit
+    assert not [v for v in data["violations"] if v["limit"] == "angle"]
+
+
+def _figures(monkeypatch):
+    import jointlock.report as report
+
+    figs = []
+    real = report.figure_png
+
+    def keep(fig, *a, **kw):
+        figs.append(fig)
+        return real(fig, *a, **kw)
+
+    monkeypatch.setattr(report, "figure_png", keep)
+    return figs
+
+
+def _legend_texts(fig):
+    return [t.get_text() for ax in fig.axes if ax.get_legend() for t in ax.get_legend().get_texts()]
+
+
+def test_plots_label_k_by_feasibility(tmp_path, capsys, monkeypatch):
+    figs = _figures(monkeypatch)
+    argv = ["halt", "halt7", "--paper-qf", "--n-samples", "101", "--out", str(tmp_path / "a")]
+    _halt_json(capsys, argv)  # infeasible: the least-violating k, never "k*"
+    torque, profiles, history = (_legend_texts(f) for f in figs[:3])
+    assert any(t.startswith("least-violating k (infeasible) = 0.0005191 deg/s$^6$") for t in torque)
+    assert any(t.startswith("no feasible k") for t in torque)
+    assert any(t.startswith("minimum on this range") for t in torque)
+    assert "least-violating k (infeasible)" in profiles
+    assert any(t.startswith("least-violating k (infeasible) = ") and "deg/s$^6$" in t for t in history)
+    assert not any("k*" in t for t in torque + profiles + history)
+    figs.clear()
+    _halt_json(capsys, argv[:-1] + [str(tmp_path / "b"), "--T", "12"])  # feasible: band + optimum
+    torque = _legend_texts(figs[0])
+    assert any(t.startswith("feasible k: [") and t.endswith("deg/s$^6$") for t in torque)
+    assert any(t.startswith("optimal k* = ") and t.endswith("deg/s$^6$") for t in torque)
+    assert any(p.get_label().startswith("feasible k") for p in figs[0].axes[0].patches)
+
+
+def test_paper_numbers_only_for_the_paper_scenario(capsys):
+    from jointlock.cli import main
+
+    base = ["halt", "halt7", "--paper-qf", "--n-samples", "101", "--quiet"]
+    assert main(base) == 0
+    assert "000 printed: k = 0.0018" in capsys.readouterr().out
+    for extra in (["--T", "12"], ["--ddq0-deg", "8", "10", "12", "10", "-8", "0"], ["--lock", "3=0"]):
+        argv = base + extra
+        if extra[0] == "--lock":
+            argv = ["halt", "halt7", "--lock", "3=0", "--qf-deg", *["0"] * 6, "--n-samples", "101", "--quiet"]
+            argv += ["--q0-deg", *["0"] * 6, "--dq0-deg", *["0"] * 6, "--ddq0-deg", *["0"] * 6]
+        assert main(argv) == 0
+        assert "000 printed" not in capsys.readouterr().out
+        assert main(argv + ["--json"]) == 0
+        import json
+
+        assert json.loads(capsys.readouterr().out)["paper"] is None
+
+
+def test_per_joint_limits_are_all_shown(capsys):
+    from jointlock.cli import main
+
+    argv = ["halt", "halt7", "--paper-qf", "--n-samples", "101", "--quiet"]
+    assert (
+        main(
+            argv
+            + [
+                "--vmax-deg",
+                "40",
+                "30",
+                "20",
+                "30",
+                "45",
+                "40",
+                "--amax-deg",
+                "20",
+                "10",
+                "20",
+                "20",
+                "20",
+                "20",
+            ]
+        )
+        == 0
+    )
+    out = capsys.readouterr().out
+    assert (
+        "speed limits: joints 1, 7: 40 deg/s (--vmax-deg); joints 2, 5: 30 deg/s (--vmax-deg); "
+        "joint 3: 20 deg/s (--vmax-deg); joint 6: 40 deg/s (model's limit, below --vmax-deg 45)"
+    ) in out
+    assert "acceleration limits: joints 1, 3, 5, 6, 7: 20 deg/s^2 (--amax-deg); joint 2: 10 deg/s^2" in out
+    assert "limits 40 deg/s, 20 deg/s^2" not in out
+
+
+def test_least_violating_k_has_six_digits_and_a_unit():
+    from jointlock.planning.halt_motion import infeasibility_message
+
+    msg = infeasibility_message(optimal_halt_motion(_problem(theta_offsets=False, n_samples=101), n_scan=11))
+    line = next(x for x in msg.splitlines() if x.startswith("least-violating k = "))
+    value = line.split(" = ")[1].split()[0]
+    assert len(value.replace("0.", "", 1).lstrip("0").replace(".", "")) <= 6, line  # was 18 digits
+    assert line.split(" = ")[1].split()[1].rstrip(";") == "deg/s^6"
+
+
+def test_impossible_start_skips_the_search(capsys, monkeypatch):
+    import jointlock.planning.halt_config as hc
+    from jointlock.cli import main
+
+    called = []
+    monkeypatch.setattr(hc, "optimal_halt_configuration", lambda *a, **kw: called.append(1))
+    for extra in ([], ["--no-reachability"]):
+        argv = ["halt", "halt7", "--ddq0-deg", "8", "10", "30", "10", "-8", "6", "--quiet", *extra]
+        assert main(argv) == 2
+        err = capsys.readouterr().err
+        assert "joint 3 starts with acceleration 30 deg/s^2, outside its allowed range [-20, 20]" in err
+        assert "no halt configuration searched" in err and "20 deg/s^2 (000's default)" in err
+    assert called == []  # was: a failed reachable search, then a full Monte Carlo search
+    # a given halt configuration still gets the halt motion's report
+    assert (
+        main(["halt", "halt7", "--ddq0-deg", "8", "10", "30", "10", "-8", "6", "--paper-qf", "--quiet"]) == 0
+    )
+    assert "no halt time or k helps" in capsys.readouterr().out

@@ -363,3 +363,49 @@ def test_load_scenario_unreadable_files(tmp_path):
     bad.write_bytes("kp = 1.5 # \xe9\n".encode("latin-1"))
     with pytest.raises(jl.ScenarioError, match="is not UTF-8 text"):
         load_scenario(bad)
+
+
+# -- UX review: the default task on another robot, run-scenario files --------------------------------
+
+
+def test_default_task_on_another_robot_says_where_q0_comes_from():
+    with pytest.raises(jl.ScenarioError, match="default task's, NOTES-001's start for canadarm7"):
+        jl.planning.jump.jump_table(jl.load_robot("puma6"))
+
+
+def test_load_scenario_refuses_a_run_scenario_file(tmp_path):
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "jump_001.toml"
+    with pytest.raises(jl.ScenarioError) as err:
+        load_scenario(example)
+    msg = str(err.value)
+    assert "`jointlock run` scenario file" in msg and "[jump]" in msg and "unknown field" not in msg
+    f = tmp_path / "task.toml"
+    f.write_text('title = "x"\nq0_deg = [0, 0, 0, 0, 0, 0, 0]\n')
+    with pytest.raises(jl.ScenarioError, match="title"):
+        load_scenario(f)
+    f.write_text('q0_deg = [10, 40, -70, 100, -60, 30, 20]\nbase = "fixed"\n')  # a task file: fine
+    assert load_scenario(f).base == "fixed"
+
+
+def test_kappa_unit_is_in_the_figures(tmp_path, monkeypatch):
+    import matplotlib.axes
+
+    from jointlock.cli.jump import KAPPA_UNIT
+
+    labels: list[str] = []
+    for name in ("set_xlabel", "set_ylabel"):
+        real = getattr(matplotlib.axes.Axes, name)
+
+        def spy(self, text, *a, _real=real, **k):
+            labels.append(text)
+            return _real(self, text, *a, **k)
+
+        monkeypatch.setattr(matplotlib.axes.Axes, name, spy)
+    out = tmp_path / "o"
+    assert cli_main(["jump", "canadarm7", "--sweep", "4", "--quiet", "--out", str(out)]) == 0
+    assert f"kappa [{KAPPA_UNIT}]" in labels  # fig5 x, fig8 y
+    assert labels.count(f"kappa [{KAPPA_UNIT}]") >= 2
+    jump_labels = [t for t in labels if "jump" in t]
+    assert jump_labels and all("deg/s" in t for t in jump_labels)

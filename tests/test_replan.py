@@ -410,3 +410,62 @@ def test_cli_bad_lock_is_an_error(capsys):
     code = main(["tolerance-angle", "puma6", "--q-target-deg", "5", "60", "35", "10", "-120", "90"])
     assert code == 2
     assert "--lock" in capsys.readouterr().err
+
+
+# -- UX review: --steps, jump threshold, velocity legend --------------------------------------------
+
+
+def test_cli_replan_refuses_zero_steps(capsys):
+    argv = ["replan", "puma6", "--lock", "2=59.4", "--from-deg", "0", "60", "0", "0", "0", "0"]
+    argv += ["--to-deg", "5", "60", "35", "10", "-120", "90", "--steps", "0"]
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--steps must be >= 1" in err
+
+
+def test_default_jump_threshold_is_capped():
+    """A plan too coarse to follow the line (one interior point): the default threshold, 5x the
+    median step, would exceed the steps themselves; capped at 30 deg, the big steps are flagged."""
+    from jointlock.planning.replan import JUMP_MAX_STEP
+
+    full = jl.load_robot("puma6")
+    model = jl.lock(full, 2, math.radians(59.4))
+    start = jl.ee_pose(full, np.radians([0, 60, 0, 0, 0, 0]))
+    goal = jl.ee_pose(full, np.radians([5, 60, 35, 10, -120, 90]))
+    res = replan_line(model, start, goal, steps=1, cycle=0.25, q_ref=np.radians([5, 60, 35, 10, -120, 90]))
+    assert res.jump_threshold == pytest.approx(JUMP_MAX_STEP)
+    assert res.max_joint_step > JUMP_MAX_STEP and res.jumps
+    # a fine plan keeps its median-based threshold
+    fine = replan_line(model, start, goal, steps=40, cycle=0.25, q_ref=np.radians([5, 60, 35, 10, -120, 90]))
+    assert fine.jump_threshold < JUMP_MAX_STEP
+
+
+def test_cli_replan_velocity_legend(tmp_path, monkeypatch):
+    import matplotlib.axes
+
+    labels: list[str] = []
+    real = matplotlib.axes.Axes.plot
+
+    def spy(self, *args, **kwargs):
+        if "label" in kwargs:
+            labels.append(kwargs["label"])
+        return real(self, *args, **kwargs)
+
+    monkeypatch.setattr(matplotlib.axes.Axes, "plot", spy)
+    argv = ["replan", "puma6", "--lock", "2=60", "--from-deg", "0", "60", "0", "0", "0", "0"]
+    argv += [
+        "--to-deg",
+        "5",
+        "60",
+        "35",
+        "10",
+        "-120",
+        "90",
+        "--steps",
+        "4",
+        "--json",
+        "--out",
+        str(tmp_path),
+    ]
+    assert main(argv) == 0
+    assert {"vx", "vy", "vz", "wx", "wy", "wz"} <= set(labels)

@@ -8,6 +8,7 @@ import contextlib
 import io
 import json
 import os
+from html import unescape
 from pathlib import Path
 
 import pytest
@@ -125,3 +126,109 @@ def test_interrupted_write_leaves_the_old_file(tmp_path, monkeypatch):
         atomic_write_text(target, "new, half written")
     assert target.read_text() == "old"
     assert [p.name for p in tmp_path.iterdir()] == ["results.json"]
+
+
+# -- UX review ------------------------------------------------------------------------------------
+
+
+def test_overridden_failure_is_marked_in_title_summary_and_report(tmp_path):
+    out = tmp_path / "o"
+    argv = ["run", str(EXAMPLES / "replan_002.toml"), "--lock", "2=52.0547", "--jobs", "tolerance_angle"]
+    code, stdout, _ = cli(*argv, "--out", str(out))
+    assert code == 0
+    mark = "[failure overridden: joint 2 locked at 52.0547 deg]"
+    assert mark in stdout.splitlines()[0]
+    res = json.loads((out / "results.json").read_text())
+    assert res["title"].endswith(mark)
+    assert res["overrides"]["failure.angle_deg"] == {"file": 59.4, "value": pytest.approx(52.0547)}
+    html = (out / "report.html").read_text()
+    assert mark in html and "the file gives angle_deg = 59.4" in html
+    # without the override the file's title stands
+    code, stdout, _ = cli(
+        "run", str(EXAMPLES / "replan_002.toml"), "--jobs", "tolerance_angle", "--out", str(out)
+    )
+    assert "overridden" not in stdout.splitlines()[0]
+
+
+def test_halt_report_labels_limits_and_the_000_note(tmp_path):
+    out = tmp_path / "h"
+    code, _, _ = cli("run", str(EXAMPLES / "halt_000.toml"), "--out", str(out), "--quiet", *FAST["halt_000"])
+    assert code == 0
+    html = unescape((out / "report.html").read_text())
+    assert "speed limit [deg/s]" in html and "acceleration limit [deg/s^2]" in html
+    assert "vmax_deg" not in html.split(">The failure</h2>")[1].split("</h2>")[0]
+    assert "000's headline numbers are not reproduced" in html  # halt7, joint 4 at 0: 000's case
+
+
+def test_000_note_only_for_000s_scenario(tmp_path):
+    from jointlock.cli.run import _model, assumptions, is_000_case
+    from jointlock.scenario import load_scenario
+
+    for angle, expected in ((0.0, True), (10.0, False)):
+        path = tmp_path / f"s{angle:g}.toml"
+        path.write_text(f'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = {angle}\n[halt]\n')
+        sc = load_scenario(path)
+        full, _ = _model(sc)
+        assert is_000_case(sc, full) is expected
+        assert any("not reproduced" in n for n in assumptions(sc, full)) is expected
+    path = tmp_path / "puma.toml"
+    path.write_text('robot = "puma6"\n[failure]\njoint = 4\nangle_deg = 0\n[workspace]\n')
+    sc = load_scenario(path)
+    assert not is_000_case(sc, _model(sc)[0])
+
+
+def test_halt_k_label_by_feasibility():
+    from jointlock.cli.run import halt_k_label
+
+    assert halt_k_label({"k": 0.00105573, "feasible": True}) == "k* = 0.00106 deg/s^6 (feasible)"
+    label = halt_k_label({"k": [0.02], "feasible": False})
+    assert label.startswith("least-violating k = 0.02 deg/s^6") and "k*" not in label
+
+
+def test_singular_report_verdicts_and_no_failure(tmp_path):
+    from jointlock.cli.run import _condition_verdict
+
+    assert _condition_verdict("cond1f", True) == "sufficient (ours)"
+    assert _condition_verdict("cond2", True) == "reproduced"
+    assert _condition_verdict("cond1", False) == "not reproduced: not sufficient"
+    out = tmp_path / "s"
+    code, stdout, _ = cli(
+        "run", str(EXAMPLES / "singular_004.toml"), "--out", str(out), *FAST["singular_004"]
+    )
+    assert code == 0 and "cond1f sufficient (ours)" in stdout
+    html = unescape((out / "report.html").read_text())
+    assert "sufficient (ours)" in html
+    failure = html.split(">The failure</h2>")[1].split("</h2>")[0]
+    assert "no locked joint" in failure
+
+
+def test_singular_job_inherits_the_scenarios_base(tmp_path):
+    path = tmp_path / "s.toml"
+    path.write_text(
+        'robot = "canadarm7"\nbase = "floating"\n[singular]\nq_deg = [0, 10, 20, 30, 40, 50, 60]\n'
+    )
+    out = tmp_path / "o"
+    code, _, _ = cli("run", str(path), "--out", str(out), "--quiet")
+    assert code == 0
+    res = json.loads((out / "results.json").read_text())
+    assert "--base floating" in res["jobs"]["singular"]["command"]
+    assert res["jobs"]["singular"]["result"]["base"] == "floating"
+
+
+def test_workspace_summary_prints_few_digits_and_the_half_sample_estimate(tmp_path):
+    out = tmp_path / "w"
+    code, stdout, _ = cli(
+        "run",
+        str(EXAMPLES / "replan_002.toml"),
+        "--jobs",
+        "workspace",
+        "--out",
+        str(out),
+        *FAST["replan_002"],
+    )
+    assert code == 0
+    line = next(x for x in stdout.splitlines() if x.strip().startswith("workspace:"))
+    assert "half the samples" in line
+    import re
+
+    assert re.search(r"kept \d+ % ", line)  # a Monte Carlo share, to the percent

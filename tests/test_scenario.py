@@ -90,7 +90,7 @@ def test_model_file_paths_are_resolved_against_the_scenario(tmp_path):
     sub = tmp_path / "sub"
     sub.mkdir()
     (sub / "arm.urdf").write_text(data.read_text())
-    sc = load_scenario(write(sub, 'robot = "arm.urdf"\n[workspace]\nsamples = 10\n'))
+    sc = load_scenario(write(sub, 'robot = "arm.urdf"\n[workspace]\nsamples = 1000\n'))
     assert Path(sc.data["robot"]) == (sub / "arm.urdf").resolve()
 
 
@@ -106,11 +106,11 @@ def test_malformed_model_files(tmp_path, content, suffix):
 
 
 def test_overrides_win_over_the_file(tmp_path):
-    path = write(tmp_path, 'robot = "puma6"\nseed = 1\n[workspace]\nsamples = 100\n')
+    path = write(tmp_path, 'robot = "puma6"\nseed = 1\n[workspace]\nsamples = 100000\n')
     sc = load_scenario(
-        path, {"seed": 7, "workspace.samples": 20, "failure.joint": 2, "failure.angle_deg": 30.0}
+        path, {"seed": 7, "workspace.samples": 2000, "failure.joint": 2, "failure.angle_deg": 30.0}
     )
-    assert sc.data["seed"] == 7 and sc.data["workspace"]["samples"] == 20 and sc.lock == (2, 30.0)
+    assert sc.data["seed"] == 7 and sc.data["workspace"]["samples"] == 2000 and sc.lock == (2, 30.0)
     assert parse_set("halt.T=12") == ("halt.T", 12)
     assert parse_set("halt.solver=ga") == ("halt.solver", "ga")
     assert parse_set("state.q0_deg=[1, 2.5]") == ("state.q0_deg", [1, 2.5])
@@ -156,3 +156,80 @@ def test_full_arm_rates_need_a_zero_locked_entry(tmp_path):
         ScenarioError, match=r"state.q0_deg: entry 4 \(the locked joint\) must equal failure.angle_deg"
     ):
         load_scenario(bad_q)
+
+
+# -- UX review: bases, minimums, field table -------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    "top, singular, expected",
+    [
+        ('base = "floating"\n', "search = true\n", "floating"),  # inherited, as every job
+        ('base = "fixed"\n', "verify_conditions = true\n", "fixed"),
+        ('base = "floating"\n', "verify_conditions = true\n", "virtual"),  # 004's free-floating case
+        ("", "verify_conditions = true\n", None),  # no top-level base: the command's default
+        ('base = "floating"\n', 'base = "fixed"\n', "fixed"),  # the table's own base wins
+    ],
+)
+def test_singular_job_inherits_the_top_level_base(tmp_path, top, singular, expected):
+    sc = load_scenario(write(tmp_path, f'robot = "canadarm7"\n{top}[singular]\n{singular}'))
+    assert sc.data["singular"]["base"] == expected
+
+
+def test_singular_job_command_line_uses_the_inherited_base(tmp_path):
+    from jointlock.cli.run import job_argv
+
+    sc = load_scenario(write(tmp_path, 'robot = "canadarm7"\nbase = "floating"\n[singular]\nsearch = true\n'))
+    argv = job_argv("singular", sc, tmp_path / "out", {}, quiet=True)
+    assert argv[argv.index("--base") + 1] == "floating"
+
+
+@pytest.mark.parametrize(
+    "text, words",
+    [
+        ('robot = "puma6"\n[workspace]\nsamples = 1\n', ["workspace.samples", ">= 1000", "got 1"]),
+        (
+            'robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 0\n[replan]\nsteps = 0\n'
+            "from_deg = [0, 0, 0, 0, 0, 0]\nto_deg = [1, 0, 0, 0, 0, 0]\n",
+            ["replan.steps", ">= 1", "got 0"],
+        ),
+    ],
+)
+def test_degenerate_sample_and_step_counts_are_refused(tmp_path, text, words):
+    with pytest.raises(ScenarioError) as err:
+        load_scenario(write(tmp_path, text))
+    for w in words:
+        assert w in str(err.value)
+
+
+def test_workspace_minimum_matches_the_library():
+    from jointlock.analysis.workspace import MIN_SAMPLES
+    from jointlock.scenario import WORKSPACE_MIN_SAMPLES
+
+    assert WORKSPACE_MIN_SAMPLES == MIN_SAMPLES
+
+
+def test_every_field_has_a_meaning_in_the_schema_and_the_docs():
+    from jointlock.scenario import ALL_TABLES, TOP_FIELDS
+
+    for table, fields in {"": TOP_FIELDS, **ALL_TABLES}.items():
+        for name, spec in fields.items():
+            assert spec.help, f"{table}.{name}"
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "scenarios.md").read_text()
+    rows = [line for line in doc.splitlines() if line.startswith("| `")]
+    assert len(rows) > 40
+    for line in rows:
+        cells = [c.strip() for c in line.replace("\\|", "/").strip("|").split("|")]
+        assert cells[-1], line  # the "meaning" cell
+    assert "`limits.vmax_deg` is a speed **[deg/s]**" in doc
+    assert "`limits.amax_deg` an acceleration **[deg/s²]**" in doc
+
+
+def test_overrides_are_recorded_with_the_files_values(tmp_path):
+    path = write(tmp_path, 'robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 59.4\n[workspace]\n')
+    assert load_scenario(path).overrides == {} and not load_scenario(path).failure_overridden()
+    sc = load_scenario(path, {"failure.angle_deg": 52.0547, "seed": 3})
+    assert sc.overrides["failure.angle_deg"] == {"file": 59.4, "value": 52.0547}
+    assert sc.overrides["seed"] == {"file": None, "value": 3}
+    assert sc.failure_overridden()
+    assert not load_scenario(path, {"failure.angle_deg": 59.4}).failure_overridden()  # same value

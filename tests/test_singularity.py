@@ -203,3 +203,34 @@ def test_installed_cli_runs():
     ]
     proc = subprocess.run(exe, capture_output=True, text=True, check=True)
     assert json.loads(proc.stdout)["robot"] == "puma6"
+
+
+# -- UX review: arms with fewer than 6 joints, labelled search output -------------------------------
+
+
+def test_cli_single_reports_det_jtj_below_six_joints(capsys):
+    q = ["0", "0", "10", "20", "30"]
+    assert main(["singular", "puma6", "--lock", "2=30", "--q-deg", *q, "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    sv = np.asarray(out["singular_values"])
+    assert out["det_jjt"] == pytest.approx(0.0, abs=1e-12)  # identically 0 with 5 joints (kept)
+    assert out["gram_det_kind"] == "det(J^T J)" and out["gram_det"] == pytest.approx(np.prod(sv**2))
+    assert out["gram_det"] > 1e-6 and not out["singular"]
+    assert main(["singular", "puma6", "--lock", "2=30", "--q-deg", *q]) == 0
+    text = capsys.readouterr().out
+    assert "det(J^T J) = " in text and "det(J J^T) = 0 always" in text
+    assert "det(J J^T) = 0 " not in text.split("->")[0]
+    # six joints: det(J J^T), as before
+    assert main(["singular", "puma6", "--q-deg", "0", "10", "20", "30", "40", "50", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["gram_det_kind"] == "det(J J^T)" and out["gram_det"] == pytest.approx(out["det_jjt"], rel=1e-9)
+
+
+def test_cli_search_labels_joints_and_names_the_lock(capsys):
+    assert main(["singular", "puma6", "--lock", "2=30", "--search", "--samples", "16", "--quiet"]) == 0
+    text = capsys.readouterr().out
+    assert text.splitlines()[0].startswith(
+        "puma6: 5 movable joints [1, 3, 4, 5, 6], locked: joint 2 at 30 deg"
+    )
+    rep = next(line for line in text.splitlines() if "representative q [deg]" in line)
+    assert "q1=" in rep and "q3=" in rep and "q2=" not in rep

@@ -88,3 +88,52 @@ def test_cli_workspace(capsys, tmp_path):
     out = json.loads(capsys.readouterr().out)
     assert 0 < out["share_kept"] < 1
     assert (tmp_path / "projections.png").exists() and (tmp_path / "points.npz").exists()
+
+
+# -- UX review: convergence indication, fewer digits, degenerate inputs -----------------------------
+
+
+def test_half_sample_estimate_and_warnings(puma):
+    from jointlock.analysis.workspace import OUTSIDE_TOL, SHARE_HALF_TOL, _auto_voxel
+
+    cmp = compare_workspaces(puma, 2, math.radians(60.0), samples=20_000, rng=5)
+    # the half estimate is the same rule on the first half of each cloud
+    v = _auto_voxel(cmp.full[:10_000])
+    expected = voxel_keys(cmp.locked[:10_000], v).shape[0] / voxel_keys(cmp.full[:10_000], v).shape[0]
+    assert cmp.voxel_half == pytest.approx(v) and cmp.share_kept_half == pytest.approx(expected)
+    assert cmp.samples_per_voxel > 10
+    assert 0 < SHARE_HALF_TOL < 0.1 and 0 < OUTSIDE_TOL < 0.1  # "a few %"
+    # halt7 with joint 4 locked: the share moves with the sample count (83 % at 2e4 samples,
+    # 61 % at 1e6) and many locked voxels lie outside the full cloud: it must say so
+    halt7 = jl.load_robot("halt7")
+    coarse = compare_workspaces(halt7, 4, 0.0, samples=20_000, rng=0)
+    words = " ".join(coarse.warnings())
+    assert "not converged" in words and "outside the full arm's cloud" in words
+    # a given voxel: the half estimate uses the same voxel
+    fixed = compare_workspaces(puma, 2, math.radians(60.0), samples=4000, voxel=0.3, rng=5)
+    assert fixed.voxel_half == 0.3
+
+
+def test_cli_workspace_refuses_degenerate_inputs(capsys):
+    assert main(["workspace", "puma6", "--lock", "2=60", "--samples", "1"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--samples must be >= 1000" in err
+    assert main(["workspace", "puma6", "--lock", "2=60", "--samples", "2000", "--voxel", "0.001"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "--voxel 0.001 m is too small for 2000 samples" in err
+    assert "automatic for these samples" in err
+    assert main(["workspace", "puma6", "--samples", "2000", "--voxel", "0.001"]) == 2  # no lock too
+    assert "too small" in capsys.readouterr().err
+
+
+def test_cli_workspace_text_has_few_digits_and_the_half_estimate(capsys):
+    assert main(["workspace", "halt7", "--lock", "4=0", "--samples", "20000"]) == 0
+    cap = capsys.readouterr()
+    share = next(line for line in cap.out.splitlines() if "share kept" in line)
+    import re
+
+    assert re.search(r"share kept\s+: \d+ % \(from half the samples: \d+ %\); not converged", share)
+    assert "warning: share kept moves from" in cap.err
+    assert main(["workspace", "halt7", "--lock", "4=0", "--samples", "20000", "--json"]) == 0
+    out = json.loads(capsys.readouterr().out)
+    assert out["warnings"] and 0 < out["share_kept_half_samples"] < 2 and out["samples_per_voxel"] > 2

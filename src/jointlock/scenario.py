@@ -40,6 +40,7 @@ Jobs run in the order of :data:`JOB_ORDER`: those whose table is present, or tho
 from __future__ import annotations
 
 import copy
+import dataclasses
 import difflib
 import math
 import tomllib
@@ -76,6 +77,9 @@ JOB_PAPER: dict[str, str] = {
 
 #: Largest |angle| accepted in an ``*_deg`` field [deg] (one turn either way).
 MAX_ABS_DEG = 360.0
+
+#: Fewest ``workspace.samples`` (:data:`jointlock.analysis.workspace.MIN_SAMPLES`).
+WORKSPACE_MIN_SAMPLES = 1000
 
 
 @dataclass(frozen=True)
@@ -155,8 +159,8 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         "ddq0_deg": _deg("accelerations at failure", unit="deg/s^2", lo=-1e5, hi=1e5),
     },
     "limits": {
-        "vmax_deg": _pos("deg/s", "joint speed limit (halt, halt_config, jump)"),
-        "amax_deg": _pos("deg/s^2", "joint acceleration limit (halt, halt_config, jump)"),
+        "vmax_deg": _pos("deg/s", "joint speed limit [deg/s] (halt, halt_config, jump)"),
+        "amax_deg": _pos("deg/s^2", "joint acceleration limit [deg/s^2] (halt, halt_config, jump)"),
         "eps_m": _pos("m", "end-effector position-deviation threshold (jump)"),
     },
 }
@@ -167,9 +171,23 @@ _BASE2 = ("fixed", "floating")
 JOB_TABLES: dict[str, dict[str, Field]] = {
     "halt_config": {
         "samples": Field("int", 36000, lo=2, hi=5_000_000, help="Monte Carlo samples K (000: 36000)"),
-        "jacobian": Field("choice", "generalized", choices=("generalized", "fixed")),
-        "assignment": Field("choice", "equation", choices=("equation", "text")),
-        "renormalize": Field("bool", False),
+        "jacobian": Field(
+            "choice",
+            "generalized",
+            choices=("generalized", "fixed"),
+            help="Jacobian of the indices: 000's generalized J_F (free-floating; differs from fixed "
+            "only with base 'floating') or the fixed-base one",
+        ),
+        "assignment": Field(
+            "choice",
+            "equation",
+            choices=("equation", "text"),
+            help="which index gets AHP weight 1/2: the condition number (000 eq. 19) or the "
+            "manipulability (000 §5.1 text)",
+        ),
+        "renormalize": Field(
+            "bool", False, help="divide the combined weights by their sum (000 eq. 18 does not)"
+        ),
         "length": _pos("m", "characteristic length dividing the linear rows"),
         "no_refine": Field("bool", False, help="plain Monte Carlo, as 000"),
         "reachable": Field(
@@ -180,25 +198,43 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             "time are given",
         ),
         "halt_time": _pos("s", "halt time of the reachability bound (default: halt.T)"),
-        "base": Field("choice", None, choices=_BASE2, help="overrides the top-level base"),
+        "base": Field("choice", None, choices=_BASE2, help="base of this job (default: the top-level base)"),
     },
     "halt": {
         "T": _pos("s", "halt time (000: 10)"),
         "qf_deg": _deg("halt configuration (default: from halt_config, or a Monte Carlo search)"),
         "paper_qf": Field("bool", False, help="000's printed q_best (halt7 only)"),
-        "solver": Field("choice", "scan", choices=("scan", "ga", "vector")),
+        "solver": Field(
+            "choice",
+            "scan",
+            choices=("scan", "ga", "vector"),
+            help="scan: exact search of the shared k; ga: 000's adaptive GA; vector: one k per "
+            "joint (extension)",
+        ),
         "samples": Field("int", 36000, lo=2, hi=5_000_000, help="Monte Carlo samples when no halt_config"),
         "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
         "generations": Field("int", 100, lo=1, hi=100_000, help="GA generations"),
         "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
-        "base": Field("choice", None, choices=_BASE2, help="base of the disturbance torque"),
+        "base": Field(
+            "choice",
+            None,
+            choices=_BASE2,
+            help="base of the disturbance torque: 'fixed' = spacecraft held, as 000 (default: the "
+            "top-level base)",
+        ),
     },
     "jump": {
         "fail_at": Field("number", None, lo=0.0, unit="s", help="one failure time (default failure.time_s)"),
         "sweep": Field("int", None, lo=1, hi=10_000, help="sampled failure times (default 40)"),
-        "kappa": Field("number", None, help="constant kappa instead of the search"),
+        "kappa": Field("number", None, unit="rad^2/(s m^3)", help="constant kappa instead of the search"),
         "order": Field("int", 5, lo=1, hi=9, help="polynomial order of kappa(t)"),
-        "fix": Field("choice", "auto", choices=("auto", "clip", "ramp", "clip+ramp", "none")),
+        "fix": Field(
+            "choice",
+            "auto",
+            choices=("auto", "clip", "ramp", "clip+ramp", "none"),
+            help="fix of kappa(t) verified as well: clip to the feasible band, ramp (rate-limit "
+            "kappa), both, none; auto = clip+ramp only when kappa(t) breaks a limit",
+        ),
         "q0_deg": _deg("task start, every joint of the arm"),
         "dx_m": Field(
             "numbers", None, lo=-1e3, hi=1e3, length=3, unit="m", help="straight-line displacement"
@@ -210,32 +246,68 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "amax_deg_s2": _pos("deg/s^2", "joint acceleration limit (default limits.amax_deg, else 5)"),
         "eps_m": _pos("m", "position-deviation threshold (default limits.eps_m, else 0.001)"),
         "kp": Field("number", None, lo=0.0, unit="1/s", help="feedback gain"),
-        "rest_transitions": Field("bool", None),
-        "feedforward": Field("choice", None, choices=("step", "instant")),
-        "base": Field("choice", None, choices=_BASE2),
+        "rest_transitions": Field(
+            "bool", None, help="also check the start from rest and the stop at the end (default false)"
+        ),
+        "feedforward": Field(
+            "choice",
+            None,
+            choices=("step", "instant"),
+            help="feed-forward over a control step: nominal displacement / dt (step, default) or "
+            "the nominal velocity at the step's start (instant)",
+        ),
+        "base": Field("choice", None, choices=_BASE2, help="base of this job (default: the top-level base)"),
     },
     "tolerance_angle": {
         "q_target_deg": _deg("desired joints, every joint of the arm"),
-        "gamma_limit_deg": Field("number", 180.0, lo=0.0, lo_open=True, hi=180.0, unit="deg"),
-        "zoom_deg": Field("number", 2.0, lo=0.0, lo_open=True, hi=180.0, unit="deg"),
-        "step_deg": Field("number", 0.1, lo=0.0, lo_open=True, hi=180.0, unit="deg"),
+        "gamma_limit_deg": Field(
+            "number", 180.0, lo=0.0, lo_open=True, hi=180.0, unit="deg", help="sweep |gamma| <= this"
+        ),
+        "zoom_deg": Field(
+            "number",
+            2.0,
+            lo=0.0,
+            lo_open=True,
+            hi=180.0,
+            unit="deg",
+            help="half-width of the second, narrow gamma range (002 Fig. 6: 2)",
+        ),
+        "step_deg": Field("number", 0.1, lo=0.0, lo_open=True, hi=180.0, unit="deg", help="gamma sweep step"),
     },
     "replan": {
         "from_deg": _deg("start joints, every joint of the arm"),
         "to_deg": _deg("goal joints, every joint of the arm"),
-        "steps": Field("int", 40, lo=0, hi=100_000, help="interior points N of 002 eq. (19)"),
+        "steps": Field("int", 40, lo=1, hi=100_000, help="interior points N of 002 eq. (19)"),
         "cycle": _pos("s", "time between points (002: 0.25)", 0.25),
         "tolerance_deg": Field("number", 0.0, lo=0.0, hi=180.0, unit="deg", help="largest |gamma|"),
     },
     "workspace": {
-        "samples": Field("int", 200_000, lo=1, hi=20_000_000, help="configurations per arm"),
+        "samples": Field(
+            "int",
+            200_000,
+            lo=WORKSPACE_MIN_SAMPLES,
+            hi=20_000_000,
+            help="configurations per arm (fewer than 1000 say little about a volume)",
+        ),
         "voxel": _pos("m", "voxel side (default automatic)"),
     },
     "singular": {
         "verify_conditions": Field("bool", False, help="check 004's Cond1-Cond5"),
         "search": Field("bool", False, help="search for singular configurations"),
-        "base": Field("choice", None, choices=("fixed", "floating", "virtual")),
-        "weighting": Field("choice", "segment", choices=("segment", "vafa-dubowsky")),
+        "base": Field(
+            "choice",
+            None,
+            choices=("fixed", "floating", "virtual"),
+            help="Jacobian: fixed, floating (generalized) or virtual (004's virtual manipulator); "
+            "default: the top-level base if given (floating -> virtual with verify_conditions), "
+            "else virtual with verify_conditions and fixed otherwise",
+        ),
+        "weighting": Field(
+            "choice",
+            "segment",
+            choices=("segment", "vafa-dubowsky"),
+            help="virtual link lengths: 004's formula (segment) or the exact Vafa-Dubowsky one",
+        ),
         "q_deg": _deg("configuration analysed (default zeros)"),
         "tol": _pos("", "rank tolerance on singular values", 1e-8),
         "length": _pos("m", "characteristic length"),
@@ -262,12 +334,23 @@ class Scenario:
         Jobs to run, in :data:`JOB_ORDER`.
     source
         The file it came from (or a label such as ``"built-in demo scenario"``).
+    overrides
+        The command-line overrides applied to the file: ``{"table.field": {"file": value in
+        the file or None, "value": value used}}`` (empty when none).
     """
 
     data: dict[str, Any]
     jobs: tuple[str, ...]
     source: str
     base_dir: Path = field(default_factory=Path.cwd)
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+
+    def failure_overridden(self) -> bool:
+        """Whether an override changed the file's failure (joint or angle)."""
+        return any(
+            key in ("failure.joint", "failure.angle_deg") and item["file"] != item["value"]
+            for key, item in self.overrides.items()
+        )
 
     def to_dict(self) -> dict[str, Any]:
         return copy.deepcopy(self.data) | {"jobs": list(self.jobs)}
@@ -314,9 +397,16 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
         data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    applied: dict[str, Any] = {}
     if overrides:
+        for key, value in overrides.items():
+            table, _, name = key.rpartition(".")
+            holder = data.get(table, {}) if table else data
+            old = holder.get(name) if isinstance(holder, dict) else None
+            applied[key] = {"file": old, "value": value}
         data = apply_overrides(data, overrides, source=str(path))
-    return scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
+    sc = scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
+    return dataclasses.replace(sc, overrides=applied) if applied else sc
 
 
 def parse_set(text: str) -> tuple[str, Any]:
@@ -471,12 +561,26 @@ def scenario_from_dict(
     for job in jobs:
         out.setdefault(job, _table({}, job, JOB_TABLES[job], source))
     out.pop("jobs", None)
+    _inherit_singular_base(out, jobs, given_base="base" in data)
     _resolve_robot(out, source, base_dir)
     _check_semantics(out, jobs, source)
     return Scenario(data=out, jobs=jobs, source=source, base_dir=base_dir)
 
 
 # -- cross-field checks ------------------------------------------------------------------------
+
+
+def _inherit_singular_base(out: dict[str, Any], jobs: tuple[str, ...], *, given_base: bool) -> None:
+    """``singular.base`` falls back to the top-level ``base`` when the file gives one, as every
+    other job's base does (with ``verify_conditions``, a floating base is analysed on 004's
+    virtual manipulator, the free-floating arm's equivalent).  Without either, the ``singular``
+    command's own default holds (virtual with ``verify_conditions``, fixed otherwise)."""
+    if "singular" not in jobs or not given_base:
+        return
+    s = out["singular"]
+    if s["base"] is None:
+        top = out["base"]
+        s["base"] = "virtual" if top == "floating" and s["verify_conditions"] else top
 
 
 def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:

@@ -34,6 +34,18 @@ DEFAULT_CHUNK = 65536
 #: Mean full-arm samples per voxel of the bounding box when the voxel side is chosen [-].
 SAMPLES_PER_VOXEL = 16.0
 
+#: Fewest samples per arm the command line and scenario files accept: below, the voxel
+#: estimate says little (a handful of voxels, or a volume of ~0 with a tiny voxel).
+MIN_SAMPLES = 1000
+#: Fewest mean samples per occupied voxel of the full arm for a volume estimate: with fewer,
+#: nearly every sample has its own voxel and the "volume" is ``samples x voxel^3``.
+MIN_SAMPLES_PER_VOXEL = 2.0
+#: :meth:`WorkspaceComparison.warnings`: largest difference between the share kept from all
+#: the samples and from half of them [-] ...
+SHARE_HALF_TOL = 0.03
+#: ... and largest share of the locked arm's voxels outside the full cloud [-].
+OUTSIDE_TOL = 0.03
+
 
 def _frame_with_z(axis: FloatArray) -> FloatArray:
     z = axis / np.linalg.norm(axis)
@@ -183,6 +195,12 @@ class Workspace:
     volume: float
     seed: int | None
 
+    @property
+    def samples_per_voxel(self) -> float:
+        """Mean samples per occupied voxel [-] (see :data:`MIN_SAMPLES_PER_VOXEL`)."""
+        occupied = self.volume / self.voxel**3
+        return float(self.points.shape[0] / occupied) if occupied > 0 else math.nan
+
 
 def sample_workspace(
     model: ArmModel,
@@ -221,6 +239,12 @@ class WorkspaceComparison:
         The locked joint (1-based) and its angle [rad].
     seed
         The ``rng`` argument used (None when a Generator was passed).
+    share_kept_half
+        The same estimate from the first half of each cloud (same voxel rule: the given
+        ``voxel``, or the automatic side for half the samples) [-]; its distance to
+        ``share_kept`` shows how far the estimate has converged.
+    voxel_half
+        The voxel side of that estimate [m].
     """
 
     full: FloatArray
@@ -233,6 +257,41 @@ class WorkspaceComparison:
     joint: int
     angle: float
     seed: int | None
+    share_kept_half: float = math.nan
+    voxel_half: float = math.nan
+
+    @property
+    def samples_per_voxel(self) -> float:
+        """Mean full-arm samples per occupied voxel [-] (below :data:`MIN_SAMPLES_PER_VOXEL`
+        the voxel is too small for the samples)."""
+        occupied = self.volume_full / self.voxel**3
+        return float(self.full.shape[0] / occupied) if occupied > 0 else math.nan
+
+    def warnings(self) -> list[str]:
+        """Why ``share_kept`` should not be trusted to its digits (empty when it looks converged):
+        it moves by more than :data:`SHARE_HALF_TOL` between half and all the samples, more than
+        :data:`OUTSIDE_TOL` of the locked voxels lie outside the full cloud (samples missed),
+        or the voxel holds fewer than :data:`MIN_SAMPLES_PER_VOXEL` samples on average."""
+        out = []
+        if (
+            math.isfinite(self.share_kept_half)
+            and abs(self.share_kept - self.share_kept_half) > SHARE_HALF_TOL
+        ):
+            out.append(
+                f"share kept moves from {100 * self.share_kept_half:.0f} % (half the samples) to "
+                f"{100 * self.share_kept:.0f} % (all): not converged; use more samples"
+            )
+        if self.outside > OUTSIDE_TOL:
+            out.append(
+                f"{100 * self.outside:.0f} % of the locked arm's voxels lie outside the full arm's cloud "
+                f"(> {100 * OUTSIDE_TOL:.0f} %): the full cloud is under-sampled at this voxel"
+            )
+        if self.samples_per_voxel < MIN_SAMPLES_PER_VOXEL:
+            out.append(
+                f"{self.samples_per_voxel:.2g} samples per occupied voxel: the voxel "
+                f"({self.voxel:.3g} m) is too small for the samples, the volumes are meaningless"
+            )
+        return out
 
 
 def compare_workspaces(
@@ -265,6 +324,7 @@ def compare_workspaces(
     locked_model = lock(model, joint, angle)
     full = ee_positions(model, sample_configurations(model, samples, gen))
     locked = ee_positions(locked_model, sample_configurations(locked_model, locked_samples or samples, gen))
+    auto = voxel is None
     if voxel is None:
         voxel = _auto_voxel(full)
     keys_full = voxel_keys(full, voxel)
@@ -272,6 +332,12 @@ def compare_workspaces(
     inside = _rows_in(keys_locked, keys_full)
     vol_full = keys_full.shape[0] * voxel**3
     vol_locked = keys_locked.shape[0] * voxel**3
+    # the same estimate from half of each cloud: how far it has converged
+    share_half, voxel_half = math.nan, math.nan
+    nf, nl = full.shape[0] // 2, locked.shape[0] // 2
+    if nf >= 1 and nl >= 1:
+        voxel_half = _auto_voxel(full[:nf]) if auto else float(voxel)
+        share_half = voxel_keys(locked[:nl], voxel_half).shape[0] / voxel_keys(full[:nf], voxel_half).shape[0]
     return WorkspaceComparison(
         full,
         locked,
@@ -283,6 +349,8 @@ def compare_workspaces(
         int(joint),
         float(angle),
         rng if isinstance(rng, (int, np.integer)) else None,
+        float(share_half),
+        float(voxel_half),
     )
 
 

@@ -10,8 +10,10 @@ import argparse
 import importlib
 import importlib.util
 import logging
+import os
 import sys
 from collections.abc import Sequence
+from typing import NoReturn
 
 from .. import __version__
 from ..errors import JointlockError
@@ -35,19 +37,38 @@ COMMAND_MODULES: tuple[str, ...] = (
 )
 
 
+#: Help of ``--debug`` (accepted before and after the subcommand).
+DEBUG_HELP = "show tracebacks and debug logs"
+
+
+class Parser(argparse.ArgumentParser):
+    """:class:`argparse.ArgumentParser` whose usage errors are one line pointing to ``--help``
+    (instead of the whole usage).  Subparsers made by ``add_subparsers`` are of this class too."""
+
+    def error(self, message: str) -> NoReturn:
+        self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(
+    parser = Parser(
         prog="jointlock",
         description="Space manipulators after a locked-joint failure: halt, compensate, re-plan, analyse.",
     )
     parser.add_argument("--version", action="version", version=f"jointlock {__version__}")
-    parser.add_argument("--debug", action="store_true", help="show tracebacks and debug logs")
+    parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
     for name in COMMAND_MODULES:
         if importlib.util.find_spec(f"{__name__}.{name}") is None:
             continue
         importlib.import_module(f"{__name__}.{name}").register(sub)
+    for command_parser in sub.choices.values():
+        # --debug after the subcommand too; SUPPRESS keeps the top-level value when absent
+        if not any("--debug" in a.option_strings for a in command_parser._actions):
+            command_parser.add_argument(
+                "--debug", action="store_true", default=argparse.SUPPRESS, help=DEBUG_HELP
+            )
+    parser.set_defaults(_commands=sub.choices)
     return parser
 
 
@@ -66,17 +87,25 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (0 ok, 2 usage or input error, including a
     file or folder that cannot be read or written; tracebacks only with ``--debug``)."""
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args, extra = parser.parse_known_args(argv)
+    commands = vars(args).pop("_commands", {})
+    if extra:  # named by the subcommand, so that the hint points to its --help
+        commands.get(args.command, parser).error(f"unrecognized arguments: {' '.join(extra)}")
     logging.basicConfig(
         level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s"
     )
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's final flush
+        return code
     except JointlockError as exc:
         if args.debug:
             raise
         print(f"jointlock {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # e.g. `jointlock ... | head`: the reader left; exit quietly
+        _silence_stdout()
+        return 141 if os.name == "posix" else 1
     except OSError as exc:  # a file or folder that cannot be read or written (e.g. --out)
         if args.debug:
             raise
@@ -85,6 +114,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("jointlock: interrupted", file=sys.stderr)
         return 130
+
+
+def _silence_stdout() -> None:
+    """Point stdout at /dev/null so that the interpreter's final flush of a closed pipe does
+    not print another error."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())
+    except (OSError, ValueError, AttributeError):  # stdout replaced (tests) or already closed
+        pass
 
 
 if __name__ == "__main__":  # pragma: no cover

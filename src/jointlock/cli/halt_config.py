@@ -22,6 +22,7 @@ from ..planning.halt_config import (
 from ..progress import Progress
 from ..report import atomic_write_bytes, atomic_write_json
 from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
+from .halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, LIMITS_HELP, limits_text, resolve_limits
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
 PROGRESS_MIN_SAMPLES = 20000
@@ -85,10 +86,19 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     reach.add_argument("--halt-time", type=float, metavar="S", help="halt time T [s]")
     reach.add_argument(
-        "--vmax-deg", type=float, default=40.0, help="speed limit [deg/s] (default 40, as 000)"
+        "--vmax-deg",
+        type=float,
+        nargs="+",
+        metavar="DEG",
+        help="speed limit(s) [deg/s], one or one per healthy joint, capped by the model's own limit "
+        f"(default: the model's, else {DEFAULT_VMAX_DEG:g} as 000). " + LIMITS_HELP,
     )
     reach.add_argument(
-        "--amax-deg", type=float, default=20.0, help="acceleration limit [deg/s^2] (default 20)"
+        "--amax-deg",
+        type=float,
+        nargs="+",
+        metavar="DEG",
+        help=f"acceleration limit(s) [deg/s^2] (default {DEFAULT_AMAX_DEG:g}, as 000)",
     )
     reach.add_argument(
         "--reachability",
@@ -124,19 +134,15 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltRe
         if args.from_dq_deg
         else np.zeros(model.dof)
     )
-    for name, value in (
-        ("--halt-time", args.halt_time),
-        ("--vmax-deg", args.vmax_deg),
-        ("--amax-deg", args.amax_deg),
-    ):
-        if not (math.isfinite(value) and value > 0):
-            raise ScenarioError(f"{name} must be a finite number > 0; got {value}")
+    if not (math.isfinite(args.halt_time) and args.halt_time > 0):
+        raise ScenarioError(f"--halt-time must be a finite number > 0 [s]; got {args.halt_time}")
     ddq0 = (
         joint_vector_deg(model, args.from_ddq_deg, "--from-ddq-deg", rates=True)
         if getattr(args, "from_ddq_deg", None)
         else np.zeros(model.dof)
     )
-    vmax, amax = math.radians(args.vmax_deg), math.radians(args.amax_deg)
+    vmax, amax, v_src, a_src = resolve_limits(model, args.vmax_deg, args.amax_deg)
+    args.limit_sources = (v_src, a_src)  # for the text and JSON output
     if getattr(args, "reachability", "exact") == "bound":
         return ReachabilityBound(q0, dq0, args.halt_time, vmax, amax, ddq0)
     return HaltReachability(
@@ -200,6 +206,10 @@ def run(args: argparse.Namespace) -> int:
             progress=bar,
         )
     data = {"robot": model.name, **result.to_dict()}
+    if reach is not None and data.get("reachability") is not None:
+        v_src, a_src = args.limit_sources
+        data["reachability"]["velocity_limit_source"] = v_src
+        data["reachability"]["acceleration_limit_source"] = a_src
     files = []
     if args.out:
         out = Path(args.out)
@@ -212,7 +222,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(data)
         return 0
-    _print_text(model, result, reach)
+    _print_text(model, result, reach, getattr(args, "limit_sources", None))
     if files:
         print(f"\nwrote {len(files)} files to {args.out}: " + ", ".join(f.name for f in files))
     return 0
@@ -222,7 +232,7 @@ def _fmt_q(q: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:8.3f}" for v in np.degrees(q)) + "]"
 
 
-def _print_text(model, result, reach) -> None:
+def _print_text(model, result, reach, sources=None) -> None:
     locked = ", ".join(f"joint {k} at {math.degrees(v):g} deg" for k, v in result.locked.items())
     print(
         f"{model.name}: healthy joints {list(result.joint_numbers)}, locked: {locked}, base: {result.base}, "
@@ -243,6 +253,10 @@ def _print_text(model, result, reach) -> None:
         )
     elif reach is not None:
         print(f"reachability: bang-bang bound, box {_fmt_q(result.lower)} .. {_fmt_q(result.upper)} deg")
+    if reach is not None and sources is not None:
+        nums = result.joint_numbers
+        print(f"  speed limits: {limits_text(nums, reach.velocity_limit, sources[0], 'deg/s')}")
+        print(f"  acceleration limits: {limits_text(nums, reach.acceleration_limit, sources[1], 'deg/s^2')}")
     print(f"\n{'':<14}{'q [deg]':<62}{'CP':>9}{'sigma_min':>11}{'kappa':>11}{'w':>11}")
     rows = [("best", result.best), ("best sample", result.best_sample), ("runner-up", result.runner_up)]
     for label, c in rows:

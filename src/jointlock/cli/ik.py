@@ -41,7 +41,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="position [m] and ZYX Euler angles [deg] (R = Rz(yaw) Ry(pitch) Rx(roll), as 002 prints)",
     )
     target.add_argument("--matrix", type=float, nargs=16, metavar="M", help="4x4 pose, row-major [m]")
-    p.add_argument("--method", choices=("auto", "closed-form", "numeric"), default="auto")
+    p.add_argument(
+        "--method",
+        choices=("auto", "closed-form", "numeric"),
+        default="auto",
+        help="closed-form: 002's analytic IK, every branch (puma6-family arms only: 6 joints with "
+        "002 Table 1's structure, at most one locked); numeric: Levenberg-Marquardt from several "
+        "random starts (any arm; --seed); auto (default): closed-form when the arm is of the puma6 "
+        "family, numeric otherwise",
+    )
     p.add_argument(
         "--length-scale", type=float, default=1.0, metavar="M", help="L [m] of the nearest-pose metric (> 0)"
     )

@@ -40,6 +40,14 @@ from ._common import add_robot_arguments, check_out_dir, print_json, require_fin
 #: Largest polynomial order of kappa(t) (the scenario schema's ``jump.order`` cap).
 MAX_ORDER = 9
 
+#: Unit of kappa: qdot [rad/s] = kappa * grad w, w = sqrt(det(J J^T)) of the 3 x n position
+#: Jacobian [m^3], grad w [m^3/rad] (docs/jump.md).
+KAPPA_UNIT = "rad^2/(s m^3)"
+
+#: A start of the example task shown when a robot needs its own q0_deg (NOTES-001's start,
+#: cut or padded with zeros to the robot's joints).
+_EXAMPLE_Q0 = (10.0, 40.0, -70.0, 100.0, -60.0, 30.0, 20.0)
+
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
@@ -48,7 +56,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         description=(
             "Resolved-rate path following with the null-space compensation kappa (I - J+J) grad w "
             "(seed 001, NOTES-001). Default: NOTES-001's scenario, joint 2 locking, --sweep 40. "
-            "Jumps are 2-norms of joint-rate changes [rad/s]."
+            "Jumps are 2-norms of joint-rate changes, printed and plotted in deg/s (rad/s in the JSON "
+            f"output, as its key names say); kappa is in {KAPPA_UNIT}. The task (start q0_deg, line "
+            "dx_m, ...) is NOTES-001's for canadarm7; any other robot needs a task file: --scenario "
+            "FILE with q0_deg (one angle per joint) -- a flat TOML table, the fields of a run "
+            "scenario's [jump] table (docs/jump.md)."
         ),
     )
     add_robot_arguments(
@@ -58,13 +70,23 @@ def register(sub: argparse._SubParsersAction) -> None:
         base_help="fixed base, or free-floating spacecraft (generalized Jacobian); "
         "default: the scenario file's base, else fixed",
     )
-    p.add_argument("--scenario", metavar="FILE", help="scenario TOML (q0_deg, dx_m, duration_s, ...)")
+    p.add_argument(
+        "--scenario",
+        metavar="FILE",
+        help="task file, a flat TOML table: q0_deg (one angle per joint [deg]), dx_m, duration_s, ... "
+        "(needed for any robot but canadarm7; a `jointlock run` scenario file is run with `jointlock run`)",
+    )
     p.add_argument("--lock-joint", type=int, metavar="J", help="joint that locks (from 1; default 2)")
     when = p.add_mutually_exclusive_group()
     when.add_argument("--fail-at", type=float, metavar="S", help="one failure time [s]")
     when.add_argument("--sweep", type=int, metavar="N", help="N sampled failure times (default 40)")
     how = p.add_mutually_exclusive_group()
-    how.add_argument("--kappa", type=float, metavar="K", help="use this constant kappa (no search)")
+    how.add_argument(
+        "--kappa",
+        type=float,
+        metavar="K",
+        help=f"use this constant kappa [{KAPPA_UNIT}] (no search)",
+    )
     how.add_argument(
         "--optimize",
         action="store_true",
@@ -104,6 +126,42 @@ def _scenario(args: argparse.Namespace) -> JumpScenario:
     from ..planning.jump import scenario_from_mapping
 
     return scenario_from_mapping(fields, source="command line")
+
+
+def _check_q0(args: argparse.Namespace, sc: JumpScenario, model: Any) -> None:
+    """A start that does not fit the robot: say where it came from and what to give."""
+    if len(sc.q0) == model.dof:
+        return
+    n = model.dof
+    example_q0 = ", ".join(f"{v:g}" for v in (list(_EXAMPLE_Q0) + [0.0] * n)[:n])
+    example = (
+        f"e.g. a file task.toml with the lines `q0_deg = [{example_q0}]` and `dx_m = [0.2, -0.2, 0.1]`, "
+        f"then `jointlock jump {args.robot} --scenario task.toml`"
+    )
+    joints = f"model {model.name!r} has {n} movable joints {list(model.joint_numbers)}"
+    if args.scenario is None:
+        raise ScenarioError(
+            f"the default task is NOTES-001's for canadarm7 (q0_deg: 7 angles); {joints}: a robot other "
+            f"than canadarm7 needs --scenario FILE with q0_deg ({n} values [deg]); {example}"
+        )
+    given = "q0_deg" in _file_fields(args.scenario)
+    if not given:
+        raise ScenarioError(
+            f"{args.scenario} gives no q0_deg, and the default start is canadarm7's 7 angles; {joints}: "
+            f"add q0_deg ({n} values [deg]); {example}"
+        )
+    raise ScenarioError(
+        f"{args.scenario}: q0_deg has {len(sc.q0)} angles but {joints}; give {n} values [deg]"
+    )
+
+
+def _file_fields(path: str) -> set[str]:
+    import tomllib
+
+    try:
+        return set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
+    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):  # read before, by load_scenario
+        return set()
 
 
 def _limits(rep: Any) -> dict:
@@ -180,6 +238,7 @@ def run(args: argparse.Namespace) -> int:
     out_dir = check_out_dir(args.out)
     sc = _scenario(args)
     model = load_robot(args.robot, base=sc.base)
+    _check_q0(args, sc, model)
     _warn_ignored(args)
     order = 5 if args.order is None else args.order
     show = not args.quiet
@@ -218,7 +277,7 @@ def run(args: argparse.Namespace) -> int:
     if args.json:
         print_json(result)
         return 0
-    _print_text(result)
+    _print_text(result, kappa_given=args.kappa is not None)
     if out_dir is not None:
         print(f"\nwrote {out_dir}/results.json and figures")
     return 0
@@ -232,6 +291,7 @@ def _single_json(robot: str, sc: JumpScenario, r: JumpAtTime) -> dict:
         "lock_joint": sc.lock_joint,
         "fail_time_s": r.fail_time,
         "kappa": r.kappa,
+        "kappa_unit": KAPPA_UNIT,
         "kappa_interval": r.interval,
         "jump_before": r.jump_before,
         "jump_after": r.jump_after,
@@ -260,6 +320,7 @@ def _study_json(robot: str, sc: JumpScenario, st: JumpStudy) -> dict:
         "lock_joint": sc.lock_joint,
         "fail_times_s": s.fail_times,
         "kappa": s.kappa_opt,
+        "kappa_unit": KAPPA_UNIT,
         "kappa_interval": s.interval,
         "objective_opt": s.objective_opt,
         "objective_zero": s.objective_zero,
@@ -304,18 +365,48 @@ def _constant_json(robot: str, sc: JumpScenario, kappa: float, v: Verification) 
         "scenario": sc.to_fields(),
         "lock_joint": sc.lock_joint,
         "kappa": kappa,
+        "kappa_unit": KAPPA_UNIT,
         **_ver_series_json(v),
     }
 
 
 def _less(reduction: float | None) -> str:
-    """``"12.3 % less"``, or ``"reduction n/a"`` when it is undefined (no jump before)."""
+    """``"12.3 % less"``; ``"34x larger"`` (or ``"5.0 % larger"``) when the compensation makes
+    the jump larger; ``"reduction n/a"`` when it is undefined (no jump before)."""
     if reduction is None or not math.isfinite(reduction):
         return "reduction n/a: no jump without compensation"
-    return f"{100 * reduction:.1f} % less"
+    if reduction >= 0:
+        return f"{100 * reduction:.1f} % less"
+    ratio = 1.0 - reduction  # after / before
+    return f"{ratio:.3g}x larger" if ratio >= 2 else f"{-100 * reduction:.1f} % larger"
 
 
-def _print_text(r: dict) -> None:
+def _deg(rad_s: float) -> float:
+    return math.degrees(rad_s)
+
+
+def _kappa(value: float) -> str:
+    return f"{value:.6g} {KAPPA_UNIT}"
+
+
+def _interval_text(r: dict, given: bool) -> str:
+    lo, hi = (np.nan, np.nan) if r["kappa_interval"] is None else r["kappa_interval"]
+    lo = np.nan if lo is None else lo
+    hi = np.nan if hi is None else hi
+    if np.isfinite(lo) and np.isfinite(hi):
+        return f"feasible [{lo:.4g}, {hi:.4g}]"
+    return "given, feasible interval not searched" if given else "no feasible kappa"
+
+
+def _points_text(points: list) -> str:
+    """001's segment points [s]; NaN (kappa falls back to 0 over the whole task) -> none."""
+    vals = [np.nan if p is None else float(p) for p in points]
+    if not any(np.isfinite(vals)):
+        return "none (kappa = 0 everywhere)"
+    return ", ".join(f"{v:.3g} s" if np.isfinite(v) else "none" for v in vals)
+
+
+def _print_text(r: dict, *, kappa_given: bool = False) -> None:
     sc = r["scenario"]
     print(
         f"{r['robot']}: joint {r['lock_joint']} locks; task {sc['duration_s']:g} s, dt {sc['dt_s']:g} s, "
@@ -323,15 +414,17 @@ def _print_text(r: dict) -> None:
         f"base {sc['base']}"
     )
     if r["mode"] == "fail_at":
-        lo, hi = r["kappa_interval"]
-        print(f"failure at {r['fail_time_s']:g} s, kappa = {r['kappa']:.6g} (feasible [{lo:.4g}, {hi:.4g}])")
         print(
-            f"joint jump ||dq||: {r['jump_before']:.5g} -> {r['jump_after']:.5g} rad/s "
+            f"failure at {r['fail_time_s']:g} s, kappa = {_kappa(r['kappa'])} "
+            f"({_interval_text(r, kappa_given)})"
+        )
+        print(
+            f"joint jump ||dq||: {_deg(r['jump_before']):.5g} -> {_deg(r['jump_after']):.5g} deg/s "
             f"({_less(r['mean_reduction'])})"
         )
         print(
-            f"without re-planning: locked joint stops from {r['joint_jump_noreplan_before']:.5g} / "
-            f"{r['joint_jump_noreplan_after']:.5g} rad/s; task jump {r['task_jump_noreplan_before_m_s']:.4g} / "
+            f"without re-planning: locked joint stops from {_deg(r['joint_jump_noreplan_before']):.5g} / "
+            f"{_deg(r['joint_jump_noreplan_after']):.5g} deg/s; task jump {r['task_jump_noreplan_before_m_s']:.4g} / "
             f"{r['task_jump_noreplan_after_m_s']:.4g} m/s (re-planned: {r['task_jump_replan_after_m_s']:.2g} m/s)"
         )
         la = r["limits_after"]
@@ -342,15 +435,18 @@ def _print_text(r: dict) -> None:
         return
     if "kappa_fit" in r:
         f = r["kappa_fit"]
-        t1, t2 = f["segment_points_s"]
-        k = np.asarray(r["kappa"], dtype=float)
-        print(
-            f"optimal kappa at {len(k)} failure times: {np.nanmin(k):.4g} .. {np.nanmax(k):.4g} "
-            f"({int(np.sum(np.isfinite(k)))} feasible)"
-        )
+        k = np.asarray([np.nan if v is None else v for v in r["kappa"]], dtype=float)
+        feasible = int(np.sum(np.isfinite(k)))
+        if feasible:
+            print(
+                f"optimal kappa at {len(k)} failure times: {np.nanmin(k):.4g} .. {np.nanmax(k):.4g} "
+                f"{KAPPA_UNIT} ({feasible} feasible)"
+            )
+        else:
+            print(f"no feasible kappa at any of the {len(k)} failure times")
         print(
             f"kappa(t): order {f['order']}, SSR {f['ssr']:.3g} (threshold {f['threshold']:.3g}, "
-            f"accepted {f['accepted']}), segment points {t1:.3g} s, {t2:.3g} s"
+            f"accepted {f['accepted']}), segment points {_points_text(f['segment_points_s'])}"
         )
         if len(f.get("breaks_s", [])):
             print(
@@ -363,15 +459,17 @@ def _print_text(r: dict) -> None:
                 f"  piece {pc['start_s']:.3g}..{pc['end_s']:.3g} s: order {pc['order']}, {pc['n_samples']} samples, "
                 f"SSR {pc['ssr']:.3g} (threshold {pc['threshold']:.3g}), {pc['source']}"
             )
+    elif r["kappa"] is not None and np.ndim(r["kappa"]) == 0:
+        print(f"constant kappa = {_kappa(r['kappa'])}")
     for key in ("verification", "verification_fixed"):
         if key not in r:
             continue
         v = r[key]
         label = "kappa(t)" if v["fix"] is None else f"kappa(t) with fix {v['fix']}"
         print(
-            f"{label}, failure at every step: mean jump {v['mean_jump_before']:.5g} -> {v['mean_jump_after']:.5g} "
-            f"rad/s ({_less(v['mean_reduction'])}), improved at {100 * v['share_improved']:.1f} % of steps, "
-            f"limits kept: {v['limits_ok']}"
+            f"{label}, failure at every step: mean jump {_deg(v['mean_jump_before']):.5g} -> "
+            f"{_deg(v['mean_jump_after']):.5g} deg/s ({_less(v['mean_reduction'])}), improved at "
+            f"{100 * v['share_improved']:.1f} % of steps, limits kept: {v['limits_ok']}"
         )
         if not v["limits_ok"]:
             times = v["broken_failure_times_s"]
@@ -405,14 +503,14 @@ def _save(out_dir: Path, name: str, fig: Any) -> None:
 def _fig_objective(out_dir: Path, search: Any, f: int, title: str) -> None:
     plt = _plt()
     fig, ax = plt.subplots(figsize=(6, 3.6))
-    g, obj, feas = search.kappa_grid, search.objective[:, f], search.feasible[:, f]
+    g, obj, feas = search.kappa_grid, np.degrees(search.objective[:, f]), search.feasible[:, f]
     ax.plot(g, obj, "-", color="0.6")
     ax.plot(g[feas], obj[feas], "o", label="feasible")
     ax.plot(g[~feas], obj[~feas], "x", color="r", label="breaks a limit")
     if np.isfinite(search.kappa_opt[f]):
-        ax.plot(search.kappa_opt[f], search.objective_opt[f], "*", ms=12, label="optimum")
-    ax.set_xlabel("kappa")
-    ax.set_ylabel("||dq jump|| [rad/s]")
+        ax.plot(search.kappa_opt[f], np.degrees(search.objective_opt[f]), "*", ms=12, label="optimum")
+    ax.set_xlabel(f"kappa [{KAPPA_UNIT}]")
+    ax.set_ylabel("||dq jump|| [deg/s]")
     ax.set_title(title)
     ax.legend()
     _save(out_dir, "fig5_objective_vs_kappa.png", fig)
@@ -480,22 +578,22 @@ def _sweep_files(
         for tb in f.breaks:
             ax.axvline(tb, color="r", lw=0.6, ls="--")
         ax.set_xlabel("failure time [s]")
-        ax.set_ylabel("kappa")
+        ax.set_ylabel(f"kappa [{KAPPA_UNIT}]")
         ax.legend()
         _save(out_dir, "fig8_kappa_fit.png", fig)
     k_mid = ver.kappa
     _fig_runs(out_dir, model, sc, k_mid, float(np.round(mid_t / sc.dt) * sc.dt))
     fig, ax = plt.subplots(figsize=(7, 3.6))
-    ax.plot(ver.t, ver.jump_before, label="kappa = 0")
-    ax.plot(ver.t, ver.jump_after, label="kappa(t)")
+    ax.plot(ver.t, np.degrees(ver.jump_before), label="kappa = 0")
+    ax.plot(ver.t, np.degrees(ver.jump_after), label="kappa(t)")
     if st is not None and st.verification_fixed is not None:
         ax.plot(
             st.verification_fixed.t,
-            st.verification_fixed.jump_after,
+            np.degrees(st.verification_fixed.jump_after),
             ":",
             label=f"kappa(t), {st.verification_fixed.fix}",
         )
     ax.set_xlabel("failure time [s]")
-    ax.set_ylabel("||dq jump|| [rad/s]")
+    ax.set_ylabel("||dq jump|| [deg/s]")
     ax.legend()
     _save(out_dir, "fig9_jump_vs_failure_time.png", fig)

@@ -20,8 +20,11 @@ from ._common import add_robot_arguments, check_out_dir, print_json, require_fin
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "replan",
-        help="straight-line Cartesian plan through the locked-arm IK, with the tolerance angle gamma",
+        help="straight-line Cartesian plan through the locked-arm IK, with the tolerance angle gamma "
+        "(puma6-family arms only)",
         description=(
+            "Works on puma6-family arms only (6 joints with 002 Table 1's structure, any a2, d4, d6: "
+            "002's closed-form IK). "
             "Start and goal are the poses of the full-arm joint vectors --from-deg and --to-deg; the "
             "line (002 eqs. 19-20) is followed by the arm with --lock, each waypoint rotated about the "
             "tool x axis by some |gamma| <= --tolerance-deg.  --method continuous (default) chooses "
@@ -33,10 +36,22 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_arguments(p)
     p.add_argument(
-        "--from-deg", type=float, nargs="+", required=True, metavar="DEG", help="start joints (all)"
+        "--from-deg",
+        type=float,
+        nargs="+",
+        required=True,
+        metavar="DEG",
+        help="start configuration, every joint of the arm [deg]",
     )
-    p.add_argument("--to-deg", type=float, nargs="+", required=True, metavar="DEG", help="goal joints (all)")
-    p.add_argument("--steps", type=int, default=40, help="interior points N of eq. (19) (default 40)")
+    p.add_argument(
+        "--to-deg",
+        type=float,
+        nargs="+",
+        required=True,
+        metavar="DEG",
+        help="goal configuration, every joint of the arm [deg]",
+    )
+    p.add_argument("--steps", type=int, default=40, help="interior points N of eq. (19), >= 1 (default 40)")
     p.add_argument("--cycle", type=float, default=0.25, help="time between points [s] (002: 0.25)")
     p.add_argument(
         "--tolerance-deg", type=float, default=0.0, help="largest |gamma| accepted [deg] (default 0)"
@@ -59,7 +74,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=float,
         default=None,
         metavar="DEG",
-        help="flag joint steps above this [deg] (default: 5x the median step, at least 2 deg)",
+        help="flag joint steps above this [deg] (default: 5x the median step, between 2 and 30 deg)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", type=Path, metavar="DIR", help="write plots, trajectory.csv and plan.json here")
@@ -74,8 +89,10 @@ def run(args: argparse.Namespace) -> int:
     for opt, vals in (("--from-deg", args.from_deg), ("--to-deg", args.to_deg)):
         if len(vals) != full.dof or not np.all(np.isfinite(vals)):
             raise ScenarioError(f"{opt} needs {full.dof} finite values (all joints) [deg]; got {vals}")
-    if args.steps < 0:
-        raise ScenarioError(f"--steps must be >= 0; got {args.steps}")
+    if args.steps < 1:
+        raise ScenarioError(
+            f"--steps must be >= 1 (interior points between start and goal); got {args.steps}"
+        )
     if not (args.cycle > 0):
         raise ScenarioError(f"--cycle must be > 0 [s]; got {args.cycle}")
     if not (0 <= args.tolerance_deg <= 180):
@@ -240,7 +257,7 @@ def _write(out_dir: Path, res, summary, trajectory) -> list[str]:
 
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4))
     for k in range(3):
-        a1.plot(t, res.ee_velocity[:, k] * 1e3, label="vxyz"[k] if k else "vx")
+        a1.plot(t, res.ee_velocity[:, k] * 1e3, label=f"v{'xyz'[k]}")
         a2.plot(t, np.degrees(res.ee_velocity[:, 3 + k]), label=f"w{'xyz'[k]}")
     a1.set_ylabel("linear velocity [mm/s]")
     a2.set_ylabel("angular velocity [deg/s]")

@@ -267,7 +267,7 @@ def job_argv(job: str, scenario: Scenario, out: Path, previous: dict[str, dict],
         argv += ["--seed", str(seed), "--json", "--out", job_out]
     elif job == "singular":
         argv += job_lock_args(scenario)
-        argv += ["--base", t["base"]] if t["base"] else []
+        argv += ["--base", t["base"]] if t["base"] else []  # inherited from the top level when given
         argv += ["--weighting", t["weighting"], "--tol", _num(t["tol"]), "--seed", str(seed)]
         argv += ["--q-deg", *_nums(t["q_deg"])] if t["q_deg"] is not None else []
         argv += ["--length", _num(t["length"])] if t["length"] is not None else []
@@ -320,14 +320,31 @@ def run_jobs(scenario: Scenario, out: str | Path, *, quiet: bool = False) -> dic
             "result": result,
         }
     return {
-        "title": scenario.data.get("title") or Path(scenario.source).stem,
+        "title": run_title(scenario),
         "scenario_file": scenario.source,
+        "overrides": dict(scenario.overrides),
         "scenario": scenario.to_dict(),
         "seed": scenario.data["seed"],
         "versions": versions(),
         "jobs": jobs,
         "summary": summarize(jobs),
     }
+
+
+def run_title(scenario: Scenario) -> str:
+    """The file's title (else its name); when a command-line override changed the failure, the
+    file's title no longer describes the run: it is marked, with the failure actually run."""
+    title = scenario.data.get("title") or Path(scenario.source).stem
+    if not scenario.failure_overridden():
+        return title
+    lk = scenario.lock
+    fail = scenario.data["failure"]
+    what = (
+        f"joint {lk[0]} locked at {lk[1]:g} deg"
+        if lk is not None
+        else (f"joint {fail['joint']} locks" if fail["joint"] is not None else "no locked joint")
+    )
+    return f"{title} [failure overridden: {what}]"
 
 
 def write_results(
@@ -422,7 +439,16 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
         }
     if "workspace" in jobs:
         r = jobs["workspace"]["result"]
-        s["workspace"] = {k: r.get(k) for k in ("volume_full_m3", "volume_locked_m3", "share_kept")}
+        s["workspace"] = {
+            k: r.get(k)
+            for k in (
+                "volume_full_m3",
+                "volume_locked_m3",
+                "share_kept",
+                "share_kept_half_samples",
+                "warnings",
+            )
+        }
     if "singular" in jobs:
         r = jobs["singular"]["result"]
         if "conditions" in r and isinstance(r["conditions"], dict) and "cond1" in r["conditions"]:
@@ -443,6 +469,42 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
 
 def _pct(x: Any) -> str:
     return "n/a" if x is None else f"{100 * float(x):.1f} %"
+
+
+def _pct0(x: Any) -> str:
+    """A Monte Carlo share, to the percent (its further digits move with the sample count)."""
+    return "n/a" if x is None else f"{100 * float(x):.0f} %"
+
+
+#: Row labels of the report's limits table (``[limits]`` field -> words and unit).
+LIMIT_LABELS = {
+    "vmax_deg": "speed limit [deg/s]",
+    "amax_deg": "acceleration limit [deg/s^2]",
+    "eps_m": "position-deviation threshold [m]",
+}
+
+
+def _condition_verdict(name: str, sufficient: bool) -> str:
+    """Verdict of one singularity condition: 004's Cond1-Cond5 are reproduced or not;
+    ``cond1f`` is jointlock's own condition, so it is only sufficient or not."""
+    if name == "cond1f":
+        return "sufficient (ours)" if sufficient else "not sufficient (ours)"
+    return "reproduced" if sufficient else "not reproduced: not sufficient"
+
+
+def halt_k_label(r: dict[str, Any]) -> str:
+    """Legend of the halt's chosen k, by feasibility: ``k*`` only when it keeps every limit."""
+    k_text = f"{float(np.ravel(r['k'])[0]):.3g} deg/s^6"
+    if r["feasible"]:
+        return f"k* = {k_text} (feasible)"
+    return f"least-violating k = {k_text} (INFEASIBLE: breaks a limit)"
+
+
+def is_000_case(scenario: Scenario, model: Any) -> bool:
+    """halt7 with joint 4 locked at 0 deg: 000 §5's scenario, whose headline numbers the halt
+    report compares against."""
+    lk = scenario.lock
+    return model.name == "halt7" and lk is not None and lk[0] == 4 and math.isclose(lk[1], 0.0, abs_tol=1e-9)
 
 
 def summary_lines(results: dict[str, Any]) -> list[str]:
@@ -494,9 +556,11 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     if "workspace" in s:
         w = s["workspace"]
         lines.append(
-            f"  workspace: full {w['volume_full_m3']:.3f} m^3"
+            f"  workspace: full {w['volume_full_m3']:.3g} m^3"
             + (
-                f", locked {w['volume_locked_m3']:.3f} m^3, kept {_pct(w['share_kept'])}"
+                f", locked {w['volume_locked_m3']:.3g} m^3, kept {_pct0(w['share_kept'])} "
+                f"(half the samples: {_pct0(w.get('share_kept_half_samples'))})"
+                + ("; not converged" if w.get("warnings") else "")
                 if w.get("volume_locked_m3") is not None
                 else ""
             )
@@ -507,7 +571,9 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
             lines.append(
                 "  singular: "
                 + ", ".join(
-                    f"{k} {'sufficient' if c['sufficient'] else 'NOT sufficient'}" for k, c in g.items()
+                    f"{k} {'sufficient' if c['sufficient'] else 'NOT sufficient'}"
+                    + (" (ours)" if k == "cond1f" else "")
+                    for k, c in g.items()
                 )
             )
         else:
@@ -542,6 +608,7 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
     import matplotlib.pyplot as plt
 
     from ..report import LIMITS_HEADER, Section, arm_figure, limit_status, limits_rows, save_figure
+    from .jump import KAPPA_UNIT, _points_text
 
     d = scenario.data
     jobs = results["jobs"]
@@ -568,10 +635,24 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
     # the failure
     fail = d["failure"]
     ffacts: list[tuple[str, Any]] = []
+    if fail["joint"] is None:
+        ffacts.append(("locked joint", "none: no locked joint in this scenario (no [failure] table)"))
     if fail["joint"] is not None:
         ffacts.append(("joint that locks", fail["joint"]))
     if fail["angle_deg"] is not None:
         ffacts.append(("locked angle [deg]", fail["angle_deg"]))
+    if scenario.failure_overridden():
+        changed = {
+            k.split(".", 1)[1]: v["file"]
+            for k, v in scenario.overrides.items()
+            if k in ("failure.joint", "failure.angle_deg") and v["file"] != v["value"]
+        }
+        ffacts.append(
+            (
+                "overridden on the command line",
+                "the file gives " + ", ".join(f"{k} = {v}" for k, v in changed.items()),
+            )
+        )
     if "jump" in jobs:
         r = jobs["jump"]["result"]
         ffacts.append(
@@ -597,7 +678,7 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
             )
         ]
         tables.append((["joint", "q [deg]", "dq [deg/s]", "ddq [deg/s^2]"], rows, "state at failure"))
-    lim_rows = [[k, v] for k, v in d["limits"].items() if v is not None]
+    lim_rows = [[LIMIT_LABELS.get(k, k), v] for k, v in d["limits"].items() if v is not None]
     if lim_rows:
         tables.append((["limit", "value"], lim_rows, "limits"))
     sections.append(Section("The failure", facts=ffacts, tables=tables))
@@ -645,15 +726,21 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
             f = r["kappa_fit"]
             decisions.append(
                 (
-                    "kappa(t)",
-                    f"polynomial of order {f['order']} in tau = t/T, segment points {f['segment_points_s']} s",
+                    f"kappa(t) [{KAPPA_UNIT}]",
+                    f"polynomial of order {f['order']} in tau = t/T, segment points "
+                    f"{_points_text(f['segment_points_s'])}",
                 )
             )
             decisions.append(
-                ("kappa(t) coefficients (tau^0 first)", [float(f"{c:.4g}") for c in f["coefficients_tau"]])
+                (
+                    f"kappa(t) coefficients (tau^0 first) [{KAPPA_UNIT}]",
+                    [float(f"{c:.4g}") for c in f["coefficients_tau"]],
+                )
             )
         elif r["mode"] == "fail_at":
-            decisions.append(("optimal kappa at the failure", r["kappa"]))
+            decisions.append((f"optimal kappa at the failure [{KAPPA_UNIT}]", r["kappa"]))
+        elif np.ndim(r["kappa"]) == 0:
+            decisions.append((f"constant kappa [{KAPPA_UNIT}]", r["kappa"]))
         decisions.append(
             (
                 "mean jump reduction / share improved",
@@ -676,12 +763,18 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
         )
     if "workspace" in jobs:
         r = jobs["workspace"]["result"]
-        decisions.append(
-            (
-                "workspace volume full / locked [m^3]",
-                f"{r['volume_full_m3']:.4g} / {r.get('volume_locked_m3') or float('nan'):.4g} (kept {_pct(r.get('share_kept'))})",
+        if r.get("volume_locked_m3") is None:
+            decisions.append(("workspace volume [m^3]", f"{r['volume_full_m3']:.3g}"))
+        else:
+            decisions.append(
+                (
+                    "workspace volume full / locked [m^3]",
+                    f"{r['volume_full_m3']:.3g} / {r['volume_locked_m3']:.3g} (kept {_pct0(r.get('share_kept'))}; "
+                    f"from half the samples {_pct0(r.get('share_kept_half_samples'))})",
+                )
             )
-        )
+            for w in r.get("warnings", []):
+                decisions.append(("workspace: warning", w))
     if "singular" in jobs:
         r = jobs["singular"]["result"]
         if isinstance(r.get("conditions"), dict) and "cond1" in r["conditions"]:
@@ -696,7 +789,7 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
                             c["singular"],
                             c["fraction_singular"],
                             c["sigma_min_median"],
-                            "reproduced" if c["sufficient"] else "not reproduced: not sufficient",
+                            _condition_verdict(k, c["sufficient"]),
                         ]
                         for k, c in conds.items()
                     ],
@@ -818,21 +911,22 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
     ):
         r = jobs["jump"]["result"]
         fig, ax = plt.subplots(figsize=(7, 3.6))
-        ax.plot(r["verification_t_s"], r["jump_before"], label="kappa = 0")
-        ax.plot(r["verification_t_s"], r["jump_after"], label="kappa(t)")
+        ax.plot(r["verification_t_s"], np.degrees(_floats(r["jump_before"])), label="kappa = 0")
+        ax.plot(r["verification_t_s"], np.degrees(_floats(r["jump_after"])), label="kappa(t)")
         ax.set_xlabel("failure time [s]")
-        ax.set_ylabel("||joint-rate jump|| [rad/s]")
+        ax.set_ylabel("||joint-rate jump|| [deg/s]")
         ax.legend()
         images.append(("velocity jump vs failure time", save_figure(fig, figdir, "jump_vs_failure_time")))
         plt.close(fig)
     if "halt" in jobs:
+        r = jobs["halt"]["result"]
         npz = out / "halt" / "halt_motion.npz"
         if npz.is_file():
             with np.load(npz) as z:
                 t, tb, tb0 = z["t"], z["tau_b"], z["tau_b_k0"]
             fig, ax = plt.subplots(figsize=(7, 3.6))
             ax.plot(t, np.linalg.norm(tb0, axis=-1), label="k = 0")
-            ax.plot(t, np.linalg.norm(tb, axis=-1), label="k*")
+            ax.plot(t, np.linalg.norm(tb, axis=-1), label=halt_k_label(r))
             ax.set_xlabel("t [s]")
             ax.set_ylabel("||base torque|| [N m]")
             ax.legend()
@@ -860,6 +954,11 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
             sections.append(Section(f"Figures: {job} ({JOB_PAPER[job]})", images=imgs, level=3))
     sections.append(Section("Assumptions and readings", notes=assumptions(scenario, full)))
     return sections
+
+
+def _floats(values: Any) -> np.ndarray:
+    """A JSON list of numbers (null = NaN) as a float array."""
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
 
 
 def rp_escape(text: str) -> str:
@@ -900,7 +999,8 @@ def assumptions(scenario: Scenario, model: Any) -> list[str]:
         notes.append(
             "Halt motion: 000 eq. (27) with one shared k, k read in deg/s^6 (000's reading); objective = "
             "time average of the base torque about the spacecraft's centre of mass (Simpson's rule); limits "
-            "checked on a 2001-point grid (docs/halt-motion.md). 000's headline numbers are not reproduced."
+            "checked on a 2001-point grid (docs/halt-motion.md)."
+            + (" 000's headline numbers are not reproduced." if is_000_case(scenario, model) else "")
         )
     if "jump" in jobs:
         notes.append(

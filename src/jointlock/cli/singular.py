@@ -142,6 +142,7 @@ def _single(args: argparse.Namespace) -> int:
         "full_rank": int(res.singular_values.shape[-1]),
         "singular": bool(res.singular),
         "det_jjt": float(res.det_jjt),
+        **_gram(res.singular_values, model.dof),
         "tol": res.tol,
         "lost_directions": lost.T,
         "direction_convention": "unit twists (vx, vy, vz, wx, wy, wz), base frame, sign arbitrary",
@@ -161,8 +162,13 @@ def _single(args: argparse.Namespace) -> int:
     state = "SINGULAR" if res.singular else "regular"
     print(
         f"sigma_min = {res.sigma_min:.6g}   rank = {res.rank} of {out['full_rank']} (tol {res.tol:g})   "
-        f"det(J J^T) = {res.det_jjt:.6g}   -> {state}"
+        f"{out['gram_det_kind']} = {out['gram_det']:.6g}   -> {state}"
     )
+    if model.dof < 6:
+        print(
+            f"  ({model.dof} movable joints < 6: J J^T (6 x 6) has rank <= {model.dof}, so det(J J^T) = 0 "
+            f"always; det(J^T J) = product of the squared singular values tests the {model.dof} joints instead)"
+        )
     if lost.shape[1]:
         print("lost directions (base frame, columns):")
         print(format_matrix(lost, "{:>9.4f}", [f"u{i + 1}" for i in range(lost.shape[1])]))
@@ -182,6 +188,13 @@ def _single(args: argparse.Namespace) -> int:
                 f"|J'^T u|/|J'| = {item['residual']:.2e}  |u.u_num| = {item['alignment']:.4f}"
             )
     return 0
+
+
+def _gram(singular_values: np.ndarray, dof: int) -> dict[str, Any]:
+    """The Gram determinant that can vanish: ``det(J J^T)`` for 6 or more joints, ``det(J^T J)``
+    (= product of the squared singular values) for fewer, where ``det(J J^T)`` is always 0."""
+    kind = "det(J J^T)" if dof >= 6 else "det(J^T J)"
+    return {"gram_det_kind": kind, "gram_det": float(np.prod(np.square(singular_values)))}
 
 
 def _conditions_at(
@@ -338,6 +351,7 @@ def _search(args: argparse.Namespace) -> int:
         "robot": model.name,
         "base": base,
         "joint_numbers": list(model.joint_numbers),
+        "locked": locked_deg(model),
         "seed": res.seed,
         "starts": samples,
         "converged": int(res.converged.sum()),
@@ -355,12 +369,19 @@ def _search(args: argparse.Namespace) -> int:
         print_json({k: v for k, v in out.items() if k not in ("q_deg", "sigma_min")} | {"found": len(res.q)})
         return 0
     print(
-        f"{model.name}: Jacobian {base}, {samples} starts (seed {res.seed}): {out['converged']} converged to "
+        f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: "
+        f"{locked_text(locked_deg(model))}, Jacobian {base}"
+    )
+    print(
+        f"{samples} starts (seed {res.seed}): {out['converged']} converged to "
         f"sigma_min < {res.tol:g} in {res.iterations} iterations; {len(families)} families"
     )
     for i, fam in enumerate(families, 1):
         print(f"\n{i:2d}. {fam['label']}  ({fam['size']} configurations)")
-        print("    representative q [deg]: " + ", ".join(f"{v:.2f}" for v in fam["representative_q_deg"]))
+        print(
+            "    representative q [deg]: "
+            + ", ".join(f"q{j}={v:.2f}" for j, v in zip(model.joint_numbers, fam["representative_q_deg"]))
+        )
         print(
             "    lost direction (ee frame vx vy vz wx wy wz): "
             + np.array2string(np.asarray(fam["lost_direction_ee"]), precision=3, suppress_small=True)

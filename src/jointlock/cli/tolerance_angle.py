@@ -22,20 +22,41 @@ MAX_GAMMA_SAMPLES = 200_000
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "tolerance-angle",
-        help="gamma sweep (rotate the target about the tool x axis) and the gamma absorbing a lock",
+        help="gamma sweep (rotate the target about the tool x axis) and the gamma absorbing a lock "
+        "(puma6-family arms only)",
         description=(
-            "Rotate the pose of --q-target-deg about the tool x axis by gamma in [-limit, limit], solve "
+            "Works on puma6-family arms only (6 joints with 002 Table 1's structure, any a2, d4, d6: "
+            "002's closed-form IK). Rotate the pose of --q-target-deg about the tool x axis by gamma in [-limit, limit], solve "
             "the full-arm IK on the branch of the target configuration, and find where the locked "
             "joint equals its locked angle (seed 002, eq. 18 and Figs. 5-8)."
         ),
     )
     add_robot_arguments(p)
     p.add_argument(
-        "--q-target-deg", type=float, nargs="+", required=True, metavar="DEG", help="desired joints (all)"
+        "--q-target-deg",
+        type=float,
+        nargs="+",
+        required=True,
+        metavar="DEG",
+        help="desired configuration, every joint of the arm [deg]",
     )
-    p.add_argument("--gamma-limit-deg", type=float, default=180.0, help="sweep |gamma| <= this (default 180)")
-    p.add_argument("--zoom-deg", type=float, default=2.0, help="second, narrow range (002 Fig. 6: 2)")
-    p.add_argument("--step-deg", type=float, default=0.1, help="sweep step (default 0.1)")
+    p.add_argument(
+        "--gamma-limit-deg",
+        type=float,
+        default=180.0,
+        metavar="DEG",
+        help="sweep |gamma| <= this [deg], in (0, 180] (default 180)",
+    )
+    p.add_argument(
+        "--zoom-deg",
+        type=float,
+        default=2.0,
+        metavar="DEG",
+        help="half-width of the second, narrow gamma range [deg] (002 Fig. 6: 2)",
+    )
+    p.add_argument(
+        "--step-deg", type=float, default=0.1, metavar="DEG", help="gamma sweep step [deg] (default 0.1)"
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", type=Path, metavar="DIR", help="write plots and sweep.json here")
     p.set_defaults(func=run)

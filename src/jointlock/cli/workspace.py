@@ -5,11 +5,19 @@ from __future__ import annotations
 import argparse
 import io
 import math
+import sys
 from pathlib import Path
 
 import numpy as np
 
-from ..analysis.workspace import compare_workspaces, projection_extent, sample_workspace
+from ..analysis.workspace import (
+    MIN_SAMPLES,
+    MIN_SAMPLES_PER_VOXEL,
+    _auto_voxel,
+    compare_workspaces,
+    projection_extent,
+    sample_workspace,
+)
 from ..errors import ScenarioError
 from ..progress import Progress
 from ..robots import load_robot
@@ -20,9 +28,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "workspace",
         help="Monte Carlo workspace, full arm vs locked arm: clouds, projections, volume, share kept",
+        description=(
+            "Sample joint angles uniformly within the limits (capped to +-180 deg), compute the "
+            "end-effector positions of the full arm and, with --lock, of the arm with that joint "
+            "locked (002 Figs. 2-3), and estimate each volume by voxel occupancy on one common grid "
+            "(cubes of side --voxel holding at least one sample). The share of the full workspace "
+            "that the locked arm keeps is a Monte Carlo estimate that moves with --samples and "
+            "--voxel: it is printed next to the same estimate from half the samples, and a warning "
+            "says when the two differ or when many locked voxels fall outside the full cloud."
+        ),
     )
     add_robot_arguments(p)
-    p.add_argument("--samples", type=int, default=200_000, help="configurations per arm (default 200000)")
+    p.add_argument(
+        "--samples",
+        type=int,
+        default=200_000,
+        help=f"configurations per arm, >= {MIN_SAMPLES} (default 200000)",
+    )
     p.add_argument(
         "--voxel", type=float, default=None, metavar="M", help="voxel side [m] (default: automatic)"
     )
@@ -33,8 +55,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.samples < 1:
-        raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
+    if args.samples < MIN_SAMPLES:
+        raise ScenarioError(
+            f"--samples must be >= {MIN_SAMPLES} (a voxel-occupancy volume from fewer samples says "
+            f"little); got {args.samples}"
+        )
     require_finite(args, "voxel")
     check_out_dir(args.out)
     if args.voxel is not None and not (args.voxel > 0):
@@ -49,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
                 model, joint, angle, samples=args.samples, voxel=args.voxel, rng=args.seed
             )
             full, locked, voxel = cmp.full, cmp.locked, cmp.voxel
+            density, warnings = cmp.samples_per_voxel, cmp.warnings()
             summary = {
                 "robot": model.name,
                 "samples": args.samples,
@@ -58,6 +84,8 @@ def run(args: argparse.Namespace) -> int:
                 "volume_full_m3": cmp.volume_full,
                 "volume_locked_m3": cmp.volume_locked,
                 "share_kept": cmp.share_kept,
+                "share_kept_half_samples": cmp.share_kept_half,
+                "voxel_half_samples_m": cmp.voxel_half,
                 "locked_voxels_outside_full": cmp.outside,
                 "extent_full_m": projection_extent(full),
                 "extent_locked_m": projection_extent(locked),
@@ -65,6 +93,7 @@ def run(args: argparse.Namespace) -> int:
         else:
             ws = sample_workspace(model, samples=args.samples, voxel=args.voxel, rng=args.seed)
             full, locked, voxel = ws.points, None, ws.voxel
+            density, warnings = ws.samples_per_voxel, []
             summary = {
                 "robot": model.name,
                 "samples": args.samples,
@@ -75,21 +104,39 @@ def run(args: argparse.Namespace) -> int:
                 "extent_full_m": projection_extent(full),
             }
         bar.update()
+    if args.voxel is not None and not density >= MIN_SAMPLES_PER_VOXEL:
+        raise ScenarioError(
+            f"--voxel {args.voxel:g} m is too small for {args.samples} samples: only {density:.2g} samples per "
+            f"occupied voxel on average, so the volume is about samples x voxel^3, not the workspace's; use a "
+            f"larger --voxel (automatic for these samples: {_auto_voxel(full):.3g} m) or more samples"
+        )
+    summary["samples_per_voxel"] = density
+    if locked is not None:
+        summary["warnings"] = warnings
+    for w in warnings:
+        print(f"jointlock workspace: warning: {w}", file=sys.stderr)
     if args.out is not None:
         summary["files"] = _write(args.out, full, locked, summary)
     if args.json:
         print_json(summary)
         return 0
-    print(f"{model.name}: {args.samples} samples per arm (seed {args.seed}), voxel {voxel:.4g} m")
-    print(f"  full arm volume   : {summary['volume_full_m3']:.4f} m^3")
+    print(
+        f"{model.name}: {args.samples} samples per arm (seed {args.seed}), voxel {voxel:.3g} m "
+        f"({density:.3g} samples per occupied voxel)"
+    )
+    print(f"  full arm volume   : {summary['volume_full_m3']:.3g} m^3")
     if locked is not None:
         lk = summary["lock"]
         print(
-            f"  locked arm volume : {summary['volume_locked_m3']:.4f} m^3 (joint {lk['joint']} at {lk['angle_deg']:g} deg)"
+            f"  locked arm volume : {summary['volume_locked_m3']:.3g} m^3 (joint {lk['joint']} at {lk['angle_deg']:g} deg)"
         )
-        print(f"  share kept        : {100 * summary['share_kept']:.2f} %")
         print(
-            f"  locked voxels outside the full cloud (sampling): {100 * summary['locked_voxels_outside_full']:.2f} %"
+            f"  share kept        : {100 * summary['share_kept']:.0f} % (from half the samples: "
+            f"{100 * summary['share_kept_half_samples']:.0f} %)"
+            + ("; not converged, see the warnings" if warnings else "")
+        )
+        print(
+            f"  locked voxels outside the full cloud (sampling): {100 * summary['locked_voxels_outside_full']:.1f} %"
         )
     for f in summary.get("files", []):
         print(f"wrote {f}")

@@ -208,7 +208,8 @@ class HaltReachability:
         False (000): one shared ``k``; True: one ``k`` per joint (then the set is a box).
     angle_lower, angle_upper
         (n,) angle limits [rad] of the halt; None: the model's (filled in by
-        :func:`optimal_halt_configuration`, as ``HaltProblem`` does).
+        :func:`optimal_halt_configuration`, as ``HaltProblem`` does).  ``-inf``/``+inf``
+        (a continuous joint): no angle constraint for that joint.
     n_check
         Time grid of the check (``HaltProblem.n_check``).
     margin
@@ -247,8 +248,10 @@ class HaltReachability:
             v = getattr(self, name)
             if v is not None:
                 arr = np.broadcast_to(np.asarray(v, dtype=float), (n,))
-                if not np.all(np.isfinite(arr)):
-                    raise ConfigurationError(f"{name} must be finite [rad]; got {arr.tolist()}")
+                if np.any(np.isnan(arr)):  # -inf/+inf: a joint without an angle limit
+                    raise ConfigurationError(
+                        f"{name} must be angles [rad] (-inf/+inf for no limit), not NaN; got {arr.tolist()}"
+                    )
                 object.__setattr__(self, name, _readonly(arr))
         if not (isinstance(self.margin, (int, float)) and 0 <= self.margin < 0.1):
             raise ConfigurationError(f"margin must be in [0, 0.1); got {self.margin!r}")
@@ -320,7 +323,8 @@ class HaltReachability:
             checks.insert(0, ("angle", "deg", self.q0, self.angle_lower, self.angle_upper))
         out = []
         for quantity, unit, value, lo, hi in checks:
-            slack = LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1.0)
+            lo_f, hi_f = np.where(np.isfinite(lo), lo, 0.0), np.where(np.isfinite(hi), hi, 0.0)
+            slack = LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo_f), np.abs(hi_f)), 1.0)
             for i in np.nonzero((value < lo - slack) | (value > hi + slack))[0]:
                 out.append(
                     f"joint {numbers[i]} starts with {quantity} {math.degrees(value[i]):.6g} {unit}, "
@@ -716,7 +720,9 @@ def optimal_halt_configuration(
     characteristic_length
         ``L`` [m] to scale the Jacobian's linear rows; None (000) uses the raw matrix.
     lower, upper
-        (n,) sampling box [rad]; default the joint limits capped to +-pi (000: [-180, 180] deg).
+        (n,) sampling box [rad]; default the joint limits capped to +-pi (000: [-180, 180] deg),
+        so a joint without angle limits (continuous, limits +-inf) is sampled over [-pi, pi]
+        (every angle, once) and has no angle constraint in the reachability check.
     reachability
         :class:`HaltReachability` (exact): only configurations that 000's halt polynomial
         reaches from the given state within ``T`` under the limits.  The sampling box is the
@@ -926,8 +932,8 @@ def evaluate_cp(result: HaltConfiguration, model_locked: ArmModel, q: ArrayLike)
 def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
     """One matplotlib figure per healthy joint: joint angle [deg] vs CP over the sample set,
     with the upper envelope (max CP per angle bin), the best and the runner-up (000 Fig. 7).
-    Under :class:`HaltReachability` unreachable samples are grey and the envelope is over
-    the reachable ones.
+    Under :class:`HaltReachability` unreachable samples are grey crosses (their own legend
+    entry) and the envelope is over the reachable ones.
 
     Returns
     -------
@@ -948,13 +954,24 @@ def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
             ax.scatter(
                 q_deg[~ok, j],
                 result.cp_samples[~ok],
-                s=1.5,
-                alpha=0.2,
-                color="0.7",
+                s=8.0,
+                alpha=0.6,
+                color="0.3",
+                marker="x",
+                linewidths=0.7,
+                zorder=2.5,  # above the reachable cloud: a thin set must stay visible
                 rasterized=True,
-                label="unreachable",
+                label=f"unreachable samples ({int((~ok).sum())})",
             )
-        ax.scatter(q_deg[ok, j], result.cp_samples[ok], s=1.5, alpha=0.25, color="tab:blue", rasterized=True)
+        ax.scatter(
+            q_deg[ok, j],
+            result.cp_samples[ok],
+            s=1.5,
+            alpha=0.25,
+            color="tab:blue",
+            rasterized=True,
+            label="samples" if result.reachable is None else f"reachable samples ({int(ok.sum())})",
+        )
         which = np.clip(np.digitize(q_deg[ok, j], edges) - 1, 0, bins - 1)
         envelope = np.full(bins, np.nan)
         np.fmax.at(envelope, which, result.cp_samples[ok])
@@ -966,7 +983,12 @@ def section_figures(result: HaltConfiguration, *, bins: int = 72) -> list[Any]:
         ax.set_xlabel(f"angle of joint {number} [deg]")
         ax.set_ylabel("CP")
         ax.set_title(f"joint {number} - CP ({result.samples} samples)", fontsize=10)
-        ax.legend(fontsize=7, loc="lower right")
+        legend = ax.legend(fontsize=7, loc="lower right", markerscale=1.0)
+        # the sample clouds are drawn faint and tiny: their legend keys opaque and readable
+        for handle in getattr(legend, "legend_handles", getattr(legend, "legendHandles", [])):
+            if hasattr(handle, "set_sizes"):
+                handle.set_sizes([25.0])
+                handle.set_alpha(1.0)
         ax.grid(alpha=0.3)
         fig.tight_layout()
         figures.append(fig)

@@ -158,6 +158,22 @@ def k_shape(t: ArrayLike, T: float) -> tuple[FloatArray, FloatArray, FloatArray]
 # -- the problem --------------------------------------------------------------------------
 
 
+def _angle_limit(value: ArrayLike, n: int, name: str) -> FloatArray:
+    """Angle limits (n,) [rad]: finite, or -inf/+inf for a joint without a limit (a continuous
+    joint: its angle constraint is absent); NaN is refused."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or np.any(np.isnan(arr)):
+        raise ScenarioError(
+            f"{name} must be one value or {n} values [rad], -inf/+inf for no limit, not NaN; "
+            f"got {arr.tolist()}"
+        )
+    out = arr.copy()
+    out.setflags(write=False)
+    return out
+
+
 def _vec(value: ArrayLike, n: int, name: str, unit: str, *, positive: bool = False) -> FloatArray:
     arr = np.asarray(value, dtype=float)
     if arr.ndim == 0:
@@ -188,7 +204,8 @@ class HaltProblem:
     dq_max, ddq_max
         (n,) speed and acceleration limits [rad/s, rad/s^2] (symmetric).
     q_min, q_max
-        (n,) angle limits [rad]; default the model's.
+        (n,) angle limits [rad]; default the model's.  ``-inf``/``+inf`` (a continuous
+        joint): no angle constraint for that joint.
     base
         ``"fixed"`` (000) or ``"floating"`` base for the disturbance torque.
     n_samples
@@ -219,8 +236,11 @@ class HaltProblem:
         object.__setattr__(self, "ddq_max", _vec(self.ddq_max, n, "ddq_max", "rad/s^2", positive=True))
         lo = self.model.lower if self.q_min is None else self.q_min
         hi = self.model.upper if self.q_max is None else self.q_max
-        object.__setattr__(self, "q_min", _vec(lo, n, "q_min", "rad"))
-        object.__setattr__(self, "q_max", _vec(hi, n, "q_max", "rad"))
+        lo, hi = _angle_limit(lo, n, "q_min"), _angle_limit(hi, n, "q_max")
+        if np.any(lo > hi):
+            raise ScenarioError(f"q_min must be <= q_max [rad]; got {lo.tolist()} and {hi.tolist()}")
+        object.__setattr__(self, "q_min", lo)
+        object.__setattr__(self, "q_max", hi)
         T = float(self.T)
         if not (math.isfinite(T) and T > 0):
             raise ScenarioError(f"halt time T must be a finite number > 0 [s]; got {self.T}")
@@ -382,6 +402,9 @@ def _limits(problem: HaltProblem) -> tuple[FloatArray, FloatArray]:
 
 
 def _slack(lo: FloatArray, hi: FloatArray) -> FloatArray:
+    """Round-off slack of each limit (relative to its finite ends; an infinite end -- no
+    limit -- needs none)."""
+    lo, hi = np.where(np.isfinite(lo), lo, 0.0), np.where(np.isfinite(hi), hi, 0.0)
     return LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1.0)
 
 
@@ -780,7 +803,8 @@ def relative_violation(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = 
     t = problem.times(problem.n_check)
     lo, hi = _limits(problem)
     traj = np.stack(problem.trajectory(k, t, per_joint=per_joint), axis=-3)  # (..., 3, n_t, n)
-    scale = np.maximum(np.abs(lo), np.abs(hi))[:, None, :]
+    scale = np.maximum(np.abs(lo), np.abs(hi))
+    scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
     excess = np.maximum(traj - hi[:, None, :], lo[:, None, :] - traj) / scale
     return np.maximum(excess.max(axis=(-3, -2, -1)), 0.0)
 
@@ -1143,9 +1167,10 @@ def infeasibility_message(result: HaltMotion, *, k_unit: str = "deg/s^6") -> str
     and the smallest halt time with a feasible ``k``."""
     scale = K_UNIT_SCALE[k_unit]
     p = result.problem
+    k = ", ".join(f"{v:.6g}" for v in np.atleast_1d(np.asarray(result.k, dtype=float) / scale))
     lines = [
         f"no k satisfies the limits for a {p.T:g} s halt: every value of k breaks at least one limit.",
-        f"least-violating k = {np.asarray(result.k) / scale} {k_unit}; there:",
+        f"least-violating k = {k} {k_unit}; there:",
     ]
     lines += ["  " + v.describe() for v in result.violations[:6]]
     if result.minimum_T is not None:

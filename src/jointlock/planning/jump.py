@@ -296,7 +296,28 @@ def load_scenario(path: str | Path) -> JumpScenario:
         raise ScenarioError(f"cannot read scenario file {str(path)!r}: {reason}") from None
     except tomllib.TOMLDecodeError as exc:
         raise ScenarioError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
+    _refuse_run_scenario(data, str(path))
     return scenario_from_mapping(data, source=str(path))
+
+
+#: Top-level keys of a ``jointlock run`` scenario file that a jump task file never has.
+_RUN_SCENARIO_KEYS = ("title", "description", "robot", "seed", "jobs", "out")
+
+
+def _refuse_run_scenario(data: Mapping[str, Any], source: str) -> None:
+    """A ``jointlock run`` scenario file (tables such as ``[jump]``, ``[failure]``, or keys such
+    as ``title``, ``robot``) given where a flat task file is expected: say which command runs it."""
+    tables = [k for k, v in data.items() if isinstance(v, Mapping)]
+    keys = [k for k in _RUN_SCENARIO_KEYS if k in data]
+    if not tables and not keys:
+        return
+    what = ", ".join([f"[{t}]" for t in tables] + keys)
+    raise ScenarioError(
+        f"{source} is a `jointlock run` scenario file ({what}), not a jump task file: run it with "
+        f"`jointlock run {source}` (add --jobs jump to run only its [jump] table), or give "
+        "--scenario a flat task file: the task fields of a [jump] table (q0_deg, dx_m, duration_s, ...) at the "
+        "top level, no tables (docs/jump.md)"
+    )
 
 
 # -- Cartesian path -------------------------------------------------------------------------
@@ -469,9 +490,16 @@ def _problem(model: ArmModel, scenario: JumpScenario) -> _Problem:
     if not isinstance(scenario, JumpScenario):
         raise ScenarioError(f"scenario must be a JumpScenario; got {type(scenario).__name__}")
     if len(scenario.q0) != model.dof:
+        default = scenario.q0 == JumpScenario().q0
         raise ScenarioError(
             f"q0 has {len(scenario.q0)} angles but model {model.name!r} has {model.dof} movable joints "
             f"{list(model.joint_numbers)}"
+            + (
+                " (q0 is the default task's, NOTES-001's start for canadarm7: give a JumpScenario with "
+                f"q0 = {model.dof} angles [rad], or in a task file q0_deg [deg])"
+                if default
+                else ""
+            )
         )
     floating = scenario.base == "floating"
     if floating and not model.floating:

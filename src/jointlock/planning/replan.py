@@ -357,8 +357,11 @@ DEFAULT_STEP_WEIGHT = 0.5
 GOAL_WEIGHT = 100.0
 #: Default jump threshold: this many times the median largest joint step ...
 JUMP_MEDIAN_FACTOR = 5.0
-#: ... and at least this [rad].
+#: ... and at least this [rad] ...
 JUMP_MIN_STEP = math.radians(2.0)
+#: ... and at most this [rad]: a joint that moves more between two waypoints is flagged even
+#: when every step is that large (a plan too coarse to follow the line: few waypoints).
+JUMP_MAX_STEP = math.radians(30.0)
 
 _GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
@@ -554,7 +557,8 @@ def replan_line(
     length_scale
         [m / rad]: weight of the rotation error in the tracking error.
     jump_threshold
-        [rad]; default ``max(JUMP_MEDIAN_FACTOR * median step, JUMP_MIN_STEP)``, the median
+        [rad]; default ``max(JUMP_MEDIAN_FACTOR * median step, JUMP_MIN_STEP)`` capped at
+        ``JUMP_MAX_STEP`` (30 deg), the median
         taken over the steps' largest joint change.
     """
     geom_locked = puma6_geometry(model)
@@ -623,7 +627,7 @@ def replan_line(
     vlim = np.array([jt.velocity_limit for jt in model.joints], dtype=float)
     if jump_threshold is None:
         typical = float(np.median(step.max(axis=1))) if step.size else 0.0
-        jump_threshold = max(JUMP_MEDIAN_FACTOR * typical, JUMP_MIN_STEP)
+        jump_threshold = min(max(JUMP_MEDIAN_FACTOR * typical, JUMP_MIN_STEP), JUMP_MAX_STEP)
     numbers = model.joint_numbers
     jumps = _flags(step, times, cycle, numbers, np.full(step.shape[1], float(jump_threshold)), per_rate=False)
     over = _flags(step, times, cycle, numbers, vlim, per_rate=True)
