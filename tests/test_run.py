@@ -70,6 +70,7 @@ def test_example_runs_and_writes_documented_keys(tmp_path, name):
         # the halt configuration is searched among those the halt polynomial can reach
         assert "halt/halt_motion.csv" in files and res["summary"]["halt"]["feasible"] is True
         assert res["scenario"]["halt_config"]["reachable"] is True
+        assert "limits applied by the halt" in (out / "report.html").read_text()
     if name == "jump_001":
         assert "jump/verification.csv" in files and 0 < res["summary"]["jump"]["mean_reduction"] < 1
     if name == "replan_002":

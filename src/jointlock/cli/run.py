@@ -680,7 +680,31 @@ def report_sections(scenario: Scenario, results: dict[str, Any], out: Path) -> l
         tables.append((["joint", "q [deg]", "dq [deg/s]", "ddq [deg/s^2]"], rows, "state at failure"))
     lim_rows = [[LIMIT_LABELS.get(k, k), v] for k, v in d["limits"].items() if v is not None]
     if lim_rows:
-        tables.append((["limit", "value"], lim_rows, "limits"))
+        tables.append((["limit", "value"], lim_rows, "limits given in the scenario"))
+    if "halt" in jobs and "velocity_limit_deg_s" in jobs["halt"]["result"]:
+        # what the halt actually applied: the scenario's limits capped by the model's
+        r = jobs["halt"]["result"]
+
+        def per_joint(value: Any, j: int) -> Any:
+            return value[j] if isinstance(value, (list, tuple)) else value
+
+        rows = [
+            [
+                num,
+                round(r["velocity_limit_deg_s"][j], 6),
+                per_joint(r.get("velocity_limit_source", ""), j),
+                round(r["acceleration_limit_deg_s2"][j], 6),
+                per_joint(r.get("acceleration_limit_source", ""), j),
+            ]
+            for j, num in enumerate(r["joint_numbers"])
+        ]
+        tables.append(
+            (
+                ["joint", "speed limit [deg/s]", "from", "acceleration limit [deg/s^2]", "from"],
+                rows,
+                "limits applied by the halt",
+            )
+        )
     sections.append(Section("The failure", facts=ffacts, tables=tables))
     # decisions
     decisions: list[tuple[str, Any]] = []
