@@ -15,7 +15,8 @@ from _info import best_of, machine_info
 
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 
-import jointlock as jl  # noqa: E402
+import jointlock as jl
+from jointlock.cli.halt import PAPER_SCENARIO  # noqa: E402
 from jointlock.dynamics import rnea  # noqa: E402
 from jointlock.planning.ga import GASettings  # noqa: E402
 from jointlock.planning.halt_motion import HaltProblem, optimal_halt_motion  # noqa: E402
@@ -25,15 +26,16 @@ def main() -> None:
     print(machine_info())
     model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
     d = np.radians
+    sc = PAPER_SCENARIO  # 000 §5.2's state at failure and its printed q_best (T = 12 s: feasible)
     p = HaltProblem(
         model,
-        d([-180, -180, -100, -10, 20, 20]),
-        d([20, 30, 15, 25, 40, 35]),
-        d([8, 10, 12, 10, -8, 6]),
-        d([-167, -90, 40, -158, 90, -62]),
+        d(sc["q0_deg"]),
+        d(sc["dq0_deg"]),
+        d(sc["ddq0_deg"]),
+        d(sc["qf_deg"]),
         12.0,
-        d(40),
-        d(20),
+        d(sc["vmax_deg"]),
+        d(sc["amax_deg"]),
         n_samples=1001,
     )
     q, dq, ddq = p.trajectory(3e-4 * np.pi / 180, p.times(1001))
