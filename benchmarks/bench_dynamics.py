@@ -16,8 +16,8 @@ from _info import best_of, machine_info
 sys.path.insert(0, os.path.join(os.path.dirname(__file__), "..", "tests"))
 
 import jointlock as jl
-from jointlock.cli.halt import PAPER_SCENARIO  # noqa: E402
 from jointlock.dynamics import rnea  # noqa: E402
+from jointlock.papers.p000 import SCENARIO as PAPER_SCENARIO  # noqa: E402
 from jointlock.planning.ga import GASettings  # noqa: E402
 from jointlock.planning.halt_motion import HaltProblem, optimal_halt_motion  # noqa: E402
 

@@ -11,7 +11,9 @@ from conftest import EXACT_ATOL, random_q
 
 import jointlock as jl
 from jointlock.analysis.ability import (
+    CR_LIMIT,
     PAPER_JUDGMENT,
+    PAPER_RI,
     KinematicIndices,
     Normalization,
     ahp_weights,
@@ -24,6 +26,7 @@ from jointlock.analysis.ability import (
     standardize,
 )
 from jointlock.errors import ConfigurationError, ScenarioError
+from jointlock.papers import p000
 
 #: Agreement of the Gram-eigenvalue path with the SVD for well-conditioned random matrices
 #: (error ~ eps * sigma_max^2 / sigma_min with sigma ~ 1).
@@ -36,12 +39,14 @@ GRAM_RTOL = 1e-9
 @pytest.mark.paper
 def test_paper_judgment_matrix_eq39():
     # 000 §5.1: lambda = 3, eigenvector (1/4, 1/2, 1/4), CR = 0 < 0.10.
+    np.testing.assert_array_equal(PAPER_JUDGMENT, p000.JUDGMENT)  # eq. (39)
+    assert dict(PAPER_RI) == dict(p000.RANDOM_INDEX) and CR_LIMIT == p000.CR_LIMIT  # Table 5, §3.1.3
     res = ahp_weights(PAPER_JUDGMENT)
-    np.testing.assert_allclose(res.weights, [0.25, 0.5, 0.25], atol=1e-12)
+    np.testing.assert_allclose(res.weights, p000.AHP_WEIGHTS, atol=1e-12)
     assert res.lambda_max == pytest.approx(3.0, abs=1e-12)
     assert res.ci == pytest.approx(0.0, abs=1e-12)
     assert res.cr == pytest.approx(0.0, abs=1e-12)
-    assert res.ri == 0.52  # 000 Table 5
+    assert res.ri == p000.RANDOM_INDEX[3]  # 000 Table 5
 
 
 def test_consistent_matrix_recovers_its_weights():
@@ -64,7 +69,7 @@ def test_mildly_inconsistent_matrix_ri_tables():
     saaty = ahp_weights(m, ri="saaty")
     assert paper.lambda_max > 3
     assert paper.ci == pytest.approx((paper.lambda_max - 3) / 2)
-    assert paper.cr == pytest.approx(paper.ci / 0.52)
+    assert paper.cr == pytest.approx(paper.ci / p000.RANDOM_INDEX[3])
     assert saaty.cr == pytest.approx(paper.ci / 0.58)
     np.testing.assert_allclose(paper.weights.sum(), 1.0)
     assert ahp_weights(m, ri={3: 1.0}).cr == pytest.approx(paper.ci)

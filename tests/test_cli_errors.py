@@ -281,16 +281,16 @@ def test_tolerance_angle_bounds_the_grid(capsys, monkeypatch):
 
 @pytest.mark.parametrize("command", ["workspace", "replan", "tolerance-angle"])
 def test_result_files_are_written_atomically(tmp_path, monkeypatch, command):
-    import jointlock.report as report
+    import jointlock.io.files as files_io  # every writer goes through its atomic_write_bytes
 
     written: list[str] = []
-    real = report.atomic_write_bytes
+    real = files_io.atomic_write_bytes
 
     def spy(path, data):
         written.append(Path(path).name)
         real(path, data)
 
-    monkeypatch.setattr(report, "atomic_write_bytes", spy)
+    monkeypatch.setattr(files_io, "atomic_write_bytes", spy)
     out = tmp_path / "out"
     argv = {
         "workspace": ["workspace", "halt7", "--lock", "2=0", "--samples", "1000", "--json"],

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import jointlock as jl
+from jointlock.papers import p000
 from jointlock.planning.ga import GASettings, _adaptive_probability, adaptive_ga, bits_for_precision, decode
 from jointlock.planning.halt_motion import HaltProblem, optimal_halt_motion
 
@@ -48,13 +49,10 @@ def test_ga_lands_on_scan_optimum():
     d = np.radians
     p = HaltProblem(
         model,
-        d([-180, -180, -100, -10, 20, 20]),
-        d([20, 30, 15, 25, 40, 35]),
-        d([8, 10, 12, 10, -8, 6]),
-        d([-167, -90, 40, -158, 90, -62]),
+        *(d(p000.SCENARIO[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg", "qf_deg")),  # 000 §5.2
         12.0,
-        d(40),
-        d(20),
+        d(p000.SCENARIO["vmax_deg"]),
+        d(p000.SCENARIO["amax_deg"]),
         n_samples=201,
     )
     scan = optimal_halt_motion(p, n_scan=201)

@@ -12,6 +12,7 @@ import pytest
 import jointlock as jl
 from jointlock.cli import main
 from jointlock.errors import ConfigurationError, InfeasibleError
+from jointlock.papers import p000
 from jointlock.planning.halt_config import (
     HaltReachability,
     ReachabilityBound,
@@ -20,11 +21,13 @@ from jointlock.planning.halt_config import (
     section_figures,
 )
 
-#: 000 §5.1, healthy joints 1, 2, 3, 5, 6, 7 [deg].
-PAPER_Q_BEST_DEG = [-167.0, -90.0, 40.0, -158.0, 90.0, -62.0]
-PAPER_Q_SUB_DEG = [-52.0, 90.0, 84.0, 148.0, -90.0, 157.0]
-PAPER_CP_SUB = 0.2969
-PAPER_GAIN = 2.368
+#: 000 §5.1, healthy joints 1, 2, 3, 5, 6, 7 [deg]: q_best, q_sub, CP(q_sub), the CP gain of
+#: q_best over q_sub and the number of samples K.
+PAPER_Q_BEST_DEG = p000.Q_BEST_DEG
+PAPER_Q_SUB_DEG = p000.Q_SUB_DEG
+PAPER_CP_SUB = p000.CP_Q_SUB
+PAPER_GAIN = p000.CP_GAIN
+PAPER_K = p000.SAMPLES
 #: Samples used where the test is not about the paper's K = 36000 (keeps the suite fast).
 FEW = 1500
 
@@ -162,22 +165,19 @@ def test_reachability_infeasible_names_joint_and_time():
 
 # -- exact reachability (the halt polynomial) ------------------------------------------------------
 
-#: 000 §5.2's state at failure and limits (healthy joints 1, 2, 3, 5, 6, 7).
-STATE = (
-    np.radians([-180, -180, -100, -10, 20, 20]),
-    np.radians([20, 30, 15, 25, 40, 35]),
-    np.radians([8, 10, 12, 10, -8, 6]),
-)
-VMAX, AMAX = math.radians(40), math.radians(20)
+#: 000 §5.2's state at failure, halt time [s] and limits (healthy joints 1, 2, 3, 5, 6, 7).
+STATE = tuple(np.radians(p000.SCENARIO[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg"))
+T000 = p000.SCENARIO["T"]
+VMAX, AMAX = math.radians(p000.SCENARIO["vmax_deg"]), math.radians(p000.SCENARIO["amax_deg"])
 
 
-def _halt_problem(model, qf, T=10.0):
+def _halt_problem(model, qf, T=T000):
     from jointlock.planning.halt_motion import HaltProblem
 
     return HaltProblem(model, *STATE, qf, T, VMAX, AMAX)
 
 
-def _shared_k(model, qf, T=10.0):
+def _shared_k(model, qf, T=T000):
     from jointlock.planning.halt_motion import shared_k_interval
 
     return shared_k_interval(_halt_problem(model, qf, T))
@@ -185,7 +185,7 @@ def _shared_k(model, qf, T=10.0):
 
 @pytest.fixture(scope="module")
 def reach10():
-    return HaltReachability(*STATE, 10.0, VMAX, AMAX)
+    return HaltReachability(*STATE, T000, VMAX, AMAX)
 
 
 def test_constrained_optimum_has_a_feasible_halt_motion(floating4, reach10):
@@ -308,7 +308,7 @@ def test_cp_at_paper_configurations(base):
     q = np.radians([PAPER_Q_BEST_DEG, PAPER_Q_SUB_DEG])
     for assignment, renorm in READINGS:
         res = optimal_halt_configuration(
-            model, samples=36000, rng=0, refine=False, assignment=assignment, renormalize=renorm
+            model, samples=PAPER_K, rng=0, refine=False, assignment=assignment, renormalize=renorm
         )
         cp_best, cp_sub = evaluate_cp(res, model, q)
         print(
@@ -439,7 +439,7 @@ def test_reachability_builds_its_bounds_once(floating4, monkeypatch, rng):
 
 
 def test_halt_cli_records_the_search_jacobian(capsys, monkeypatch):
-    import jointlock.planning.halt_config as hc
+    import jointlock.jobs.halt as hc  # plan_halt calls the search from there
 
     seen = []
     real = hc.optimal_halt_configuration

@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 import jointlock as jl
+from jointlock.papers import p000
 from jointlock.planning.halt_motion import (
     K_UNIT_SCALE,
     AffineKBounds,
@@ -25,16 +26,20 @@ from jointlock.planning.halt_motion import (
 
 DEG = math.pi / 180
 K_DEG = K_UNIT_SCALE["deg/s^6"]
-#: 000 §5.2 scenario (healthy joints 1, 2, 3, 5, 6, 7).
-Q0 = np.radians([-180, -180, -100, -10, 20, 20])
-DQ0 = np.radians([20, 30, 15, 25, 40, 35])
-DDQ0 = np.radians([8, 10, 12, 10, -8, 6])
-QF_PAPER = np.radians([-167, -90, 40, -158, 90, -62])
+#: 000 §5.2 scenario (healthy joints 1, 2, 3, 5, 6, 7): state at failure, printed q_best,
+#: halt time [s] and limits [rad/s, rad/s^2].
+SC = p000.SCENARIO
+Q0, DQ0, DDQ0, QF_PAPER = (np.radians(SC[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg", "qf_deg"))
+T000 = SC["T"]
+VMAX, AMAX = SC["vmax_deg"] * DEG, SC["amax_deg"] * DEG
+#: 000 §5.2's printed k* [deg/s^6] and global base torque at k = 0 [N m].
+PAPER_K = p000.HALT_RESULTS["k"]
+PAPER_TORQUE_K0 = p000.HALT_RESULTS["global_torque_k0_Nm"]
 
 
-def _problem(T=10.0, base="fixed", theta_offsets=True, **kw):
+def _problem(T=T000, base="fixed", theta_offsets=True, **kw):
     model = jl.lock(jl.robots.halt7(base="floating", theta_offsets=theta_offsets), 4, 0.0)
-    return HaltProblem(model, Q0, DQ0, DDQ0, QF_PAPER, T, 40 * DEG, 20 * DEG, base=base, **kw)
+    return HaltProblem(model, Q0, DQ0, DDQ0, QF_PAPER, T, VMAX, AMAX, base=base, **kw)
 
 
 def test_k_part_leaves_boundary_conditions(rng):
@@ -162,10 +167,10 @@ def test_paper_numbers_under_each_reading():
     }
     for (offsets, base), (t0, tk) in expected.items():
         p = _problem(base=base, theta_offsets=offsets)
-        got = global_base_torque(p, np.array([0.0, 0.0018 * K_DEG]))
+        got = global_base_torque(p, np.array([0.0, PAPER_K * K_DEG]))
         np.testing.assert_allclose(got, [t0, tk], rtol=1e-3)
-        assert abs(got[0] - 22.25) / 22.25 > 5  # two orders of magnitude from 000's figure
-    assert constraint_violations(_problem(), 0.0018 * K_DEG)
+        assert abs(got[0] - PAPER_TORQUE_K0) / PAPER_TORQUE_K0 > 5  # two orders of magnitude from 000's figure
+    assert constraint_violations(_problem(), PAPER_K * K_DEG)
 
 
 # -- feasible k for a batch of halt configurations ------------------------------------------------
@@ -225,7 +230,7 @@ def _at_rest(**kw):
     """A halt from rest at 0 to 0: no motion, no base torque at any k = 0."""
     model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
     z = np.zeros(6)
-    return HaltProblem(model, z, z, z, z, 10.0, 40 * DEG, 20 * DEG, n_samples=101, n_check=201, **kw)
+    return HaltProblem(model, z, z, z, z, 10.0, VMAX, AMAX, n_samples=101, n_check=201, **kw)
 
 
 def test_reduction_is_nan_without_torque_at_k0():
@@ -288,7 +293,7 @@ def test_impossible_start_has_no_minimum_halt_time_at_once():
     ddq0 = DDQ0.copy()
     ddq0[2] = 30 * DEG  # above the 20 deg/s^2 limit at t = 0, whatever T and k
     model = jl.lock(jl.robots.halt7(base="floating"), 4, 0.0)
-    p = HaltProblem(model, Q0, DQ0, ddq0, QF_PAPER, 10.0, 40 * DEG, 20 * DEG, n_samples=101, n_check=401)
+    p = HaltProblem(model, Q0, DQ0, ddq0, QF_PAPER, T000, VMAX, AMAX, n_samples=101, n_check=401)
     import time
 
     t0 = time.perf_counter()
@@ -424,7 +429,7 @@ def test_halt7_limits_and_result_unchanged(capsys):
     assert data["velocity_limit_deg_s"] == pytest.approx([40.0] * 6)
     assert data["acceleration_limit_deg_s2"] == pytest.approx([20.0] * 6)
     assert data["velocity_limit_source"] == ["model's limit"] * 6
-    assert not data["feasible"] and data["paper"]["k"] == 0.0018
+    assert not data["feasible"] and data["paper"]["k"] == PAPER_K
 
 
 def test_unlimited_joint_has_no_angle_constraint():
@@ -433,7 +438,7 @@ def test_unlimited_joint_has_no_angle_constraint():
     q_min[1], q_max[1] = -math.inf, math.inf
     qf = np.radians([-170, -90, 40, -158, 90, -62])
     p = HaltProblem(
-        model, Q0, DQ0, DDQ0, qf, 12.0, 40 * DEG, 20 * DEG, q_min=q_min, q_max=q_max, n_samples=101
+        model, Q0, DQ0, DDQ0, qf, 12.0, VMAX, AMAX, q_min=q_min, q_max=q_max, n_samples=101
     )
     per = feasible_k_intervals(p)
     assert not np.any(np.isnan(per))
@@ -443,7 +448,7 @@ def test_unlimited_joint_has_no_angle_constraint():
     res = optimal_halt_motion(p, n_scan=21)
     assert all(not (v.joint == 2 and v.kind == "angle") for v in res.violations)
     with pytest.raises(jl.ScenarioError, match="not NaN"):
-        HaltProblem(model, Q0, DQ0, DDQ0, qf, 12.0, 40 * DEG, 20 * DEG, q_min=np.full(6, np.nan))
+        HaltProblem(model, Q0, DQ0, DDQ0, qf, 12.0, VMAX, AMAX, q_min=np.full(6, np.nan))
 
 
 def test_halt_of_a_model_with_a_continuous_joint(capsys):
@@ -475,16 +480,16 @@ def test_halt_of_a_model_with_a_continuous_joint(capsys):
 
 
 def _figures(monkeypatch):
-    import jointlock.report as report
+    import jointlock.jobs.halt as halt_job  # HaltPlan.write renders its figures there
 
     figs = []
-    real = report.figure_png
+    real = halt_job.figure_png
 
     def keep(fig, *a, **kw):
         figs.append(fig)
         return real(fig, *a, **kw)
 
-    monkeypatch.setattr(report, "figure_png", keep)
+    monkeypatch.setattr(halt_job, "figure_png", keep)
     return figs
 
 
@@ -516,7 +521,7 @@ def test_paper_numbers_only_for_the_paper_scenario(capsys):
 
     base = ["halt", "halt7", "--paper-qf", "--n-samples", "101", "--quiet"]
     assert main(base) == 0
-    assert "000 printed: k = 0.0018" in capsys.readouterr().out
+    assert f"000 printed: k = {PAPER_K:g}" in capsys.readouterr().out
     for extra in (["--T", "12"], ["--ddq0-deg", "8", "10", "12", "10", "-8", "0"], ["--lock", "3=0"]):
         argv = base + extra
         if extra[0] == "--lock":

@@ -19,6 +19,7 @@ from jointlock.ik import (
     wrap_angle,
     zyx_angles,
 )
+from jointlock.papers import p002
 from jointlock.spatial import pose_error, rot_x, translation
 
 #: Round trips away from singularities: round-off only [m], [rad].
@@ -31,15 +32,10 @@ PRINT4_DEG = 0.5e-4 + 1e-9
 LOCK_ANGLES = {1: 0.7, 2: 0.9, 3: -1.1, 4: 0.4, 5: -2.0, 6: 1.3}
 
 # 002, §"The straight trajectory planning ... (fault-tolerant attitude error <= 10 deg)":
-Q_FINAL_DEG = [5, 60, 65, 10, -120, 90]
-EQ22_DEG = [10.5789, 52.0547, 66.1915, 8.5610, -124.0978, 82.7611]
-EQ21 = np.array(
-    [
-        [0.0134, -0.9966, -0.0819, -98.3390],
-        [0.9897, 0.0249, -0.1407, -66.2696],
-        [0.1422, -0.0792, 0.9867, -37.8197],
-    ]
-)
+# the terminal configuration, eq. (22) and eq. (21) (rotation, position [mm]; 4 decimals).
+Q_FINAL_DEG = p002.B_QF_DEG
+EQ22_DEG = p002.EQ22_DEG
+EQ21 = np.array(p002.EQ21_POSE)[:3]
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +45,7 @@ def puma() -> jl.ArmModel:
 
 def _eq21_target(model: jl.ArmModel) -> np.ndarray:
     """002's eq. (21) target: FK(q_f) rotated by gamma = -10 deg about the tool x axis."""
-    return jl.ee_pose(model, np.radians(Q_FINAL_DEG)) @ rot_x(math.radians(-10.0))
+    return jl.ee_pose(model, np.radians(Q_FINAL_DEG)) @ rot_x(math.radians(p002.B_GAMMA_DEG))
 
 
 def _contains(branches: np.ndarray, q: np.ndarray, mask: np.ndarray) -> np.ndarray:
@@ -71,7 +67,7 @@ def test_eq22_is_a_branch_of_the_full_ik_of_eq21(puma):
 @pytest.mark.paper
 def test_eq22_from_the_locked_arm_closed_form(puma):
     """002 step 6: the 5-DOF IK with theta2 = 52.0547 deg of the eq. (21) pose gives eq. (22)."""
-    locked = jl.lock(puma, 2, math.radians(52.0547))
+    locked = jl.lock(puma, 2, math.radians(p002.B_LOCK_DEG))
     res = ik_closed_form(locked, _eq21_target(puma))
     d = np.abs(np.degrees(res.q_full) - EQ22_DEG).max(axis=-1)
     best = int(np.argmin(d))
@@ -85,7 +81,7 @@ def test_eq21_pose_and_euler_convention(puma):
     t = jl.ee_pose(puma, np.radians(EQ22_DEG))
     assert np.abs(t[:3, :3] - EQ21[:, :3]).max() <= 0.5e-4 + 1e-6  # 4 printed decimals
     assert np.abs(t[:3, 3] * 1e3 - EQ21[:, 3]).max() <= 0.5e-4
-    assert np.allclose(zyx_angles(t[:3, :3]), [1.5573, -0.1427, -0.0801], atol=0.5e-4)
+    assert np.allclose(zyx_angles(t[:3, :3]), p002.EXAMPLES["E5"].euler_zyx, atol=0.5e-4)  # after eq. (22)
     back = pose_from_zyx(t[:3, 3], zyx_angles(t[:3, :3]))
     assert np.allclose(back, t, atol=1e-12)
 

@@ -12,6 +12,7 @@ import pytest
 import jointlock as jl
 from jointlock.cli import main as cli_main
 from jointlock.derivatives import jacobian_derivatives
+from jointlock.jobs.reproduce import notes_001_task
 from jointlock.planning.jump import (
     JumpScenario,
     cartesian_trapezoid,
@@ -38,6 +39,13 @@ SHORT = JumpScenario(duration=3.0, blend=0.75, dx=(0.1, -0.125, 0.07))
 @pytest.fixture(scope="module")
 def arm():
     return jl.load_robot("canadarm7")
+
+
+def test_default_scenario_is_notes_001_task():
+    """JumpScenario's defaults are NOTES-001's task (jointlock.papers.p001.TASK; 001's own
+    numbers were lost), the task ``jointlock reproduce`` runs."""
+    assert JumpScenario() == notes_001_task()
+    assert JumpScenario(duration=6.0) != notes_001_task()
 
 
 def test_trapezoid_endpoints_and_continuity():

@@ -14,32 +14,15 @@ import numpy as np
 import pytest
 
 import jointlock as jl
+from jointlock.papers import p002
 
 pytestmark = pytest.mark.paper
 
-# (q [deg], position [mm], ZYX Euler [rad], printed decimals)
-EXAMPLES = [
-    ([0, 60, 30, 10, -80, 30], [-206.16, -65.32, -482.55], [0.54, 0.06, 0.23], 2),
-    ([5, 60, 65, 10, -120, 90], [-98.33, -66.26, -37.81], [1.55, -0.14, 0.09], 2),
-    ([0, 30, 30, 10, -80, 30], [62.7315, -65.3258, -520.9870], [0.5931, -0.3826, -0.0452], 4),
-    ([5, 60, 65, 10, -120, 90], [-98.3390, -66.2696, -37.8197], [1.5573, -0.1427, 0.0945], 4),
-    (
-        [10.5789, 52.0547, 66.1915, 8.5610, -124.0978, 82.7611],
-        [-98.3390, -66.2696, -37.8197],
-        [1.5573, -0.1427, -0.0801],
-        4,
-    ),
-]
+#: 002's worked examples E1-E5 (q [deg], position [mm], ZYX Euler [rad], printed decimals).
+EXAMPLES = p002.EXAMPLES
 
 #: Eq. (21): the target pose of the 52.0547 deg example (rotation and mm), 4 decimals.
-EQ21 = np.array(
-    [
-        [0.0134, -0.9966, -0.0819, -98.3390],
-        [0.9897, 0.0249, -0.1407, -66.2696],
-        [0.1422, -0.0792, 0.9867, -37.8197],
-        [0, 0, 0, 1],
-    ]
-)
+EQ21 = np.array(p002.EQ21_POSE)
 
 
 def zyx_euler(rot: np.ndarray) -> np.ndarray:
@@ -48,7 +31,7 @@ def zyx_euler(rot: np.ndarray) -> np.ndarray:
     )
 
 
-@pytest.mark.parametrize("q_deg, position_mm, euler, decimals", EXAMPLES)
+@pytest.mark.parametrize("q_deg, position_mm, euler, decimals", list(EXAMPLES.values()), ids=list(EXAMPLES))
 def test_printed_example(q_deg, position_mm, euler, decimals):
     pose = jl.ee_pose(jl.load_robot("puma6"), np.radians(q_deg))
     ours_pos = pose[:3, 3] * 1000.0
@@ -63,7 +46,7 @@ def test_printed_example(q_deg, position_mm, euler, decimals):
 
 
 def test_eq22_joints_give_eq21_pose():
-    pose = jl.ee_pose(jl.load_robot("puma6"), np.radians(EXAMPLES[-1][0]))
+    pose = jl.ee_pose(jl.load_robot("puma6"), np.radians(p002.EQ22_DEG))
     ours = pose.copy()
     ours[:3, 3] *= 1000.0
     # eq. (22) itself is rounded to 1e-4 deg; that moves the rotation entries by < 1e-5
@@ -84,6 +67,6 @@ def test_the_other_readings_do_not_reproduce_002():
         theta=deg([90, 0, 90, 0, 0, 0]),
         convention="standard",
     )
-    q_deg, position_mm, _, _ = EXAMPLES[2]
+    q_deg, position_mm, _, _ = EXAMPLES["E3"]
     error = np.linalg.norm(jl.ee_pose(offsets, deg(q_deg))[:3, 3] * 1000 - position_mm)
     assert error > 100.0

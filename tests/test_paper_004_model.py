@@ -14,11 +14,13 @@ import pytest
 from conftest import random_q
 
 import jointlock as jl
+from jointlock.papers import p004
 
 pytestmark = pytest.mark.paper
 
-PRINTED_VIRTUAL = {"a": 0.38, "c": 0.39, "d": 2.15, "e": 2.33, "f": 0.48, "h": 0.49, "k": 0.5}
-HALF_UNIT = 0.005
+#: 004 §5's printed virtual lengths [m] and half a unit of their last printed digit [m].
+PRINTED_VIRTUAL = p004.VIRTUAL_LENGTHS
+HALF_UNIT = 0.5 * 10.0**-p004.VIRTUAL_LENGTH_DECIMALS
 
 
 def test_virtual_lengths_reproduce_004_with_its_segment_weighting():

@@ -32,27 +32,17 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from scipy.optimize import brentq, fsolve
 
 import jointlock as jl
 from jointlock.analysis import singularity as sg
+from jointlock.jobs.reproduce import solve_table3  # Table 3's angles re-solved, unrounded
+from jointlock.papers import p004
 
 pytestmark = pytest.mark.paper
 
-TABLE3_DEG = {
-    "cond1": [25, 0, 90, 0, 45, 90, 0],
-    "cond2": [25, 0, 34, 30, 45, 0, 0],
-    "cond3": [25, 0, 20, 140, -139.1, 45, 0],
-    "cond4": [25, 10, -132.9, 140, 20, 0, 0],
-    "cond5": [25, 10, 24, 180, -44.9, 45, 0],
-}
-TABLE3_DET = {
-    "cond1": -1.06608e-14,
-    "cond2": -6.80933e-14,
-    "cond3": 2.43766e-30,
-    "cond4": 2.97193e-12,
-    "cond5": -1.60952e-16,
-}
+#: Table 3's printed configurations [deg] and det(Ĵm Ĵmᵀ).
+TABLE3_DEG = p004.TABLE3_DEG
+TABLE3_DET = p004.TABLE3_DET
 #: |det(Ĵm Ĵmᵀ)| below which a configuration counts as singular: the paper's largest printed
 #: value is 2.97e-12; random configurations give >= 2e-5 (10^4 samples).
 DET_SINGULAR = 1e-11
@@ -70,26 +60,9 @@ def lengths(arm):
     return sg.arm_lengths(arm)
 
 
-def solve_table3(name: str, lengths: sg.ArmLengths) -> np.ndarray:
-    """Table 3's configuration for ``name`` with its length equation solved exactly."""
-    q = np.radians(np.array(TABLE3_DEG[name], dtype=float))
-
-    def eqs(qq):
-        return sg.condition_equations(qq, lengths)[name]
-
-    if name == "cond3":  # theta5 from d C3 + e C34 + h S345 = 0
-        q[4] = brentq(lambda x: eqs(np.r_[q[:4], x, q[5:]])[1], q[4] - 0.05, q[4] + 0.05, xtol=1e-15)
-    elif name == "cond4":  # theta3 from e C5 + d C45 - a S345 = 0
-        q[2] = brentq(lambda x: eqs(np.r_[q[:2], x, q[3:]])[1], q[2] - 0.05, q[2] + 0.05, xtol=1e-15)
-    elif name == "cond5":  # theta3, theta5 at theta4 = 180 deg
-        q[2], q[4] = fsolve(lambda v: eqs(np.r_[q[:2], v[0], q[3], v[1], q[5:]]), q[[2, 4]], xtol=1e-13)
-    return q
-
-
 def test_virtual_lengths_are_004s(lengths):
-    printed = {"a": 0.38, "c": 0.39, "d": 2.15, "e": 2.33, "f": 0.48, "h": 0.49, "k": 0.5}
-    for k, v in printed.items():
-        assert getattr(lengths, k) == pytest.approx(v, abs=0.005)
+    for k, v in p004.VIRTUAL_LENGTHS.items():
+        assert getattr(lengths, k) == pytest.approx(v, abs=0.005)  # half a unit of 2 decimals
 
 
 @pytest.mark.parametrize("name", sg.CONDITIONS)

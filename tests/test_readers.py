@@ -10,6 +10,7 @@ import pytest
 from conftest import EXACT_ATOL, random_q
 
 import jointlock as jl
+from jointlock.papers import p000
 
 DATA = Path(__file__).parent / "data"
 
@@ -188,8 +189,8 @@ def test_halt7_default_reading_keeps_000s_halt_configurations_regular():
     is added, regular under the default reading (the test that chose the default)."""
     from jointlock.robots import halt7
 
-    q_best = np.radians([-167, -90, 40, -158, 90, -62])
-    q_sub = np.radians([-52, 90, 84, 148, -90, 157])
+    q_best = np.radians(p000.Q_BEST_DEG)
+    q_sub = np.radians(p000.Q_SUB_DEG)
     for offsets, singular in ((True, True), (False, False)):
         model = jl.lock(halt7(theta_offsets=offsets), 4, 0.0)
         for q in (q_best, q_sub):

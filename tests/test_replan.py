@@ -15,6 +15,7 @@ import jointlock as jl
 from jointlock.cli import main
 from jointlock.errors import ConfigurationError, ModelError
 from jointlock.ik import ik_closed_form, wrap_angle
+from jointlock.papers import p002
 from jointlock.planning.replan import (
     ReplanResult,
     absorbable_range,
@@ -32,11 +33,11 @@ PRINT4_DEG = 0.5e-4 + 1e-9
 ROOT_TOL = 1e-10
 
 # 002 §"The analysis of fault tolerance under a single joint failure" (Figs. 5-8)
-QD_A = np.radians([5, 60, 35, 10, -120, 90])
-PRINTED_QA = [5.18, 59.40, 35.51, 9.89, -121.40, 89.76]
+QD_A = np.radians(p002.A_QF_DEG)
+PRINTED_QA = p002.A_Q_AT_GAMMA_DEG
 # 002 §"... (fault-tolerant attitude error <= 10 deg)", eqs. (21)-(22)
-QD_B = np.radians([5, 60, 65, 10, -120, 90])
-EQ22_DEG = [10.5789, 52.0547, 66.1915, 8.5610, -124.0978, 82.7611]
+QD_B = np.radians(p002.B_QF_DEG)
+EQ22_DEG = p002.EQ22_DEG
 
 
 @pytest.fixture(scope="module")
@@ -52,13 +53,14 @@ def sweep_a(puma):
 @pytest.mark.paper
 def test_fig5_fig6_absorbable_ranges(sweep_a):
     """002: joint 2 compensates '48 deg to 123 deg' over +-180 deg, '59.2 to 60.8 deg' over +-2 deg."""
-    wide = absorbable_range(sweep_a, 2, math.pi)
-    narrow = absorbable_range(sweep_a, 2, math.radians(2.0))
+    wide = absorbable_range(sweep_a, 2, math.radians(p002.A_WIDE_GAMMA_DEG))
+    narrow = absorbable_range(sweep_a, 2, math.radians(p002.A_NARROW_GAMMA_DEG))
+    (lo, hi), (lo2, hi2) = p002.A_WIDE_RANGE_DEG, p002.A_NARROW_RANGE_DEG
     # ours 47.35 .. 123.23 deg; 002's "48" is read off Fig. 5 (1-deg digits, +-1 deg)
-    assert abs(math.degrees(wide.lower) - 48.0) < 1.0
-    assert round(math.degrees(wide.upper)) == 123
-    assert round(math.degrees(narrow.lower), 1) == 59.2
-    assert round(math.degrees(narrow.upper), 1) == 60.8
+    assert abs(math.degrees(wide.lower) - lo) < 1.0
+    assert round(math.degrees(wide.upper)) == hi
+    assert round(math.degrees(narrow.lower), 1) == lo2
+    assert round(math.degrees(narrow.upper), 1) == hi2
 
 
 @pytest.mark.paper
@@ -68,12 +70,12 @@ def test_gamma_for_joint2_locked_at_59_4(puma):
     The exact root is gamma = -1.4694 deg; 002's vector is the IK at gamma = -1.45 deg
     exactly, truncated to 2 decimals (theta2 = 59.4079 there)."""
     target = jl.ee_pose(puma, QD_A)
-    roots = gammas_for_lock(puma, target, 2, math.radians(59.4), q_ref=QD_A)
+    roots = gammas_for_lock(puma, target, 2, math.radians(p002.A_LOCK_DEG), q_ref=QD_A)
     best = roots[0]
     assert math.degrees(best.gamma) == pytest.approx(-1.4694, abs=1e-4)
-    assert abs(math.degrees(best.gamma) - (-1.45)) < 0.02
-    assert abs(best.q_full[1] - math.radians(59.4)) < ROOT_TOL
-    res = ik_closed_form(puma, tool_x_rotation(target, math.radians(-1.45)))
+    assert abs(math.degrees(best.gamma) - p002.A_GAMMA_DEG) < 0.02
+    assert abs(best.q_full[1] - math.radians(p002.A_LOCK_DEG)) < ROOT_TOL
+    res = ik_closed_form(puma, tool_x_rotation(target, math.radians(p002.A_GAMMA_DEG)))
     q = np.degrees(res.q_full[best.branch])
     assert np.array_equal(np.trunc(q * 100) / 100, PRINTED_QA)
 
@@ -82,18 +84,18 @@ def test_gamma_for_joint2_locked_at_59_4(puma):
 def test_gamma_minus_10_gives_eq21_eq22(puma):
     """002: joint 2 locked at 52.0547 deg, tolerance -10 deg -> eq. (21) pose and eq. (22)."""
     target = jl.ee_pose(puma, QD_B)
-    roots = gammas_for_lock(puma, target, 2, math.radians(52.0547), q_ref=QD_B)
+    roots = gammas_for_lock(puma, target, 2, math.radians(p002.B_LOCK_DEG), q_ref=QD_B)
     best = roots[0]
-    assert round(math.degrees(best.gamma), 4) == -10.0
+    assert round(math.degrees(best.gamma), 4) == p002.B_GAMMA_DEG
     # the printed lock angle is theta2(-10 deg) = 52.054712 deg rounded, so the exact root
     # sits 1.5e-5 deg away and moves the other joints by < 1e-4 deg ...
     assert np.abs(np.degrees(best.q_full) - EQ22_DEG).max() < 1e-4
     # ... while the IK at gamma = -10 deg exactly is eq. (22) to every printed digit
-    exact = ik_closed_form(puma, tool_x_rotation(target, math.radians(-10.0)))
+    exact = ik_closed_form(puma, tool_x_rotation(target, math.radians(p002.B_GAMMA_DEG)))
     assert np.abs(np.degrees(exact.q_full[best.branch]) - EQ22_DEG).max() <= PRINT4_DEG
     sweep = gamma_sweep(puma, target, np.radians(np.linspace(-10, 10, 201)), q_ref=QD_B)
     rng10 = absorbable_range(sweep, 2, math.radians(10.0))
-    assert math.degrees(rng10.lower) == pytest.approx(52.0547, abs=PRINT4_DEG)
+    assert math.degrees(rng10.lower) == pytest.approx(p002.B_LOCK_DEG, abs=PRINT4_DEG)
 
 
 def test_sweep_batched_equals_single_calls(puma, sweep_a):
@@ -136,21 +138,21 @@ def test_replan_line_exact_when_lock_matches(puma):
 
 
 def test_replan_tolerance_absorbs_more(puma):
-    locked = jl.lock(puma, 2, math.radians(52.0547))
-    start = jl.ee_pose(puma, np.radians([0, 30, 30, 10, -80, 30]))
+    locked = jl.lock(puma, 2, math.radians(p002.B_LOCK_DEG))
+    start = jl.ee_pose(puma, np.radians(p002.B_Q0_DEG))
     goal = jl.ee_pose(puma, QD_B)
     strict = replan_line(locked, start, goal, steps=30, q_ref=QD_B)
     loose = replan_line(locked, start, goal, steps=30, gamma_tolerance=math.radians(10.5), q_ref=QD_B)
     assert loose.absorbed.sum() > strict.absorbed.sum()
     assert np.all(np.abs(loose.gamma) <= math.radians(10.5) + 1e-12)
     assert loose.position_error[loose.absorbed].max() < 1e-9
-    assert math.degrees(loose.gamma[-1]) == pytest.approx(-10.0, abs=1e-4)
+    assert math.degrees(loose.gamma[-1]) == pytest.approx(p002.B_GAMMA_DEG, abs=1e-4)
     assert np.abs(np.degrees(wrap_angle(loose.q_full[-1])) - EQ22_DEG).max() < 1e-4
 
 
 # 002 §"... (fault-tolerant attitude error <= 10 deg)": the line whose pointwise plan jumps
-Q0_B = np.radians([0, 30, 30, 10, -80, 30])
-LOCK_B = math.radians(52.0547)
+Q0_B = np.radians(p002.B_Q0_DEG)
+LOCK_B = math.radians(p002.B_LOCK_DEG)
 
 
 @pytest.fixture(scope="module")
@@ -202,7 +204,7 @@ def test_continuous_plan_of_002_second_example_has_no_jump(plans_b):
     assert np.all(np.abs(res.gamma) <= math.radians(10.0) + 1e-12)
     # the goal is the pose of eq. (21) on eq. (22)'s branch (the exact root -10.000015 deg is
     # 1.5e-5 deg outside the tolerance, so gamma = -10 deg and the arm misses by < 1e-7 m)
-    assert math.degrees(res.gamma[-1]) == pytest.approx(-10.0, abs=1e-9)
+    assert math.degrees(res.gamma[-1]) == pytest.approx(p002.B_GAMMA_DEG, abs=1e-9)
     assert np.abs(np.degrees(wrap_angle(res.q_full[-1])) - EQ22_DEG).max() < 1e-4
     assert res.absorbed[-1] and res.position_error[-1] < 1e-7
 

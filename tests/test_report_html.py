@@ -32,7 +32,7 @@ CHROMIUM_FLAGS = [
 
 @pytest.fixture(scope="module")
 def report(tmp_path_factory) -> Path:
-    from jointlock.cli.run import run_scenario
+    from jointlock.run import run_scenario
 
     out = tmp_path_factory.mktemp("run")
     # 000's own, unconstrained halt-configuration search: its halt breaks limits, so the
@@ -41,7 +41,7 @@ def report(tmp_path_factory) -> Path:
         EXAMPLES / "halt_000.toml",
         {"halt_config.samples": 2000, "halt.n_samples": 101, "halt_config.reachable": False},
     )
-    run_scenario(sc, out, quiet=True)
+    run_scenario(sc).write(out)
     return out / "report.html"
 
 

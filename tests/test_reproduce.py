@@ -1,14 +1,20 @@
-"""``jointlock reproduce --json`` has a row for every headline figure of the four seeds."""
+"""``jointlock reproduce --json`` has a row for every headline figure of the four seeds; the
+library call behind it (:func:`jointlock.jobs.reproduce.reproduce`) gives the same table, and
+the papers' values in it are :mod:`jointlock.papers`'s."""
 
 from __future__ import annotations
 
 import contextlib
 import io
 import json
+import pickle
 
 import pytest
 
 from jointlock.cli import main
+from jointlock.errors import ScenarioError
+from jointlock.jobs.reproduce import ReproductionReport, ReproductionRow, reproduce
+from jointlock.papers import p000, p002, p004
 
 #: Headline figures (row keys) per seed: 000 §5 (CP, gain, torques, k*, feasibility); 001 (no
 #: numbers survived: ours only); 002 (worked examples, eq. 21/22, ranges, gamma, q at gamma);
@@ -72,3 +78,76 @@ def test_text_table_for_one_paper():
     text = out.getvalue()
     assert text.startswith("| paper | quantity | paper's value | ours | agreement |")
     assert "| 002 |" in text and "| 000 |" not in text
+
+
+# -- the library call ---------------------------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def report_002() -> ReproductionReport:
+    return reproduce("002")
+
+
+def _cli(argv: list[str]) -> str:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert main(argv) == 0
+    return out.getvalue()
+
+
+def _untimed(lines: list[str]) -> list[str]:
+    """The printed lines without the one giving each paper's wall time."""
+    return [line for line in lines if "ours only; " not in line]
+
+
+def test_library_equals_cli(report_002):
+    cli = json.loads(_cli(["reproduce", "--paper", "002", "--json"]))
+    ours = report_002.plain()
+    assert set(cli["elapsed_s"]) == set(ours["elapsed_s"]) == {"002"}
+    cli.pop("elapsed_s"), ours.pop("elapsed_s")
+    assert ours == cli
+    text = _cli(["reproduce", "--paper", "002"]).splitlines()
+    assert _untimed(report_002.summary()) == _untimed(text)
+    assert len(report_002.summary()) == len(text)
+    totals = [line for line in report_002.summary() if "ours only; " in line]
+    assert totals == [f"11 reproduced, 0 not reproduced, 0 ours only; 002: {report_002.elapsed_s[0]:.1f} s"]
+
+
+def test_report_is_picklable_and_writes_its_json(report_002, tmp_path):
+    back = pickle.loads(pickle.dumps(report_002))
+    assert back.to_dict() == report_002.to_dict() and back.summary() == report_002.summary()
+    assert report_002.write(tmp_path) == ["result.json"]
+    assert json.loads((tmp_path / "result.json").read_text()) == report_002.plain()
+    assert isinstance(report_002.rows[0], ReproductionRow) and report_002.job == "reproduce"
+
+
+def test_papers_run_in_table_order_and_unknown_ones_are_refused(monkeypatch):
+    import jointlock.jobs.reproduce as rep
+
+    for paper in rep.PAPERS:  # stand-ins: one row per paper, no experiment
+        row = ReproductionRow(paper, "k", "q", "1", "1", "reproduced")
+        monkeypatch.setitem(rep.PAPER_ROWS, paper, lambda row=row: [row])
+    got = reproduce(["004", "000", "004"])
+    assert got.papers == ("000", "004") and [r.paper for r in got.rows] == ["000", "004"]
+    assert [n[:3] for n in got.notes] == ["000", "004"] and len(got.elapsed_s) == 2
+    with pytest.raises(ScenarioError, match="papers must name some of 000, 001, 002, 004; unknown: '003'"):
+        reproduce(["002", "003"])
+    with pytest.raises(ScenarioError, match="got none"):
+        reproduce([])
+
+
+def test_paper_values_are_the_papers_constants(table, report_002):
+    value = {(r["paper"], r["key"]): r["paper_value"] for r in table["rows"]}
+    assert value["000", "cp_q_sub"] == f"{p000.CP_Q_SUB:g}"
+    assert value["000", "cp_gain"] == f"{100 * p000.CP_GAIN:+.1f} %"
+    assert value["000", "torque_k0"] == f"{p000.HALT_RESULTS['global_torque_k0_Nm']:g}"
+    assert value["000", "torque_reduction"] == f"{-100 * p000.HALT_RESULTS['reduction']:+.1f} %"
+    assert value["002", "q_at_gamma"] == str(list(p002.A_Q_AT_GAMMA_DEG))
+    assert value["002", "eq22"] == str(list(p002.EQ22_DEG))
+    for name, printed in p004.VIRTUAL_LENGTHS.items():
+        assert value["004", f"virtual_{name}"] == f"{printed:g}"
+    for name, det in p004.TABLE3_DET.items():
+        assert float(value["004", f"table3_{name}"]) == det
+    assert report_002.row("002", "gamma").paper_value == f"{p002.A_GAMMA_DEG:g}"
+    with pytest.raises(KeyError):
+        report_002.row("000", "cp_q_sub")

@@ -162,8 +162,12 @@ def test_halt_report_labels_limits_and_the_000_note(tmp_path):
 
 
 def test_000_note_only_for_000s_scenario(tmp_path):
-    from jointlock.cli.run import _model, assumptions, is_000_case
+    from jointlock.robots import load_robot
+    from jointlock.run._report import assumptions, is_000_case
     from jointlock.scenario import load_scenario
+
+    def _model(sc):
+        return load_robot(sc.data["robot"]), None
 
     for angle, expected in ((0.0, True), (10.0, False)):
         path = tmp_path / f"s{angle:g}.toml"
@@ -179,7 +183,7 @@ def test_000_note_only_for_000s_scenario(tmp_path):
 
 
 def test_halt_k_label_by_feasibility():
-    from jointlock.cli.run import halt_k_label
+    from jointlock.run._report import halt_k_label
 
     assert halt_k_label({"k": 0.00105573, "feasible": True}) == "k* = 0.00106 deg/s^6 (feasible)"
     label = halt_k_label({"k": [0.02], "feasible": False})
@@ -187,7 +191,7 @@ def test_halt_k_label_by_feasibility():
 
 
 def test_singular_report_verdicts_and_no_failure(tmp_path):
-    from jointlock.cli.run import _condition_verdict
+    from jointlock.run._report import _condition_verdict
 
     assert _condition_verdict("cond1f", True) == "sufficient (ours)"
     assert _condition_verdict("cond2", True) == "reproduced"

@@ -9,11 +9,18 @@ Quick start::
     crippled = jl.lock(arm, joint=4, angle=0.0)  # joints numbered from 1, as in the papers
     q = np.zeros((1000, crippled.dof))           # any leading batch shape
     J = jl.jacobian(crippled, q)                 # (1000, 6, 6), twist order (v, omega)
+
+    plan = jl.plan_halt("halt7")                 # 000's whole halt strategy, typed result
+    plan.summary(); plan.to_dict(); plan.write("out/halt")
+
+    run = jl.run_scenario(jl.load_scenario("examples/halt_000.toml"))  # every job, in-process
+    run.write("out/halt_000")                    # results.json, CSV, figures, report.html
 """
 
 from __future__ import annotations
 
 from . import io
+from ._version import __version__
 from .dh import from_dh
 from .dynamics import (
     InverseDynamics,
@@ -54,8 +61,6 @@ from .locking import lock, lock_joints
 from .model import ArmModel, Body, Joint, LockedJoint, as_joint_array
 from .robots import BUILTIN_ROBOTS, load_robot
 
-__version__ = "0.1.0"
-
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).
 _LAZY = {
     "kinematic_indices": "jointlock.analysis.ability",
@@ -80,19 +85,37 @@ _LAZY = {
     "gammas_for_lock": "jointlock.planning.replan",
     "replan_line": "jointlock.planning.replan",
     "compare_workspaces": "jointlock.analysis.workspace",
+    # jobs: one call per job, typed results with to_dict() / summary() / write()
+    "plan_halt": "jointlock.jobs.halt",
+    "HaltPlan": "jointlock.jobs.halt",
+    "FailureState": "jointlock.jobs.halt",
+    "JointLimits": "jointlock.jobs.halt",
+    "halt_limits": "jointlock.jobs.halt",
+    # scenarios in-process
+    "load_scenario": "jointlock.scenario",
+    "scenario_from_dict": "jointlock.scenario",
+    "Scenario": "jointlock.scenario",
+    "run_scenario": "jointlock.run",
+    "RunResult": "jointlock.run",
+    "run_demo": "jointlock.run._demo",
 }
+
+#: Subpackages reachable as attributes (``jl.plots``, ``jl.jobs``, ``jl.papers``), imported on first use.
+_LAZY_MODULES = ("plots", "jobs", "papers", "run", "report", "scenario", "analysis", "planning")
 
 
 def __getattr__(name: str):
-    if name in _LAZY:
-        import importlib
+    import importlib
 
+    if name in _LAZY:
         return getattr(importlib.import_module(_LAZY[name]), name)
+    if name in _LAZY_MODULES:
+        return importlib.import_module(f"{__name__}.{name}")
     raise AttributeError(f"module 'jointlock' has no attribute {name!r}")
 
 
 def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_MODULES))
 
 
 __all__ = [

@@ -32,7 +32,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .errors import ConfigurationError
-from .kinematics import ChainState, chain_state, generalized_jacobian, jacobian
+from .kinematics import ChainState, chain_state, generalized_jacobian, jacobian, state_at
 from .model import ArmModel, FloatArray, as_joint_array
 
 #: Rows of the 6 x n Jacobian that hold the linear velocity (seed 001's position-only task).
@@ -78,7 +78,9 @@ def linear_jacobian_derivatives(axes: FloatArray, jac_lin: FloatArray) -> FloatA
     return np.swapaxes(dlin, -1, -2)
 
 
-def jacobian_derivatives(model: ArmModel, q: ArrayLike, *, state: ChainState | None = None) -> FloatArray:
+def jacobian_derivatives(
+    model: ArmModel, q: ArrayLike | None, *, state: ChainState | None = None
+) -> FloatArray:
     """Closed-form derivative of the geometric Jacobian with respect to every joint angle.
 
     Parameters
@@ -88,7 +90,9 @@ def jacobian_derivatives(model: ArmModel, q: ArrayLike, *, state: ChainState | N
     q
         (..., n) joint angles [rad].
     state
-        Precomputed :func:`jointlock.kinematics.chain_state` for ``q`` (optional).
+        Precomputed :func:`jointlock.kinematics.chain_state` at ``q`` (optional); it must
+        have been computed at ``q`` (see :func:`jointlock.kinematics.state_at`), and with it
+        ``q=None`` means ``state.q``.
 
     Returns
     -------
@@ -97,8 +101,8 @@ def jacobian_derivatives(model: ArmModel, q: ArrayLike, *, state: ChainState | N
     the end-effector origin (same convention as :func:`jointlock.jacobian`).  NOTES-001:
     ``dJ_k/dq_i = z_i x J_k`` (i <= k), ``z_k x J_i`` (i > k) for the linear part.
     """
-    s = chain_state(model, q) if state is None else state
-    jac = jacobian(model, q, state=s)
+    s = state_at(model, q, state)
+    jac = jacobian(model, s.q, state=s)
     n = model.dof
     z = s.axes  # (..., n, 3)
     dlin = linear_jacobian_derivatives(z, jac[..., :3, :])  # (..., i, 3, k)

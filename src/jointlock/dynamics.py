@@ -9,20 +9,21 @@ and the wrench the arm exerts on its base, with the base held fixed (000) or fre
 
 from __future__ import annotations
 
-import weakref
 from dataclasses import dataclass
 from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._chain import SYM, composite, link_constants
+from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
 from .errors import ModelError
-from .kinematics import ChainState, _world_inertias, chain_state, com_jacobians, com_positions
+from .kinematics import ChainState, _world_inertias, com_jacobians, com_positions, state_at
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import skew
 
 
-def mass_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+def mass_matrix(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
     """Joint-space mass matrix of the arm on a fixed base.
 
     ``M(q) = sum_i m_i Jv_i^T Jv_i + Jw_i^T I_i Jw_i`` over the links (root body excluded).
@@ -31,13 +32,17 @@ def mass_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) 
     ----------
     q
         (..., n) joint angles [rad].
+    state
+        Precomputed :func:`jointlock.kinematics.chain_state` at ``q`` (optional); it must
+        have been computed at ``q`` (see :func:`jointlock.kinematics.state_at`), and with it
+        ``q=None`` means ``state.q``.
 
     Returns
     -------
     (..., n, n) [kg m^2], symmetric positive definite when every link has mass and inertia.
     """
-    s = chain_state(model, q) if state is None else state
-    jcom = com_jacobians(model, q, s)
+    s = state_at(model, q, state)
+    jcom = com_jacobians(model, s.q, s)
     masses = np.array([b.mass for b in model.bodies])
     inertia_w = _world_inertias(model, s)
     jv, jw = jcom[..., :3, :], jcom[..., 3:, :]
@@ -46,20 +51,22 @@ def mass_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) 
     )
 
 
-def system_mass_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+def system_mass_matrix(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
     """Mass matrix of the free-floating system in the coordinates ``(v_0, omega_0, dq)``
     (spacecraft centre-of-mass velocity, its angular velocity, joint rates; root frame).
+    ``state``: a :func:`jointlock.kinematics.chain_state` at ``q`` (optional; see
+    :func:`jointlock.kinematics.state_at`).
 
     Returns
     -------
     (..., 6 + n, 6 + n) [kg, kg m, kg m^2 blocks]; the kinetic energy is
     ``0.5 x^T M x`` with ``x = [v_0; omega_0; dq]``.
     """
-    s = chain_state(model, q) if state is None else state
+    s = state_at(model, q, state)
     n = model.dof
     batch = s.positions.shape[:-2]
-    coms = com_positions(model, q, s)
-    jcom = com_jacobians(model, q, s)
+    coms = com_positions(model, s.q, s)
+    jcom = com_jacobians(model, s.q, s)
     r0 = model.root_body.com
     a_lin = np.zeros(batch + (n, 3, 6 + n))
     a_lin[..., :, :, 0:3] = np.eye(3)
@@ -137,188 +144,10 @@ class InverseDynamics:
 
 # -- batch-last Newton-Euler in link frames --------------------------------------------------
 #
-# Every per-sample quantity below is a list of scalar rows, one (N,) array per component
-# (``None`` for an exactly zero component).  Constant matrices (placements, inertias, centres
-# of mass) are applied entry by entry with zero entries skipped and unit entries not
-# multiplied, so a signed-permutation placement (every DH model) costs nothing; the joint
-# rotation about ``z`` is four products and two sums per vector.  Links frames are rotated
-# so that every joint turns about its own ``z`` (see :func:`_link_constants`).
-
-
-def _lc(terms, const: float = 0.0):
-    """Sum of ``coef * row`` over ``terms`` plus ``const``; zero coefficients and ``None``
-    rows skipped, unit coefficients not multiplied; ``None`` when everything is zero."""
-    out = None
-    owned = False
-    for coef, row in terms:
-        if row is None or coef == 0.0:
-            continue
-        if out is None:
-            if coef == 1.0:
-                out = row
-            else:
-                out = row * coef
-                owned = True
-        elif coef == 1.0:
-            if owned:
-                out += row
-            else:
-                out = out + row
-                owned = True
-        elif coef == -1.0:
-            if owned:
-                out -= row
-            else:
-                out = out - row
-                owned = True
-        else:
-            if owned:
-                out += coef * row
-            else:
-                out = out + coef * row
-                owned = True
-    if const != 0.0:
-        out = const if out is None else out + const
-    return out
-
-
-def _add(a, b):
-    if a is None:
-        return b
-    if b is None:
-        return a
-    return a + b
-
-
-def _sub(a, b):
-    if b is None:
-        return a
-    if a is None:
-        return -b
-    return a - b
-
-
-def _mul(a, b):
-    if a is None or b is None:
-        return None
-    return a * b
-
-
-def _add3(a, b, c):
-    return [_add(_add(x, y), z) for x, y, z in zip(a, b, c)]
-
-
-def _cmv(c: FloatArray, v):
-    """Constant (3, 3) times a row vector."""
-    return [_lc(((c[r, 0], v[0]), (c[r, 1], v[1]), (c[r, 2], v[2]))) for r in range(3)]
-
-
-def _cross(a, b):
-    """Cross product of two row vectors."""
-    return [
-        _sub(_mul(a[1], b[2]), _mul(a[2], b[1])),
-        _sub(_mul(a[2], b[0]), _mul(a[0], b[2])),
-        _sub(_mul(a[0], b[1]), _mul(a[1], b[0])),
-    ]
-
-
-def _cross_vc(v, p: FloatArray):
-    """Row vector ``v`` cross a constant vector ``p``."""
-    return [
-        _lc(((p[2], v[1]), (-p[1], v[2]))),
-        _lc(((p[0], v[2]), (-p[2], v[0]))),
-        _lc(((p[1], v[0]), (-p[0], v[1]))),
-    ]
-
-
-def _rz(c, s, v, transpose: bool = False):
-    """``Rot(z, q) v`` (or its transpose) for rows ``c = cos q``, ``s = sin q``."""
-    x, y = v[0], v[1]
-    if x is None and y is None:
-        return [None, None, v[2]]
-    if transpose:
-        return [_add(_mul(c, x), _mul(s, y)), _sub(_mul(c, y), _mul(s, x)), v[2]]
-    return [_sub(_mul(c, x), _mul(s, y)), _add(_mul(s, x), _mul(c, y)), v[2]]
-
-
-@dataclass(frozen=True)
-class _Link:
-    """Constants of one link in its ``z``-joint frame (the joint frame turned by ``Q`` so that
-    the joint axis is ``z``): rotation ``E`` and translation ``p`` from the parent's frame,
-    mass, centre of mass, inertia about the centre of mass, and the composite-inertia
-    transform coefficients of :func:`_composite`."""
-
-    rot: FloatArray  # E (3, 3)
-    pos: FloatArray  # p (3,)
-    mass: float
-    com: FloatArray
-    inertia: FloatArray
-    own_first: FloatArray  # m c (3,)
-    own_inertia: FloatArray  # inertia about the frame origin (3, 3)
-    sym_rot: FloatArray  # (6, 6), see _sym_coefficients
-    sym_shift: FloatArray  # (6, 3)
-
-
-_SYM = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
-
-
-def _axis_frame(axis: FloatArray) -> FloatArray:
-    """Rotation ``Q`` with ``Q e_z = axis`` (identity for ``+z``)."""
-    a = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
-    if a[0] == 0.0 and a[1] == 0.0 and a[2] > 0:
-        return np.eye(3)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(a[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    u = np.cross(helper, a)
-    u /= np.linalg.norm(u)
-    return np.column_stack([u, np.cross(a, u), a])
-
-
-#: Link constants of recently used models, by ``id`` (models are immutable); each entry keeps
-#: a weak reference to its model so that a recycled ``id`` is never mistaken for it.
-_LINK_CACHE: dict[tuple[int, bytes], tuple[weakref.ref, list[_Link]]] = {}
-_LINK_CACHE_SIZE = 64
-
-
-def _link_constants(model: ArmModel, origin: FloatArray) -> list[_Link]:
-    """Per-link constants (cached per model); the parent of link 1 is the root frame moved
-    to ``origin``."""
-    key = (id(model), np.asarray(origin, dtype=float).tobytes())
-    hit = _LINK_CACHE.get(key)
-    if hit is not None and hit[0]() is model:
-        return hit[1]
-    links = _compute_link_constants(model, origin)
-    if len(_LINK_CACHE) >= _LINK_CACHE_SIZE:
-        _LINK_CACHE.clear()
-    _LINK_CACHE[key] = (weakref.ref(model), links)
-    return links
-
-
-def _compute_link_constants(model: ArmModel, origin: FloatArray) -> list[_Link]:
-    links = []
-    q_prev = np.eye(3)
-    for i, (joint, body) in enumerate(zip(model.joints, model.bodies)):
-        qi = _axis_frame(joint.axis)
-        pos = joint.placement[:3, 3] - (origin if i == 0 else 0.0)
-        e = q_prev.T @ joint.placement[:3, :3] @ qi
-        e[np.abs(e) < 1e-15] = 0.0
-        e[np.abs(np.abs(e) - 1.0) < 1e-15] = np.sign(e[np.abs(np.abs(e) - 1.0) < 1e-15])
-        com = qi.T @ body.com
-        inertia = qi.T @ body.inertia @ qi
-        m = body.mass
-        own = inertia + m * (com @ com * np.eye(3) - np.outer(com, com))
-        p = q_prev.T @ pos
-        links.append(_Link(e, p, m, com, inertia, m * com, own, *_sym_coefficients(e, p)))
-        q_prev = qi
-    return links
-
-
-def _cross_cv(p: FloatArray, v):
-    """Constant vector ``p`` cross a row vector ``v``."""
-    return [
-        _lc(((p[1], v[2]), (-p[2], v[1]))),
-        _lc(((p[2], v[0]), (-p[0], v[2]))),
-        _lc(((p[0], v[1]), (-p[1], v[0]))),
-    ]
+# Per-sample quantities are sparse rows (see :mod:`jointlock._rows`): one (N,) array per
+# component, ``None`` for an exactly zero component; constant matrices are applied entry by
+# entry.  Link frames are turned so that every joint turns about its own ``z``
+# (:func:`jointlock._chain.link_constants`).
 
 
 def _forward(links, cos, sin, dq, ddq, w, wd, a):
@@ -328,16 +157,16 @@ def _forward(links, cos, sin, dq, ddq, w, wd, a):
     out = []
     for i, link in enumerate(links):
         c, s = cos[i], sin[i]
-        ap = _add3(a, _cross_vc(wd, link.pos), _cross(w, _cross_vc(w, link.pos)))
+        ap = add3(a, cross_vc(wd, link.pos), cross(w, cross_vc(w, link.pos)))
         et = link.rot.T
-        wu = _rz(c, s, _cmv(et, w), True)
-        wdu = _rz(c, s, _cmv(et, wd), True)
-        a = _rz(c, s, _cmv(et, ap), True)
-        w = [wu[0], wu[1], _add(wu[2], dq[i])]
-        wd = [_add(wdu[0], _mul(wu[1], dq[i])), _sub(wdu[1], _mul(wu[0], dq[i])), _add(wdu[2], ddq[i])]
-        acc = _add3(a, _cross_vc(wd, link.com), _cross(w, _cross_vc(w, link.com)))
-        force = [_lc(((link.mass, x),)) for x in acc]
-        moment = [_add(x, y) for x, y in zip(_cmv(link.inertia, wd), _cross(w, _cmv(link.inertia, w)))]
+        wu = rz(c, s, cmv(et, w), True)
+        wdu = rz(c, s, cmv(et, wd), True)
+        a = rz(c, s, cmv(et, ap), True)
+        w = [wu[0], wu[1], add(wu[2], dq[i])]
+        wd = [add(wdu[0], mul(wu[1], dq[i])), sub(wdu[1], mul(wu[0], dq[i])), add(wdu[2], ddq[i])]
+        acc = add3(a, cross_vc(wd, link.com), cross(w, cross_vc(w, link.com)))
+        force = [lc(((link.mass, x),)) for x in acc]
+        moment = [add(x, y) for x, y in zip(cmv(link.inertia, wd), cross(w, cmv(link.inertia, w)))]
         out.append((force, moment))
     return out
 
@@ -350,122 +179,18 @@ def _backward(links, cos, sin, wrenches):
     f = nm = None
     for i in range(n - 1, -1, -1):
         force, moment = wrenches[i]
-        nm_own = _add3(moment, _cross_cv(links[i].com, force), [None] * 3)
+        nm_own = add3(moment, cross_cv(links[i].com, force), [None] * 3)
         if f is None:
             f, nm = force, nm_own
         else:
             nxt = links[i + 1]
-            fr = _cmv(nxt.rot, _rz(cos[i + 1], sin[i + 1], f))
-            nr = _cmv(nxt.rot, _rz(cos[i + 1], sin[i + 1], nm))
-            f = [_add(x, y) for x, y in zip(force, fr)]
-            nm = _add3(nm_own, nr, _cross_cv(nxt.pos, fr))
+            fr = cmv(nxt.rot, rz(cos[i + 1], sin[i + 1], f))
+            nr = cmv(nxt.rot, rz(cos[i + 1], sin[i + 1], nm))
+            f = [add(x, y) for x, y in zip(force, fr)]
+            nm = add3(nm_own, nr, cross_cv(nxt.pos, fr))
         tau[i] = nm[2]
     first = links[0]
-    return tau, _cmv(first.rot, _rz(cos[0], sin[0], f)), _cmv(first.rot, _rz(cos[0], sin[0], nm))
-
-
-def _sym_coefficients(e: FloatArray, p: FloatArray) -> tuple[FloatArray, FloatArray]:
-    """Coefficients of ``E K E^T`` on the six stored entries of ``K`` (6, 6), and of the
-    parallel-axis cross terms ``2 (p.g) 1 - p g^T - g p^T`` with ``g = E h`` on ``h`` (6, 3)."""
-    a = np.zeros((6, 6))
-    g = np.zeros((6, 3))
-    eye = np.eye(3)
-    for r, (i, j) in enumerate(_SYM):
-        for col, (k, l) in enumerate(_SYM):
-            a[r, col] = e[i, k] * e[j, l] + (e[i, l] * e[j, k] if k != l else 0.0)
-        for k in range(3):
-            g[r, k] = 2.0 * p[k] * eye[i, j] - p[i] * eye[j, k] - p[j] * eye[i, k]
-    a[np.abs(a) < 1e-15] = 0.0
-    b = g @ e
-    b[np.abs(b) < 1e-15] = 0.0
-    return a, b
-
-
-def _nz(x):
-    return 0.0 if x is None else x
-
-
-def _move_inertia(link, c, s, cos2, sin2, mass, first, inertia, own_inertia, own_first):
-    """Move a composite body (mass, first moment and inertia about its frame origin, rows,
-    in the frame of ``link``) into the parent frame of ``link``, about the parent origin,
-    and add the parent's own constant inertia and first moment."""
-    xx, yy, zz, xy, xz, yz = inertia
-    tot, dif = xx + yy, xx - yy
-    rxx = 0.5 * tot + (0.5 * cos2) * dif - sin2 * xy
-    rot_k = (rxx, tot - rxx, zz, (0.5 * sin2) * dif + cos2 * xy, c * xz - s * yz, s * xz + c * yz)
-    hz = _rz(c, s, first)
-    a, b, p = link.sym_rot, link.sym_shift, link.pos
-    const = mass * (p @ p * np.eye(3) - np.outer(p, p)) + own_inertia
-    new_inertia = [
-        _nz(_lc([(a[r, k], rot_k[k]) for k in range(6)] + [(b[r, k], hz[k]) for k in range(3)], const[i, j]))
-        for r, (i, j) in enumerate(_SYM)
-    ]
-    new_first = [
-        _nz(_lc([(link.rot[r, k], hz[k]) for k in range(3)], mass * p[r] + own_first[r])) for r in range(3)
-    ]
-    return new_first, new_inertia
-
-
-def _move_momentum(link, c, s, ang, lin):
-    """Move a momentum (angular about the frame origin, linear) into the parent frame."""
-    lin = _cmv(link.rot, _rz(c, s, lin))
-    ang = _add3(_cmv(link.rot, _rz(c, s, ang)), _cross_cv(link.pos, lin), [None] * 3)
-    return ang, lin
-
-
-def _composite(links, cos, sin, cos2, sin2, dq=None):
-    """Composite inertia of the links outboard of every joint, recursively in link frames
-    (as in the composite-rigid-body algorithm), and the momentum of the arm on a still base.
-
-    Returns ``(mass, first, inertia, columns, momentum)``: the arm's mass, first moment (3
-    rows) and inertia (6 rows, order ``_SYM``) about the parent origin of link 1, in its
-    frame; per link ``j`` the momentum (angular about origin ``j``, linear; frame ``j``) of
-    the outboard composite turning at unit rate about joint ``j``, as 5 rows
-    ``(K_xz, K_yz, K_zz, h_x, h_y)`` (angular ``K e_z``, linear ``e_z x h``); and, with
-    ``dq``, the arm's momentum ``(L, P)`` (rows, parent frame of link 1, ``L`` about its
-    origin), else ``None``."""
-    n = len(links)
-    columns = [None] * n
-    last = links[-1]
-    mass = last.mass
-    inertia = [float(last.own_inertia[i, j]) for i, j in _SYM]
-    first = [float(x) for x in last.own_first]
-    momentum = None
-    for j in range(n - 1, -1, -1):
-        if j < n - 1:
-            nxt = links[j + 1]
-            first, inertia = _move_inertia(
-                nxt,
-                cos[j + 1],
-                sin[j + 1],
-                cos2[j + 1],
-                sin2[j + 1],
-                mass,
-                first,
-                inertia,
-                links[j].own_inertia,
-                links[j].own_first,
-            )
-            mass += links[j].mass
-            if momentum is not None:
-                momentum = _move_momentum(nxt, cos[j + 1], sin[j + 1], *momentum)
-        col = (inertia[4], inertia[5], inertia[2], first[0], first[1])
-        columns[j] = col
-        if dq is not None:
-            d = dq[j]
-            own = ([col[0] * d, col[1] * d, col[2] * d], [-col[4] * d, col[3] * d, None])
-            momentum = (
-                own
-                if momentum is None
-                else tuple([_add(x, y) for x, y in zip(u, v)] for u, v in zip(momentum, own))
-            )
-    zero3 = np.zeros(3)
-    first, inertia = _move_inertia(
-        links[0], cos[0], sin[0], cos2[0], sin2[0], mass, first, inertia, np.zeros((3, 3)), zero3
-    )
-    if momentum is not None:
-        momentum = _move_momentum(links[0], cos[0], sin[0], *momentum)
-    return mass, first, inertia, columns, momentum
+    return tau, cmv(first.rot, rz(cos[0], sin[0], f)), cmv(first.rot, rz(cos[0], sin[0], nm))
 
 
 def _base_solver(mass: float, first, inertia):
@@ -498,13 +223,13 @@ def _base_solver(mass: float, first, inertia):
     inv_det = 1.0 / det
 
     def solve(rf, rn):
-        b = [_nz(x) - im * _nz(y) for x, y in zip(rn, _cross(first, rf))]
+        b = [nz(x) - im * nz(y) for x, y in zip(rn, cross(first, rf))]
         alpha = [
             (cxx * b[0] + cxy * b[1] + cxz * b[2]) * inv_det,
             (cxy * b[0] + cyy * b[1] + cyz * b[2]) * inv_det,
             (cxz * b[0] + cyz * b[1] + czz * b[2]) * inv_det,
         ]
-        lin = [(_nz(x) + _nz(y)) * im for x, y in zip(rf, _cross(first, alpha))]
+        lin = [(nz(x) + nz(y)) * im for x, y in zip(rf, cross(first, alpha))]
         return lin, alpha
 
     return solve
@@ -523,39 +248,39 @@ def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
     dq, ddq = list(dqf), list(ddqf)
     none3 = [None] * 3
     if base == "fixed":
-        links = _link_constants(model, np.zeros(3))
+        links = link_constants(model, np.zeros(3))
         acc0 = [None if x == 0.0 else -float(x) for x in g]  # gravity as an upward base acceleration
         wrenches = _forward(links, cos, sin, dq, ddq, none3, none3, acc0)
         tau, f1, n1 = _backward(links, cos, sin, wrenches)
-        force = [_lc(((-1.0, x),)) for x in f1]
-        moment = [_lc(((-1.0, x), (-1.0, y))) for x, y in zip(n1, _cross_cv(links[0].pos - point, f1))]
+        force = [lc(((-1.0, x),)) for x in f1]
+        moment = [lc(((-1.0, x), (-1.0, y))) for x, y in zip(n1, cross_cv(links[0].pos - point, f1))]
         zero6 = [None] * 6
         return tau, force, moment, zero6, zero6
     root = model.root_body
     c0 = root.com
-    links = _link_constants(model, c0)
+    links = link_constants(model, c0)
     cos2, sin2 = cos * cos - sin * sin, 2.0 * sin * cos
-    mass, first, inertia, columns, (ang, lin) = _composite(links, cos, sin, cos2, sin2, dq)
-    inertia = [x + root.inertia[i, j] for x, (i, j) in zip(inertia, _SYM)]
+    mass, first, inertia, columns, (ang, lin) = composite(links, cos, sin, cos2, sin2, dq)
+    inertia = [x + root.inertia[i, j] for x, (i, j) in zip(inertia, SYM)]
     solve = _base_solver(mass + root.mass, first, inertia)
-    v0, w0 = solve([_lc(((-1.0, x),)) for x in lin], [_lc(((-1.0, x),)) for x in ang])
+    v0, w0 = solve([lc(((-1.0, x),)) for x in lin], [lc(((-1.0, x),)) for x in ang])
     wrenches = _forward(links, cos, sin, dq, ddq, w0, none3, none3)
     tau, f1, n1 = _backward(links, cos, sin, wrenches)
-    spin = _cross(w0, _cmv(root.inertia, w0))
-    rf = [_lc(((-1.0, x),)) for x in f1]
-    rn = [_lc(((-1.0, x), (-1.0, y), (-1.0, z))) for x, y, z in zip(n1, _cross_cv(links[0].pos, f1), spin)]
+    spin = cross(w0, cmv(root.inertia, w0))
+    rf = [lc(((-1.0, x),)) for x in f1]
+    rn = [lc(((-1.0, x), (-1.0, y), (-1.0, z))) for x, y, z in zip(n1, cross_cv(links[0].pos, f1), spin)]
     a0, alpha0 = solve(rf, rn)
     # joint torques from the spacecraft's acceleration (linear in it): the rigid acceleration
     # carried out to every link, against each outboard composite's unit-rate momentum
     acc, alpha = a0, alpha0
     for j, link in enumerate(links):
         et = link.rot.T
-        acc = _rz(cos[j], sin[j], _cmv(et, _add3(acc, _cross_vc(alpha, link.pos), none3)), True)
-        alpha = _rz(cos[j], sin[j], _cmv(et, alpha), True)
+        acc = rz(cos[j], sin[j], cmv(et, add3(acc, cross_vc(alpha, link.pos), none3)), True)
+        alpha = rz(cos[j], sin[j], cmv(et, alpha), True)
         kxz, kyz, kzz, hx, hy = columns[j]
-        tau[j] = _nz(tau[j]) + kxz * alpha[0] + kyz * alpha[1] + kzz * alpha[2] + hx * acc[1] - hy * acc[0]
+        tau[j] = nz(tau[j]) + kxz * alpha[0] + kyz * alpha[1] + kzz * alpha[2] + hx * acc[1] - hy * acc[0]
     force = [root.mass * x for x in a0]
-    moment = _add3(_cmv(root.inertia, alpha0), spin, _cross_cv(c0 - point, force))
+    moment = add3(cmv(root.inertia, alpha0), spin, cross_cv(c0 - point, force))
     return tau, force, moment, a0 + alpha0, v0 + w0
 
 
@@ -607,8 +332,6 @@ def rnea(
         Joint torques (..., n) [N m], base force/moment (..., 3) [N, N m], spacecraft
         acceleration and twist (..., 6).
     """
-    from .errors import ModelError
-
     q = as_joint_array(model, q, "q")
     dq = as_joint_array(model, dq, "dq")
     ddq = as_joint_array(model, ddq, "ddq")
@@ -669,56 +392,3 @@ def base_wrench(
     """(..., 6) wrench ``[f_d; n_d]`` [N, N m] the arm exerts on its base (000 eqs. 30-31),
     moment about the spacecraft's centre of mass, root frame.  See :func:`rnea`."""
     return rnea(model, q, dq, ddq, base=base, gravity=gravity, moment_point=moment_point).base_wrench
-
-
-def _momentum_matrix_soa(model: ArmModel, qf: FloatArray, state: ChainState) -> FloatArray:
-    """:func:`jointlock.kinematics.momentum_matrix` as (6, 6 + n, N) for flattened joint
-    angles ``qf`` (n, N): composite inertias recursively in link frames, each joint's column
-    turned into the root frame once."""
-    n = model.dof
-    cos, sin = np.cos(qf), np.sin(qf)
-    cos2, sin2 = cos * cos - sin * sin, 2.0 * sin * cos
-    links = _link_constants(model, np.zeros(3))
-    mass, first, inertia, columns, _ = _composite(links, cos, sin, cos2, sin2)
-    out = np.zeros((6, 6 + n, qf.shape[1]))
-    for j, joint in enumerate(model.joints):
-        rot = state.soa_rotations[j]
-        qa = _axis_frame(joint.axis)
-        if not np.array_equal(qa, np.eye(3)):
-            rot = np.matmul(qa.T, rot)  # frame j turned so that its z is the joint axis
-        kxz, kyz, kzz, hx, hy = columns[j]
-        lin = out[0:3, 6 + j]
-        np.multiply(rot[:, 1], hx, out=lin)
-        lin -= rot[:, 0] * hy
-        ang = out[3:6, 6 + j]
-        np.multiply(rot[:, 0], kxz, out=ang)
-        ang += rot[:, 1] * kyz
-        ang += rot[:, 2] * kzz
-        p = state.soa_positions[j]
-        ang[0] += p[1] * lin[2] - p[2] * lin[1]
-        ang[1] += p[2] * lin[0] - p[0] * lin[2]
-        ang[2] += p[0] * lin[1] - p[1] * lin[0]
-    root = model.root_body
-    m0, r0 = root.mass, root.com
-    h = first
-    for k in range(3):
-        out[k, k] = m0 + mass
-        for col in range(3):
-            out[3 + k, 3 + col] = root.inertia[k, col]
-    for r, (i, j) in enumerate(_SYM):
-        out[3 + i, 3 + j] += inertia[r]
-        if i != j:
-            out[3 + j, 3 + i] += inertia[r]
-    # -skew(h - M r0) (linear from omega_0), skew(h + m0 r0) (angular from v_0), skew(h) skew(r0)
-    for a, b, c in ((0, 1, 2), (1, 2, 0), (2, 0, 1)):
-        lin_w = h[c] - mass * r0[c]
-        out[a, 3 + b] += lin_w
-        out[b, 3 + a] -= lin_w
-        ang_v = h[c] + m0 * r0[c]
-        out[3 + a, b] -= ang_v
-        out[3 + b, a] += ang_v
-    dot = h[0] * r0[0] + h[1] * r0[1] + h[2] * r0[2]
-    for a in range(3):  # skew(h) @ skew(r0) = r0 h^T - (h . r0) 1
-        for b in range(3):
-            out[3 + a, 3 + b] += h[b] * r0[a] - (dot if a == b else 0.0)
-    return out

@@ -10,171 +10,62 @@ not depend on the base pose).
 
 Twists are ordered ``(v, omega)``: linear velocity of the stated reference point [m/s], then
 angular velocity [rad/s].
+
+The forward kinematics (:func:`chain_state`, :func:`ee_pose`, :func:`ee_positions`,
+:func:`state_at`) lives in :mod:`jointlock.forward` and is re-exported here.  A function
+taking ``q`` and ``state=`` uses the state only at the angles it was computed at
+(:func:`state_at`).  The chain arithmetic shared with :mod:`jointlock.dynamics` lives in
+:mod:`jointlock._chain`: this module never imports the dynamics.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ._chain import momentum_matrix_soa
 from .errors import ConfigurationError, ModelError
+from .forward import DEFAULT_CHUNK, ChainState, chain_state, ee_pose, ee_positions, link_poses, state_at
 from .model import ArmModel, FloatArray, as_joint_array
-from .spatial import pose, skew
+
+__all__ = [
+    "DEFAULT_CHUNK",
+    "ChainState",
+    "VMWeighting",
+    "VirtualManipulator",
+    "base_jacobian",
+    "chain_state",
+    "com_jacobians",
+    "com_positions",
+    "ee_pose",
+    "ee_positions",
+    "generalized_jacobian",
+    "jacobian",
+    "link_poses",
+    "momentum",
+    "momentum_matrix",
+    "state_at",
+    "system_com",
+    "virtual_link_vectors",
+    "virtual_manipulator",
+]
 
 
-@dataclass(frozen=True)
-class ChainState:
-    """Frames of a chain for a batch of configurations (all in the root frame).
+def com_positions(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
+    """(..., n, 3) centre of mass of every link in the root frame [m].
 
-    The frames are computed and stored with the batch as the *last* axis ("structure of
-    arrays": every arithmetic step runs over one contiguous vector per matrix entry, which
-    is several times faster than small-matrix products per sample).  The attributes below
-    give them in the usual batch-first layout (computed once, on first access).
-
-    Attributes
-    ----------
-    rotations
-        (..., n, 3, 3) orientation of every link frame.
-    positions
-        (..., n, 3) origin of every link frame [m]; it lies on the joint axis.
-    axes
-        (..., n, 3) unit joint axes.
-    ee_rotation, ee_position
-        (..., 3, 3) and (..., 3) [m]: the end-effector frame.
-    """
-
-    batch_shape: tuple[int, ...]
-    soa_rotations: FloatArray  # (n, 3, 3, N)
-    soa_positions: FloatArray  # (n, 3, N)
-    soa_axes: FloatArray  # (n, 3, N)
-    soa_ee_rotation: FloatArray  # (3, 3, N)
-    soa_ee_position: FloatArray  # (3, N)
-
-    def _batch_first(self, soa: FloatArray) -> FloatArray:
-        return np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(self.batch_shape + soa.shape[:-1])
-
-    @cached_property
-    def rotations(self) -> FloatArray:
-        return self._batch_first(self.soa_rotations)
-
-    @cached_property
-    def positions(self) -> FloatArray:
-        return self._batch_first(self.soa_positions)
-
-    @cached_property
-    def axes(self) -> FloatArray:
-        return self._batch_first(self.soa_axes)
-
-    @cached_property
-    def ee_rotation(self) -> FloatArray:
-        return self._batch_first(self.soa_ee_rotation)
-
-    @cached_property
-    def ee_position(self) -> FloatArray:
-        return self._batch_first(self.soa_ee_position)
-
-    @staticmethod
-    def select(mask: ArrayLike, a: ChainState, b: ChainState) -> ChainState:
-        """Per-sample choice: ``a`` where ``mask`` (batch shape) is true, else ``b``."""
-        m = np.asarray(mask, dtype=bool).reshape(-1)
-        return ChainState(
-            a.batch_shape,
-            *(
-                np.where(m, x, y)
-                for x, y in zip(
-                    (a.soa_rotations, a.soa_positions, a.soa_axes, a.soa_ee_rotation, a.soa_ee_position),
-                    (b.soa_rotations, b.soa_positions, b.soa_axes, b.soa_ee_rotation, b.soa_ee_position),
-                )
-            ),
-        )
-
-
-def _rotate_soa(matrix: FloatArray, soa: FloatArray) -> FloatArray:
-    """``soa[r, j, N] @ matrix[j, k]`` for every sample: (3, 3, N) -> (3, 3, N)."""
-    return np.matmul(matrix.T, soa)
-
-
-def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
-    """Forward kinematics of every frame.
-
-    Parameters
-    ----------
-    model
-        The arm.
-    q
-        (..., n) joint angles [rad].
-
-    Notes
-    -----
-    Frame ``i`` is ``R_{i-1} P_i Rot(axis_i, q_i)``.  For a joint about ``z`` the rotation
-    only mixes the first two columns of ``A = R_{i-1} P_i``; for any other axis Rodrigues'
-    formula ``A (I + sin q K + (1 - cos q) K^2)`` is used.  No loop over samples.
-    """
-    q = as_joint_array(model, q)
-    n = model.dof
-    batch = q.shape[:-1]
-    flat = q.reshape(-1, n).T  # (n, N)
-    count = flat.shape[1]
-    cos, sin = np.cos(flat), np.sin(flat)
-    rotations = np.empty((n, 3, 3, count))
-    positions = np.empty((n, 3, count))
-    axes = np.empty((n, 3, count))
-    rot: FloatArray | None = None
-    pos: FloatArray | None = None
-    for i, joint in enumerate(model.joints):
-        place_rot, place_pos = joint.placement[:3, :3], joint.placement[:3, 3]
-        if rot is None:
-            a = np.broadcast_to(place_rot[:, :, None], (3, 3, count))
-            positions[i] = place_pos[:, None]
-        else:
-            a = _rotate_soa(place_rot, rot)
-            positions[i] = pos + np.einsum("rjN,j->rN", rot, place_pos)
-        out = rotations[i]
-        axis = joint.axis
-        if axis[0] == 0.0 and axis[1] == 0.0 and axis[2] > 0:  # about +z: the DH case
-            np.multiply(a[:, 0], cos[i], out=out[:, 0])
-            out[:, 0] += a[:, 1] * sin[i]
-            np.multiply(a[:, 1], cos[i], out=out[:, 1])
-            out[:, 1] -= a[:, 0] * sin[i]
-            out[:, 2] = a[:, 2]
-            axes[i] = a[:, 2]
-        else:
-            k = skew(axis)
-            out[...] = a + sin[i] * _rotate_soa(k, a) + (1.0 - cos[i]) * _rotate_soa(k @ k, a)
-            axes[i] = np.einsum("rjN,j->rN", out, axis)
-        rot, pos = rotations[i], positions[i]
-    tool = model.tool
-    ee_rot = _rotate_soa(tool[:3, :3], rot)
-    ee_pos = pos + np.einsum("rjN,j->rN", rot, tool[:3, 3])
-    return ChainState(batch, rotations, positions, axes, ee_rot, ee_pos)
-
-
-def link_poses(model: ArmModel, q: ArrayLike) -> FloatArray:
-    """(..., n, 4, 4) pose of every link frame in the root frame [m]."""
-    s = chain_state(model, q)
-    return pose(s.rotations, s.positions)
-
-
-def ee_pose(model: ArmModel, q: ArrayLike) -> FloatArray:
-    """(..., 4, 4) end-effector pose in the root frame [m]."""
-    s = chain_state(model, q)
-    return pose(s.ee_rotation, s.ee_position)
-
-
-def com_positions(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
-    """(..., n, 3) centre of mass of every link in the root frame [m]."""
-    s = chain_state(model, q) if state is None else state
+    ``state``: a :func:`chain_state` at ``q`` (optional; see :func:`state_at`)."""
+    s = state_at(model, q, state)
     coms = np.array([b.com for b in model.bodies])  # (n, 3)
     return s.positions + np.einsum("...nij,nj->...ni", s.rotations, coms)
 
 
 def jacobian(
     model: ArmModel,
-    q: ArrayLike,
+    q: ArrayLike | None,
     *,
     frame: Literal["base", "ee"] = "base",
     state: ChainState | None = None,
@@ -191,7 +82,9 @@ def jacobian(
         ``"base"``: components in the root frame (the inertial frame for a fixed base);
         ``"ee"``: components in the end-effector frame.
     state
-        Precomputed :func:`chain_state` for ``q`` (optional, saves the forward kinematics).
+        Precomputed :func:`chain_state` at ``q`` (optional, saves the forward kinematics).
+        It must have been computed at ``q`` (:class:`~jointlock.errors.ConfigurationError`
+        otherwise); with a state, ``q=None`` means ``state.q``.
 
     Returns
     -------
@@ -199,7 +92,7 @@ def jacobian(
     being the velocity of the end-effector frame's origin [m/s].  Column ``i`` is
     ``(z_i x (p_e - p_i), z_i)``.
     """
-    s = chain_state(model, q) if state is None else state
+    s = state_at(model, q, state)
     z, p, pe = s.soa_axes, s.soa_positions, s.soa_ee_position
     d = pe[None] - p  # (n, 3, N)
     soa = np.empty((6, model.dof, pe.shape[-1]))
@@ -219,11 +112,12 @@ def _rotate_twist(rot: FloatArray, jac: FloatArray) -> FloatArray:
     return np.concatenate([rot @ jac[..., :3, :], rot @ jac[..., 3:, :]], axis=-2)
 
 
-def com_jacobians(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+def com_jacobians(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
     """(..., n, 6, n): Jacobian of every link's centre-of-mass velocity and angular velocity
-    (root frame), fixed base."""
-    s = chain_state(model, q) if state is None else state
-    coms = com_positions(model, q, s)
+    (root frame), fixed base.  ``state``: a :func:`chain_state` at ``q`` (optional; see
+    :func:`state_at`)."""
+    s = state_at(model, q, state)
+    coms = com_positions(model, s.q, s)
     n = model.dof
     lin = np.cross(s.axes[..., None, :, :], coms[..., :, None, :] - s.positions[..., None, :, :])
     ang = np.broadcast_to(s.axes[..., None, :, :], lin.shape).copy()
@@ -239,8 +133,10 @@ def _world_inertias(model: ArmModel, state: ChainState) -> FloatArray:
     return rot @ inertias @ np.swapaxes(rot, -1, -2)
 
 
-def momentum_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+def momentum_matrix(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
     """Momentum map of the free-floating system.
+
+    ``state``: a :func:`chain_state` at ``q`` (optional; see :func:`state_at`).
 
     Returns
     -------
@@ -256,20 +152,19 @@ def momentum_matrix(model: ArmModel, q: ArrayLike, state: ChainState | None = No
     as in the composite-rigid-body algorithm): mass ``M_j``, first moment ``S_j = sum m_i c_i``
     and inertia about the root origin ``K_j = sum I_i + m_i (|c_i|^2 E - c_i c_i^T)``.  Joint
     ``j`` contributes ``z_j x (S_j - M_j p_j)`` to ``P`` and ``K_j z_j - S_j x (z_j x p_j)`` to
-    ``L``.  Computed in :func:`jointlock.dynamics._momentum_matrix_soa` (composite inertias
+    ``L``.  Computed by :func:`jointlock._chain.momentum_matrix_soa` (composite inertias
     recursively in link frames, batch last).
     """
-    from .dynamics import _momentum_matrix_soa  # dynamics imports this module
-
-    s = chain_state(model, q) if state is None else state
-    q = as_joint_array(model, q)
-    flat = np.ascontiguousarray(q.reshape(-1, model.dof).T)
-    soa = _momentum_matrix_soa(model, flat, s)
+    s = state_at(model, q, state)
+    flat = np.ascontiguousarray(s.q.reshape(-1, model.dof).T)
+    soa = momentum_matrix_soa(model, flat, s.soa_rotations, s.soa_positions)
     return np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(s.batch_shape + soa.shape[:2])
 
 
-def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
+def base_jacobian(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
     """Spacecraft motion caused by the joints with zero total momentum (000 eq. 4, ``J_btheta``).
+
+    ``state``: a :func:`chain_state` at ``q`` (optional; see :func:`state_at`).
 
     Returns
     -------
@@ -289,7 +184,7 @@ def base_jacobian(model: ArmModel, q: ArrayLike, state: ChainState | None = None
 
 def generalized_jacobian(
     model: ArmModel,
-    q: ArrayLike,
+    q: ArrayLike | None,
     *,
     frame: Literal["base", "ee"] = "base",
     state: ChainState | None = None,
@@ -306,6 +201,10 @@ def generalized_jacobian(
         (..., n) joint angles [rad].
     frame
         ``"base"`` (root/spacecraft frame) or ``"ee"`` (end-effector frame) components.
+    state
+        Precomputed :func:`chain_state` at ``q`` (optional, saves the forward kinematics).
+        It must have been computed at ``q`` (:class:`~jointlock.errors.ConfigurationError`
+        otherwise); with a state, ``q=None`` means ``state.q``.
 
     Returns
     -------
@@ -313,10 +212,10 @@ def generalized_jacobian(
     frame (components in the current spacecraft frame), the spacecraft moving so that
     linear and angular momentum stay zero.
     """
-    s = chain_state(model, q) if state is None else state
-    jm = jacobian(model, q, state=s)
+    s = state_at(model, q, state)
+    jm = jacobian(model, s.q, state=s)
     if model.floating:
-        jb_theta = base_jacobian(model, q, s)
+        jb_theta = base_jacobian(model, s.q, s)
         arm = s.ee_position - model.root_body.com
         lin = jb_theta[..., :3, :] - np.cross(
             arm[..., None, :], np.swapaxes(jb_theta[..., 3:, :], -1, -2)
@@ -340,11 +239,12 @@ def momentum(model: ArmModel, q: ArrayLike, dq: ArrayLike, base_twist: ArrayLike
     return np.einsum("...ij,...j->...i", h, full)
 
 
-def system_com(model: ArmModel, q: ArrayLike, state: ChainState | None = None) -> FloatArray:
-    """(..., 3) centre of mass of links plus root body, root frame [m]."""
-    s = chain_state(model, q) if state is None else state
+def system_com(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:
+    """(..., 3) centre of mass of links plus root body, root frame [m].  ``state``: a
+    :func:`chain_state` at ``q`` (optional; see :func:`state_at`)."""
+    s = state_at(model, q, state)
     masses = np.array([b.mass for b in model.bodies])
-    coms = com_positions(model, q, s)
+    coms = com_positions(model, s.q, s)
     total = masses.sum() + model.root_body.mass
     if total <= 0:
         raise ModelError(f"model {model.name!r} has no mass: the system centre of mass is undefined")
@@ -445,7 +345,7 @@ def virtual_manipulator(
     s = chain_state(model, q)
     local = virtual_link_vectors(model, weighting=weighting)
     if model.floating:
-        ground = system_com(model, q, s)
+        ground = system_com(model, s.q, s)
     else:  # m_0 -> inf: the ground is the base's own point, the virtual arm is the real one
         ground = np.broadcast_to(model.root_body.com, s.batch_shape + (3,))
     vec_links = np.einsum("...nij,nj->...ni", s.rotations, local[1:])

@@ -1,4 +1,4 @@
-"""Writing results for people: atomic file writes, arm drawings and a self-contained HTML page.
+"""A self-contained HTML page of results (sections, facts, tables, figures).
 
 Library code here never prints.  Images are embedded as base64 PNG so a report is a single
 file that opens without a network: inline CSS, no scripts, no external resources (a test
@@ -13,120 +13,21 @@ from __future__ import annotations
 
 import base64
 import html
-import io
-import json
-import os
-import tempfile
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from .kinematics import chain_state, com_positions
-from .model import ArmModel
-
-
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` via a temporary file and a rename, so an interrupted run
-    never leaves a half-written file."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
-def _umask() -> int:
-    mask = os.umask(0o022)
-    os.umask(mask)
-    return mask
-
-
-def atomic_write_text(path: str | Path, text: str) -> None:
-    atomic_write_bytes(path, text.encode("utf-8"))
-
-
-def atomic_write_json(path: str | Path, obj: Any) -> None:
-    from .cli._common import _plain
-
-    atomic_write_text(path, json.dumps(_plain(obj), indent=2, allow_nan=False) + "\n")
-
-
-def arm_points(model: ArmModel, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Polyline through the root, every joint origin and the end effector (k, 3) [m], and
-    the link centres of mass (n, 3) [m], for one configuration (root frame)."""
-    state = chain_state(model, q)
-    pts = np.vstack([np.zeros(3), state.positions, state.ee_position])
-    return pts, com_positions(model, q, state)
-
-
-def draw_arm(ax: Any, model: ArmModel, q: np.ndarray, *, label: str = "", color: str | None = None) -> None:
-    """Draw the arm at ``q`` (n,) [rad] on a matplotlib 3-D axis."""
-    pts, coms = arm_points(model, q)
-    (line,) = ax.plot(pts[:, 0], pts[:, 1], pts[:, 2], "-o", lw=2.5, ms=4, label=label, color=color)
-    ax.scatter(coms[:, 0], coms[:, 1], coms[:, 2], marker="x", s=20, color=line.get_color())
-    ax.scatter(*pts[-1], marker="*", s=80, color=line.get_color())
-
-
-def set_equal_3d(ax: Any, points: np.ndarray) -> None:
-    """Equal scaling on a 3-D axis around ``points`` (k, 3)."""
-    centre = (points.max(axis=0) + points.min(axis=0)) / 2
-    radius = max(float(np.ptp(points, axis=0).max()) / 2, 1e-3)
-    ax.set_xlim(centre[0] - radius, centre[0] + radius)
-    ax.set_ylim(centre[1] - radius, centre[1] + radius)
-    ax.set_zlim(centre[2] - radius, centre[2] + radius)
-    ax.set_xlabel("x [m]")
-    ax.set_ylabel("y [m]")
-    ax.set_zlabel("z [m]")
-
-
-def figure_png(fig: Any, dpi: int = 110) -> bytes:
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
-    return buf.getvalue()
-
-
-def figure_svg(fig: Any) -> bytes:
-    """The figure as SVG (text kept as paths, so it renders the same everywhere)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
-    return buf.getvalue()
-
-
-def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = 110) -> bytes:
-    """Write ``folder/stem.png`` and ``folder/stem.svg`` atomically; returns the PNG bytes
-    (to embed in a report).  The figure is left open."""
-    png = figure_png(fig, dpi=dpi)
-    atomic_write_bytes(Path(folder) / f"{stem}.png", png)
-    atomic_write_bytes(Path(folder) / f"{stem}.svg", figure_svg(fig))
-    return png
-
-
-def arm_figure(model: ArmModel, configurations: dict[str, np.ndarray], *, title: str = "") -> Any:
-    """A 3-D drawing of ``model`` at each ``{label: q (n,) [rad]}`` (root frame, equal axes),
-    e.g. the configuration at failure and the halt configuration.  Returns the figure."""
-    import matplotlib.pyplot as plt
-
-    fig = plt.figure(figsize=(6.0, 5.0))
-    ax = fig.add_subplot(projection="3d")
-    colours = ["tab:blue", "tab:red", "tab:green", "tab:orange", "0.5"]
-    pts = []
-    for i, (label, q) in enumerate(configurations.items()):
-        draw_arm(ax, model, np.asarray(q, dtype=float), label=label, color=colours[i % len(colours)])
-        pts.append(arm_points(model, np.asarray(q, dtype=float))[0])
-    set_equal_3d(ax, np.vstack(pts))
-    ax.legend(loc="upper left", fontsize=8)
-    if title:
-        ax.set_title(title, fontsize=10)
-    return fig
+from .io.files import (  # noqa: F401  (re-exported: the writers used to live here)
+    atomic_write_bytes,
+    atomic_write_json,
+    atomic_write_text,
+    figure_png,
+    figure_svg,
+    save_figure,
+)
+from .plots.arm import arm_figure, arm_points, draw_arm, set_equal_3d  # noqa: F401  (re-exported)
 
 
 def limit_status(value: float, limit: float) -> str:

@@ -752,7 +752,7 @@ def _defaults_000(out: dict[str, Any], jobs: tuple[str, ...], model: Any) -> Non
     fail = out["failure"]
     if model.name != "halt7" or fail["joint"] != 4 or not ({"halt", "halt_config"} & set(jobs)):
         return
-    from .cli.halt import PAPER_SCENARIO
+    from .papers.p000 import SCENARIO as PAPER_SCENARIO
 
     for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
         if out["state"][key] is None:

@@ -8,10 +8,8 @@ on one common grid.  (Voxel occupancy under-estimates with few samples and over-
 by about half a voxel layer over the surface; both shrink as samples grow and the voxel
 shrinks -- report the voxel with the number.)
 
-:func:`ee_positions` is a position-only forward kinematics: it runs the chain from the tool
-back to the root on the three coordinate arrays, folds constant entries (zeros and ones of
-DH placements) once per model, and skips joints that cannot move the tool point (e.g. the
-last joint of a spherical wrist); it is several times faster than full-pose kinematics.
+The end-effector positions come from :func:`jointlock.kinematics.ee_positions`, the
+position-only forward kinematics (re-exported here with :data:`DEFAULT_CHUNK`).
 """
 
 from __future__ import annotations
@@ -23,13 +21,26 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ConfigurationError
+from ..kinematics import DEFAULT_CHUNK, ee_positions
 from ..locking import lock
-from ..model import ArmModel, FloatArray, as_joint_array
+from ..model import ArmModel, FloatArray
 
-#: Entries of folded placement matrices below this are exact zeros of DH tables [-].
-_ZERO = 1e-15
-#: Default samples per vectorised chunk (keeps the working set in cache).
-DEFAULT_CHUNK = 65536
+__all__ = [
+    "DEFAULT_CHUNK",
+    "MIN_SAMPLES",
+    "MIN_SAMPLES_PER_VOXEL",
+    "OUTSIDE_TOL",
+    "SAMPLES_PER_VOXEL",
+    "SHARE_HALF_TOL",
+    "Workspace",
+    "WorkspaceComparison",
+    "compare_workspaces",
+    "ee_positions",
+    "projection_extent",
+    "sample_configurations",
+    "sample_workspace",
+    "voxel_keys",
+]
 
 #: Mean full-arm samples per voxel of the bounding box when the voxel side is chosen [-].
 SAMPLES_PER_VOXEL = 16.0
@@ -45,97 +56,6 @@ MIN_SAMPLES_PER_VOXEL = 2.0
 SHARE_HALF_TOL = 0.03
 #: ... and largest share of the locked arm's voxels outside the full cloud [-].
 OUTSIDE_TOL = 0.03
-
-
-def _frame_with_z(axis: FloatArray) -> FloatArray:
-    z = axis / np.linalg.norm(axis)
-    if np.allclose(z, [0.0, 0.0, 1.0]):
-        return np.eye(3)
-    helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-    x = np.cross(helper, z)
-    x /= np.linalg.norm(x)
-    return np.stack([x, np.cross(z, x), z], axis=1)
-
-
-def _clean(arr: FloatArray) -> FloatArray:
-    out = np.where(np.abs(arr) < _ZERO, 0.0, arr)
-    out = np.where(np.abs(out - 1.0) < _ZERO, 1.0, out)
-    return np.where(np.abs(out + 1.0) < _ZERO, -1.0, out)
-
-
-def _position_program(model: ArmModel) -> tuple[list[tuple[FloatArray, FloatArray]], FloatArray]:
-    """Per-joint constants ``(M_i, c_i)`` with every joint axis turned into ``z``:
-    ``v_i = c_i + M_i Rz(q_i) v_{i+1}``, ``v_n`` = tool point, ``v_1`` = end effector."""
-    frames = [_frame_with_z(j.axis) for j in model.joints]
-    prev = np.eye(3)
-    consts = []
-    for joint, frame in zip(model.joints, frames):
-        consts.append(
-            (_clean(prev.T @ joint.placement[:3, :3] @ frame), _clean(prev.T @ joint.placement[:3, 3]))
-        )
-        prev = frame
-    return consts, _clean(prev.T @ model.tool[:3, 3])
-
-
-def _mul(a: float, x):  # a * x with a a constant
-    if a == 0.0:
-        return 0.0
-    if a == 1.0:
-        return x
-    if a == -1.0:
-        return -x
-    return a * x
-
-
-def _add(x, y):
-    if isinstance(x, float) and x == 0.0:
-        return y
-    if isinstance(y, float) and y == 0.0:
-        return x
-    return x + y
-
-
-def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -> FloatArray:
-    """End-effector positions only, fast.
-
-    Parameters
-    ----------
-    model
-        Any chain (locked joints included).
-    q
-        (..., n) joint angles [rad].
-    chunk
-        Samples per vectorised pass.
-
-    Returns
-    -------
-    (..., 3) end-effector positions in the root frame [m]; equal to
-    ``ee_pose(model, q)[..., :3, 3]`` to round-off.
-    """
-    q = as_joint_array(model, q)
-    flat = q.reshape(-1, model.dof)
-    consts, tool = _position_program(model)
-    out = np.empty((flat.shape[0], 3))
-    for s0 in range(0, flat.shape[0], chunk):  # chunks of samples, each fully vectorised
-        part = flat[s0 : s0 + chunk]
-        v: list = [float(t) for t in tool]
-        for i in range(model.dof - 1, -1, -1):
-            mat, off = consts[i]
-            if isinstance(v[0], float) and isinstance(v[1], float) and v[0] == 0.0 and v[1] == 0.0:
-                u = v  # the point is on this joint's axis: the joint cannot move it
-            else:
-                c, s = np.cos(part[:, i]), np.sin(part[:, i])
-                u = [_add(c * v[0], -(s * v[1])), _add(s * v[0], c * v[1]), v[2]]
-            v = [
-                _add(
-                    _add(_add(_mul(mat[k, 0], u[0]), _mul(mat[k, 1], u[1])), _mul(mat[k, 2], u[2])),
-                    float(off[k]),
-                )
-                for k in range(3)
-            ]
-        for k in range(3):
-            out[s0 : s0 + part.shape[0], k] = v[k]
-    return out.reshape(q.shape[:-1] + (3,))
 
 
 def sample_configurations(

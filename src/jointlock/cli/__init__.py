@@ -15,7 +15,7 @@ import sys
 from collections.abc import Sequence
 from typing import NoReturn
 
-from .. import __version__
+from .._version import __version__
 from ..errors import JointlockError
 
 #: Subcommand modules, in the order ``--help`` lists them.  A module listed here that is not
@@ -83,9 +83,18 @@ def _os_error_text(exc: OSError) -> str:
     return f"{paths}: {reason}"
 
 
+def _headless_backend() -> None:
+    """Choose matplotlib's non-interactive backend when there is no display (and the user set
+    none): the command line only writes files.  Only this entry point ever chooses a backend;
+    the library never does."""
+    if not (os.environ.get("MPLBACKEND") or os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        os.environ["MPLBACKEND"] = "Agg"
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (0 ok, 2 usage or input error, including a
     file or folder that cannot be read or written; tracebacks only with ``--debug``)."""
+    _headless_backend()
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
     commands = vars(args).pop("_commands", {})

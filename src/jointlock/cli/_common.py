@@ -4,8 +4,6 @@ output folders, JSON output and atomic figure files."""
 from __future__ import annotations
 
 import argparse
-import io
-import json
 import math
 import sys
 from pathlib import Path
@@ -14,6 +12,9 @@ from typing import Any
 import numpy as np
 
 from ..errors import ScenarioError
+from ..io.files import json_text, write_png  # noqa: F401  (write_png re-exported)
+from ..io.files import to_plain as _plain  # noqa: F401  (old name)
+from ..jobs._common import joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..robots import BUILTIN_ROBOTS, load_robot
@@ -71,16 +72,6 @@ def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None
                 raise ScenarioError(f"{option} {str(out)!r}: {str(parent)!r} is not a folder")
             break
     return out
-
-
-def write_png(fig: Any, path: str | Path, *, dpi: int = 110) -> None:
-    """``fig.savefig(path, dpi=dpi)`` as PNG, written atomically (in-memory buffer, then
-    :func:`jointlock.report.atomic_write_bytes`).  The figure is left open."""
-    from ..report import atomic_write_bytes
-
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi)
-    atomic_write_bytes(path, buf.getvalue())
 
 
 def add_robot_arguments(
@@ -145,79 +136,9 @@ def model_from_args(args: argparse.Namespace) -> ArmModel:
     return lock_joints(model, locks) if locks else model
 
 
-def locked_deg(model: ArmModel) -> dict[str, float]:
-    """``{"J": angle [deg]}`` of the locked joints, for JSON output."""
-    return {str(lj.number): math.degrees(lj.angle) for lj in model.locked}
-
-
-def locked_text(locked: dict[str, float]) -> str:
-    """``"joint J at DEG deg, ..."`` (or ``"none"``) from :func:`locked_deg`'s mapping."""
-    return ", ".join(f"joint {k} at {v:g} deg" for k, v in locked.items()) or "none"
-
-
-def joint_vector_deg(
-    model: ArmModel, values: list[float] | None, option: str, *, rates: bool = False
-) -> np.ndarray:
-    """Angles [rad] of the movable joints from a ``--*-deg`` option (or, with ``rates=True``,
-    rates [rad/s] or accelerations [rad/s^2] from a ``--*dq*-deg`` option).
-
-    Accepts either one value per movable joint, or one per joint of the full arm: the locked
-    joints' entries must then equal their lock angles (angles) or be 0 (``rates=True``: a
-    locked joint does not move).
-    """
-    if values is None:
-        return np.zeros(model.dof)
-    arr = np.radians(np.asarray(values, dtype=float))
-    if not np.all(np.isfinite(arr)):
-        raise ScenarioError(f"{option} must be finite numbers [deg]; got {values}")
-    if arr.size == model.dof:
-        return arr
-    if arr.size == model.full_dof and model.locked and rates:
-        bad = [lj.number for lj in model.locked if not abs(arr[lj.number - 1]) <= 1e-9]
-        if bad:
-            raise ScenarioError(
-                f"{option}: the entries of locked joints {bad} must be 0 (a locked joint does not "
-                "move; or give only the movable joints)"
-            )
-        return model.healthy(arr)
-    if arr.size == model.full_dof and model.locked:
-        full_locked = model.expand(model.healthy(arr))
-        if not np.allclose(full_locked, arr, atol=1e-9):
-            bad = [
-                lj.number
-                for lj in model.locked
-                if not math.isclose(arr[lj.number - 1], lj.angle, abs_tol=1e-9)
-            ]
-            raise ScenarioError(
-                f"{option}: the entries of locked joints {bad} must equal their lock angles "
-                "(or give only the movable joints)"
-            )
-        return model.healthy(arr)
-    raise ScenarioError(
-        f"{option} needs {model.dof} values (movable joints {list(model.joint_numbers)}) "
-        f"[deg]; got {arr.size}"
-    )
-
-
-def _plain(obj: Any) -> Any:
-    if isinstance(obj, np.ndarray):
-        return _plain(obj.tolist())
-    if isinstance(obj, (np.floating, float)):
-        value = float(obj)
-        return value if math.isfinite(value) else None
-    if isinstance(obj, np.integer):
-        return int(obj)
-    if isinstance(obj, dict):
-        return {str(k): _plain(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_plain(v) for v in obj]
-    return obj
-
-
 def print_json(obj: Any) -> None:
     """Print one JSON object (non-finite floats become null)."""
-    json.dump(_plain(obj), sys.stdout, indent=2, allow_nan=False)
-    sys.stdout.write("\n")
+    sys.stdout.write(json_text(obj))
 
 
 def format_matrix(mat: np.ndarray, fmt: str = "{:>11.5f}", col_labels: list[str] | None = None) -> str:

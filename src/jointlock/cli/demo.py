@@ -1,58 +1,16 @@
 """``jointlock demo``: the main job on the built-in default scenario, report written to a folder.
 
-The main job is 000 §5 on ``halt7`` (joint 4 locks at 0 deg): the optimal halt configuration,
-then the optimal halt motion from 000's state at failure, with the feasibility verdict -- the
-same run as ``jointlock run examples/halt_000.toml`` (:data:`DEMO_SCENARIO`).  Then a
-kinematic overview of every built-in arm: forward kinematics, Jacobian conditioning fixed vs
-free-floating, the lock-equivalence check for every joint, the virtual manipulator, and a 3-D
-drawing.  One ``report.html``, one ``results.json`` (``robots``: the overview; ``jobs``,
-``summary``, ``scenario``: the main job).
+A thin shell over :func:`jointlock.run.run_demo` (000 §5 on ``halt7`` -- the same run as
+``jointlock run examples/halt_000.toml`` -- and an overview of the built-in arms).
 """
 
 from __future__ import annotations
 
 import argparse
+import sys
 from pathlib import Path
 
-import numpy as np
-
-from .. import __version__
-from ..dynamics import mass_matrix
-from ..kinematics import generalized_jacobian, jacobian, link_poses, virtual_link_vectors
-from ..locking import lock
-from ..report import (
-    Section,
-    arm_points,
-    atomic_write_bytes,
-    draw_arm,
-    figure_png,
-    set_equal_3d,
-)
-from ..robots import BUILTIN_ROBOTS, load_robot
-from ..scenario import scenario_from_dict
-from .halt import PAPER_SCENARIO
-from .run import run_jobs, summary_lines, write_results
-
-#: The built-in default scenario: 000 §5 on halt7 (the content of examples/halt_000.toml).
-DEMO_SCENARIO = {
-    "title": "000 §5: halt7 halts after joint 4 locks at 0 deg",
-    "robot": "halt7",
-    "base": "floating",
-    "seed": 0,
-    "failure": {"joint": 4, "angle_deg": 0.0},
-    "state": {k: list(PAPER_SCENARIO[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg")},
-    "limits": {"vmax_deg": PAPER_SCENARIO["vmax_deg"], "amax_deg": PAPER_SCENARIO["amax_deg"]},
-    "halt_config": {"samples": 36000, "jacobian": "generalized"},
-    "halt": {"T": PAPER_SCENARIO["T"], "base": "fixed", "solver": "scan"},
-}
-
-#: Reference configurations [deg]: 000 §5 start (joint 4 at its lock angle 0), NOTES-001's
-#: start, 002's terminal example.
-REFERENCE_Q_DEG = {
-    "halt7": [-180.0, -180.0, -100.0, 0.0, -10.0, 20.0, 20.0],
-    "canadarm7": [10.0, 40.0, -70.0, 100.0, -60.0, 30.0, 20.0],
-    "puma6": [5.0, 60.0, 65.0, 10.0, -120.0, 90.0],
-}
+from ..run._demo import DEMO_SCENARIO, REFERENCE_Q_DEG, lock_equivalence, run_demo  # noqa: F401  (re-exported)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -62,146 +20,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def lock_equivalence(name: str, q_deg: list[float]) -> list[dict]:
-    """For every joint: lock it at its reference angle, compare with the full model frozen."""
-    full = load_robot(name)
-    q = np.radians(q_deg)
-    rows = []
-    t_full = link_poses(full, q)
-    j_full = jacobian(full, q)
-    m_full = mass_matrix(full, q)
-    for number in full.joint_numbers:
-        i = number - 1
-        locked = lock(full, number, q[i])
-        qh = np.delete(q, i)
-        keep = [k for k in range(full.dof) if k != i]
-        rows.append(
-            {
-                "joint": number,
-                "pose_error_m": float(np.abs(link_poses(locked, qh) - t_full[keep]).max()),
-                "jacobian_error": float(np.abs(jacobian(locked, qh) - j_full[:, keep]).max()),
-                "mass_matrix_error": float(
-                    np.abs(mass_matrix(locked, qh) - m_full[np.ix_(keep, keep)]).max()
-                ),
-            }
-        )
-    return rows
-
-
 def run(args: argparse.Namespace) -> int:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
     out = Path(args.out)
-    scenario = scenario_from_dict(DEMO_SCENARIO, source="built-in demo scenario (000 §5, halt7)")
-    results: dict = run_jobs(scenario, out, quiet=args.quiet)
-    results.update({"jointlock_version": __version__, "robots": {}})
-    sections = [
-        Section(
-            "The built-in arms",
-            paragraphs=[
-                "A kinematic overview of every built-in arm at a reference configuration: conditioning of "
-                "the fixed-base and generalized Jacobians, the lock-equivalence check (each joint locked "
-                "vs the full model frozen), the virtual manipulator."
-            ],
-        )
-    ]
-    for name in BUILTIN_ROBOTS:
-        fixed = load_robot(name)
-        floating = load_robot(name, base="floating")
-        q = np.radians(REFERENCE_Q_DEG[name])
-        sv_fixed = np.linalg.svd(jacobian(fixed, q), compute_uv=False)
-        sv_float = np.linalg.svd(generalized_jacobian(floating, q), compute_uv=False)
-        equivalence = lock_equivalence(name, REFERENCE_Q_DEG[name])
-        vm = np.linalg.norm(virtual_link_vectors(floating), axis=1)
-        pts, _ = arm_points(fixed, q)
-        results["robots"][name] = {
-            "q_deg": REFERENCE_Q_DEG[name],
-            "ee_position_m": pts[-1],
-            "singular_values_fixed": sv_fixed,
-            "singular_values_floating": sv_float,
-            "lock_equivalence": equivalence,
-            "virtual_link_lengths_m": vm,
-            "description": fixed.description,
-        }
-        fig = plt.figure(figsize=(5.5, 4.5))
-        ax = fig.add_subplot(projection="3d")
-        draw_arm(ax, fixed, q, label=f"{name} at the reference configuration")
-        draw_arm(ax, fixed, np.zeros(fixed.dof), label="q = 0", color="0.6")
-        set_equal_3d(ax, np.vstack([pts, arm_points(fixed, np.zeros(fixed.dof))[0]]))
-        ax.legend(loc="upper left", fontsize=8)
-        png = figure_png(fig)
-        plt.close(fig)
-        atomic_write_bytes(out / f"{name}_arm.png", png)
-        worst = max(max(r["pose_error_m"], r["jacobian_error"], r["mass_matrix_error"]) for r in equivalence)
-        sections.append(
-            Section(
-                level=3,
-                title=f"{name}: {fixed.dof} joints",
-                paragraphs=[
-                    fixed.description,
-                    f"Reference configuration [deg]: {REFERENCE_Q_DEG[name]}. End effector at "
-                    f"{np.round(pts[-1], 4).tolist()} m.",
-                    f"Lock equivalence (each joint locked at its reference angle vs the full model "
-                    f"with that joint frozen): worst difference {worst:.2e} "
-                    f"({'<span class=ok>equal</span>' if worst < 1e-9 else '<span class=bad>DIFFERENT</span>'}).",
-                ],
-                tables=[
-                    (
-                        ["Jacobian", "sigma_min", "sigma_max", "condition number", "manipulability"],
-                        [
-                            [
-                                "fixed base",
-                                sv_fixed[-1],
-                                sv_fixed[0],
-                                sv_fixed[0] / sv_fixed[-1],
-                                float(np.prod(sv_fixed)),
-                            ],
-                            [
-                                "free-floating (generalized)",
-                                sv_float[-1],
-                                sv_float[0],
-                                sv_float[0] / sv_float[-1],
-                                float(np.prod(sv_float)),
-                            ],
-                        ],
-                    ),
-                    (
-                        ["locked joint", "pose error [m]", "Jacobian error", "mass-matrix error"],
-                        [
-                            [r["joint"], r["pose_error_m"], r["jacobian_error"], r["mass_matrix_error"]]
-                            for r in equivalence
-                        ],
-                    ),
-                    (
-                        ["virtual link"] + [str(k) for k in range(len(vm))],
-                        [["length [m]"] + [float(v) for v in vm]],
-                    ),
-                ],
-                images=[
-                    (
-                        f"{name}: reference configuration (colour) and q = 0 (grey); x = link centres of mass",
-                        png,
-                    )
-                ],
-            )
-        )
-    write_results(
-        scenario,
-        results,
-        out,
-        title="jointlock demo: 000's halt on halt7, and the built-in arms",
-        extra_sections=sections,
-    )
+    demo = run_demo(progress=not args.quiet and sys.stderr.isatty())
+    demo.write(out)
     if not args.quiet:
-        for line in summary_lines(results):
+        for line in demo.summary():
             print(line)
-        for name, r in results["robots"].items():
-            print(
-                f"{name:<10} ee {np.round(r['ee_position_m'], 3).tolist()} m, "
-                f"sigma_min fixed {r['singular_values_fixed'][-1]:.4g}, floating {r['singular_values_floating'][-1]:.4g}"
-            )
         print(f"wrote {out / 'report.html'} and {out / 'results.json'}")
     return 0

@@ -4,28 +4,14 @@
 from __future__ import annotations
 
 import argparse
-import io
 import math
-import sys
 from pathlib import Path
 
-import numpy as np
-
-from ..analysis.ability import INDEX_NAMES
 from ..errors import ScenarioError
-from ..planning.halt_config import (
-    HaltReachability,
-    ReachabilityBound,
-    optimal_halt_configuration,
-    write_section_plots,
-)
-from ..progress import Progress
-from ..report import atomic_write_bytes, atomic_write_json
+from ..jobs.halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
+from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, ReachabilitySettings, study_halt_configuration
 from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
-from .halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, LIMITS_HELP, limits_text, resolve_limits
-
-#: Below this many samples no progress bar is shown (the run takes well under a second).
-PROGRESS_MIN_SAMPLES = 20000
+from .halt import LIMITS_HELP
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -118,7 +104,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltReachability | None:
+def _reachability(args: argparse.Namespace, model) -> ReachabilitySettings | None:
+    """The reachability options as typed settings (checked and named as options), or None."""
     given = [args.from_q_deg is not None, args.halt_time is not None]
     if not any(given):
         if args.from_dq_deg is not None or getattr(args, "from_ddq_deg", None) is not None:
@@ -129,57 +116,16 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilityBound | HaltRe
             "reachability needs both --from-q-deg and --halt-time (and optionally --from-dq-deg)"
         )
     q0 = joint_vector_deg(model, args.from_q_deg, "--from-q-deg")
-    dq0 = (
-        joint_vector_deg(model, args.from_dq_deg, "--from-dq-deg", rates=True)
-        if args.from_dq_deg
-        else np.zeros(model.dof)
-    )
+    dq0 = joint_vector_deg(model, args.from_dq_deg or None, "--from-dq-deg", rates=True)
     if not (math.isfinite(args.halt_time) and args.halt_time > 0):
         raise ScenarioError(f"--halt-time must be a finite number > 0 [s]; got {args.halt_time}")
-    ddq0 = (
-        joint_vector_deg(model, args.from_ddq_deg, "--from-ddq-deg", rates=True)
-        if getattr(args, "from_ddq_deg", None)
-        else np.zeros(model.dof)
+    ddq0 = joint_vector_deg(model, getattr(args, "from_ddq_deg", None) or None, "--from-ddq-deg", rates=True)
+    return ReachabilitySettings(
+        FailureState(q0, dq0, ddq0),
+        args.halt_time,
+        method=getattr(args, "reachability", "exact"),
+        per_joint_k=getattr(args, "per_joint_k", False),
     )
-    vmax, amax, v_src, a_src = resolve_limits(model, args.vmax_deg, args.amax_deg)
-    args.limit_sources = (v_src, a_src)  # for the text and JSON output
-    if getattr(args, "reachability", "exact") == "bound":
-        return ReachabilityBound(q0, dq0, args.halt_time, vmax, amax, ddq0)
-    return HaltReachability(
-        q0, dq0, ddq0, args.halt_time, vmax, amax, per_joint=getattr(args, "per_joint_k", False)
-    )
-
-
-def _samples_csv(result) -> bytes:
-    ind = result.indices_samples
-    table = np.column_stack(
-        [
-            np.degrees(result.q_samples),
-            ind.sigma_min,
-            ind.condition_number,
-            ind.manipulability,
-            result.cp_samples,
-        ]
-    )
-    header = ",".join([f"q{n}_deg" for n in result.joint_numbers] + list(INDEX_NAMES) + ["cp"])
-    buf = io.StringIO()
-    np.savetxt(buf, table, delimiter=",", header=header, comments="", fmt="%.10g")
-    return buf.getvalue().encode("utf-8")
-
-
-def _samples_npz(result) -> bytes:
-    ind = result.indices_samples
-    buf = io.BytesIO()
-    np.savez_compressed(
-        buf,
-        q_rad=result.q_samples,
-        joint_numbers=np.array(result.joint_numbers),
-        sigma_min=ind.sigma_min,
-        condition_number=ind.condition_number,
-        manipulability=ind.manipulability,
-        cp=result.cp_samples,
-    )
-    return buf.getvalue()
 
 
 def run(args: argparse.Namespace) -> int:
@@ -190,93 +136,30 @@ def run(args: argparse.Namespace) -> int:
     model = model_from_args(args)
     if not model.locked:
         raise ScenarioError("halt-config needs a locked joint: add --lock J=DEG (e.g. --lock 4=0)")
-    reach = _reachability(args, model)
-    show = not args.quiet and args.samples >= PROGRESS_MIN_SAMPLES
-    with Progress(args.samples, "sampling", enabled=None if show else False) as bar:
-        result = optimal_halt_configuration(
-            model,
-            samples=args.samples,
-            rng=args.seed,
-            jacobian=args.jacobian,
-            refine=not args.no_refine,
-            assignment=args.assignment,
-            renormalize=args.renormalize,
-            characteristic_length=args.length,
-            reachability=reach,
-            progress=bar,
-        )
-    data = {"robot": model.name, **result.to_dict()}
-    if reach is not None and data.get("reachability") is not None:
-        v_src, a_src = args.limit_sources
-        data["reachability"]["velocity_limit_source"] = v_src
-        data["reachability"]["acceleration_limit_source"] = a_src
+    result = study_halt_configuration(
+        model,
+        samples=args.samples,
+        rng=args.seed,
+        jacobian=args.jacobian,
+        assignment=args.assignment,
+        renormalize=args.renormalize,
+        refine=not args.no_refine,
+        length=args.length,
+        reachability=_reachability(args, model),
+        vmax_deg=args.vmax_deg,
+        amax_deg=args.amax_deg,
+        progress=not args.quiet and args.samples >= PROGRESS_MIN_SAMPLES,
+    )
+    data = result.to_dict()
     files = []
     if args.out:
-        out = Path(args.out)
-        atomic_write_json(out / "result.json", data)
-        atomic_write_bytes(out / "samples.npz", _samples_npz(result))
-        atomic_write_bytes(out / "samples.csv", _samples_csv(result))
-        files = [out / "result.json", out / "samples.npz", out / "samples.csv"]
-        files += write_section_plots(result, out)
+        files = [Path(args.out) / name for name in result.write(args.out)]
         data["files"] = [str(f) for f in files]
     if args.json:
         print_json(data)
         return 0
-    _print_text(model, result, reach, getattr(args, "limit_sources", None))
+    for line in result.summary():
+        print(line)
     if files:
         print(f"\nwrote {len(files)} files to {args.out}: " + ", ".join(f.name for f in files))
     return 0
-
-
-def _fmt_q(q: np.ndarray) -> str:
-    return "[" + ", ".join(f"{v:8.3f}" for v in np.degrees(q)) + "]"
-
-
-def _print_text(model, result, reach, sources=None) -> None:
-    locked = ", ".join(f"joint {k} at {math.degrees(v):g} deg" for k, v in result.locked.items())
-    print(
-        f"{model.name}: healthy joints {list(result.joint_numbers)}, locked: {locked}, base: {result.base}, "
-        f"Jacobian: {result.jacobian}"
-    )
-    if result.jacobian == "generalized" and result.base == "fixed":
-        print("  (fixed base: the generalized Jacobian is the fixed-base one; --base floating for 000's J_F)")
-    print(f"samples: {result.samples}, seed: {result.seed}")
-    if isinstance(reach, HaltReachability):
-        k_txt = ""
-        if result.k_range is not None:
-            lo, hi = np.degrees(result.k_range)
-            k_txt = f", shared k in [{lo:.4g}, {hi:.4g}] deg/s^6"
-        print(
-            f"reachability (exact, halt polynomial, {'one k per joint' if reach.per_joint else 'shared k'}, "
-            f"T = {reach.halt_time:g} s): {result.reachable_samples} of {result.samples} samples reachable"
-            f"{k_txt}; box {_fmt_q(result.lower)} .. {_fmt_q(result.upper)} deg"
-        )
-    elif reach is not None:
-        print(f"reachability: bang-bang bound, box {_fmt_q(result.lower)} .. {_fmt_q(result.upper)} deg")
-    if reach is not None and sources is not None:
-        nums = result.joint_numbers
-        print(f"  speed limits: {limits_text(nums, reach.velocity_limit, sources[0], 'deg/s')}")
-        print(f"  acceleration limits: {limits_text(nums, reach.acceleration_limit, sources[1], 'deg/s^2')}")
-    print(f"\n{'':<14}{'q [deg]':<62}{'CP':>9}{'sigma_min':>11}{'kappa':>11}{'w':>11}")
-    rows = [("best", result.best), ("best sample", result.best_sample), ("runner-up", result.runner_up)]
-    for label, c in rows:
-        if c is None:
-            continue
-        print(
-            f"{label:<14}{_fmt_q(c.q):<62}{c.cp:9.5f}{c.sigma_min:11.5g}{c.condition_number:11.5g}"
-            f"{c.manipulability:11.5g}"
-        )
-    gain = result.refinement_gain
-    rel = gain / abs(result.best_sample.cp) if result.best_sample.cp else float("nan")
-    print(f"refinement gain: {gain:+.5f} CP ({100 * rel:+.2f} %), {result.refine_evaluations} evaluations")
-    w = result.weights
-    ahp = result.ability.ahp
-    print(
-        f"\nweights ({result.ability.assignment} reading, "
-        f"{'renormalised' if result.ability.renormalize else 'not renormalised'}):"
-    )
-    print(f"  {'':<10}" + "".join(f"{name:>18}" for name in INDEX_NAMES))
-    for key in ("ahp", "entropy", "combined"):
-        print(f"  {key:<10}" + "".join(f"{w[key][name]:18.5f}" for name in INDEX_NAMES))
-    print(f"  AHP: lambda_max = {ahp.lambda_max:.6g}, CI = {ahp.ci:.3g}, CR = {ahp.cr:.3g} (RI = {ahp.ri:g})")
-    sys.stdout.flush()

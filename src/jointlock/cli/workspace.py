@@ -3,25 +3,14 @@
 from __future__ import annotations
 
 import argparse
-import io
-import math
 import sys
 from pathlib import Path
 
-import numpy as np
-
-from ..analysis.workspace import (
-    MIN_SAMPLES,
-    MIN_SAMPLES_PER_VOXEL,
-    _auto_voxel,
-    compare_workspaces,
-    projection_extent,
-    sample_workspace,
-)
+from ..analysis.workspace import MIN_SAMPLES
 from ..errors import ScenarioError
-from ..progress import Progress
+from ..jobs.workspace import VoxelTooSmallError, study_workspace
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, seed_arg, write_png
+from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, seed_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -67,129 +56,27 @@ def run(args: argparse.Namespace) -> int:
     if len(args.lock) > 1:
         raise ScenarioError(f"--lock may be given at most once; got {len(args.lock)}")
     model = load_robot(args.robot, base=args.base)
-    with Progress(1, "workspace", enabled=None if not args.json else False) as bar:
-        if args.lock:
-            joint, angle = args.lock[0]
-            cmp = compare_workspaces(
-                model, joint, angle, samples=args.samples, voxel=args.voxel, rng=args.seed
-            )
-            full, locked, voxel = cmp.full, cmp.locked, cmp.voxel
-            density, warnings = cmp.samples_per_voxel, cmp.warnings()
-            summary = {
-                "robot": model.name,
-                "samples": args.samples,
-                "seed": args.seed,
-                "lock": {"joint": joint, "angle_deg": math.degrees(angle)},
-                "voxel_m": voxel,
-                "volume_full_m3": cmp.volume_full,
-                "volume_locked_m3": cmp.volume_locked,
-                "share_kept": cmp.share_kept,
-                "share_kept_half_samples": cmp.share_kept_half,
-                "voxel_half_samples_m": cmp.voxel_half,
-                "locked_voxels_outside_full": cmp.outside,
-                "extent_full_m": projection_extent(full),
-                "extent_locked_m": projection_extent(locked),
-            }
-        else:
-            ws = sample_workspace(model, samples=args.samples, voxel=args.voxel, rng=args.seed)
-            full, locked, voxel = ws.points, None, ws.voxel
-            density, warnings = ws.samples_per_voxel, []
-            summary = {
-                "robot": model.name,
-                "samples": args.samples,
-                "seed": args.seed,
-                "lock": None,
-                "voxel_m": voxel,
-                "volume_full_m3": ws.volume,
-                "extent_full_m": projection_extent(full),
-            }
-        bar.update()
-    if args.voxel is not None and not density >= MIN_SAMPLES_PER_VOXEL:
-        raise ScenarioError(
-            f"--voxel {args.voxel:g} m is too small for {args.samples} samples: only {density:.2g} samples per "
-            f"occupied voxel on average, so the volume is about samples x voxel^3, not the workspace's; use a "
-            f"larger --voxel (automatic for these samples: {_auto_voxel(full):.3g} m) or more samples"
+    try:
+        result = study_workspace(
+            model,
+            args.lock[0] if args.lock else None,
+            samples=args.samples,
+            voxel=args.voxel,
+            rng=args.seed,
+            progress=not args.json,
         )
-    summary["samples_per_voxel"] = density
-    if locked is not None:
-        summary["warnings"] = warnings
-    for w in warnings:
+    except VoxelTooSmallError as exc:
+        raise ScenarioError(exc.message("--voxel")) from None
+    for w in result.warnings():
         print(f"jointlock workspace: warning: {w}", file=sys.stderr)
+    out = result.to_dict()
     if args.out is not None:
-        summary["files"] = _write(args.out, full, locked, summary)
+        out["files"] = result.write(args.out)
     if args.json:
-        print_json(summary)
+        print_json(out)
         return 0
-    print(
-        f"{model.name}: {args.samples} samples per arm (seed {args.seed}), voxel {voxel:.3g} m "
-        f"({density:.3g} samples per occupied voxel)"
-    )
-    print(f"  full arm volume   : {summary['volume_full_m3']:.3g} m^3")
-    if locked is not None:
-        lk = summary["lock"]
-        print(
-            f"  locked arm volume : {summary['volume_locked_m3']:.3g} m^3 (joint {lk['joint']} at {lk['angle_deg']:g} deg)"
-        )
-        print(
-            f"  share kept        : {100 * summary['share_kept']:.0f} % (from half the samples: "
-            f"{100 * summary['share_kept_half_samples']:.0f} %)"
-            + ("; not converged, see the warnings" if warnings else "")
-        )
-        print(
-            f"  locked voxels outside the full cloud (sampling): {100 * summary['locked_voxels_outside_full']:.1f} %"
-        )
-    for f in summary.get("files", []):
+    for line in result.summary():
+        print(line)
+    for f in out.get("files", []):
         print(f"wrote {f}")
     return 0
-
-
-def _write(out_dir: Path, full: np.ndarray, locked: np.ndarray | None, summary: dict) -> list[str]:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    from ..report import atomic_write_bytes, atomic_write_json
-
-    out_dir.mkdir(parents=True, exist_ok=True)
-    files = []
-    show = 20000
-    f_pts = full[:show]
-    l_pts = None if locked is None else locked[:show]
-    fig, axes = plt.subplots(1, 3, figsize=(14, 4.5))
-    for ax, (i, j, name) in zip(axes, ((0, 1, "xy"), (0, 2, "xz"), (1, 2, "yz"))):
-        ax.scatter(f_pts[:, i], f_pts[:, j], s=0.3, alpha=0.3, label="full arm", color="tab:blue")
-        if l_pts is not None:
-            ax.scatter(l_pts[:, i], l_pts[:, j], s=0.3, alpha=0.3, label="locked arm", color="tab:red")
-        ax.set_xlabel(f"{name[0]} [m]")
-        ax.set_ylabel(f"{name[1]} [m]")
-        ax.set_aspect("equal")
-        ax.set_title(f"{name} projection")
-    axes[0].legend(markerscale=20)
-    fig.tight_layout()
-    write_png(fig, out_dir / "projections.png", dpi=110)
-    plt.close(fig)
-    files.append(str(out_dir / "projections.png"))
-    fig = plt.figure(figsize=(11, 5))
-    clouds = [("full arm", f_pts, "tab:blue")] + (
-        [("locked arm", l_pts, "tab:red")] if l_pts is not None else []
-    )
-    for k, (title, pts, color) in enumerate(clouds):
-        ax = fig.add_subplot(1, len(clouds), k + 1, projection="3d")
-        ax.scatter(pts[:5000, 0], pts[:5000, 1], pts[:5000, 2], s=0.5, alpha=0.4, color=color)
-        ax.set_title(title)
-        ax.set_xlabel("x [m]")
-        ax.set_ylabel("y [m]")
-        ax.set_zlabel("z [m]")
-    fig.tight_layout()
-    write_png(fig, out_dir / "clouds.png", dpi=110)
-    plt.close(fig)
-    files.append(str(out_dir / "clouds.png"))
-    arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
-    buf = io.BytesIO()
-    np.savez_compressed(buf, **arrays)
-    atomic_write_bytes(out_dir / "points.npz", buf.getvalue())
-    files.append(str(out_dir / "points.npz"))
-    atomic_write_json(out_dir / "workspace.json", summary)
-    files.append(str(out_dir / "workspace.json"))
-    return files

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._search1d import bisect_root, golden_section_minimize
 from ..errors import ConfigurationError, ModelError
 from ..ik import (
     EXACT_POSITION_TOL,
@@ -243,15 +244,13 @@ def _locked_value(
 
 def _bisect(geom, poses, lo, hi, f_lo, branch, joint, angle):
     """Vectorised bisection of ``wrap(theta_j(gamma) - angle)`` on brackets (K,)."""
-    lo, hi, f_lo = lo.copy(), hi.copy(), f_lo.copy()
-    for _ in range(ROOT_BISECTIONS):  # bisection steps, every bracket at once
-        mid = 0.5 * (lo + hi)
-        f_mid = wrap_angle(_locked_value(geom, poses, mid, branch, joint) - angle)
-        left = np.sign(f_mid) == np.sign(f_lo)
-        lo = np.where(left, mid, lo)
-        f_lo = np.where(left, f_mid, f_lo)
-        hi = np.where(left, hi, mid)
-    return 0.5 * (lo + hi)
+    return bisect_root(
+        lambda g: wrap_angle(_locked_value(geom, poses, g, branch, joint) - angle),
+        lo,
+        hi,
+        f_lo=f_lo,
+        iterations=ROOT_BISECTIONS,
+    )
 
 
 def _brackets(f: FloatArray) -> FloatArray:
@@ -363,7 +362,6 @@ JUMP_MIN_STEP = math.radians(2.0)
 #: when every step is that large (a plan too coarse to follow the line: few waypoints).
 JUMP_MAX_STEP = math.radians(30.0)
 
-_GOLDEN = (math.sqrt(5.0) - 1.0) / 2.0
 
 
 @dataclass(frozen=True)
@@ -775,23 +773,7 @@ def _branch_error(model, geom_locked, nominal, gammas, branches, length_scale):
 
 def _golden(fun, lo: FloatArray, hi: FloatArray) -> FloatArray:
     """Vectorised golden-section minimisation of ``fun`` (K,) -> (K,) on ``[lo, hi]``."""
-    a, b = lo.astype(float).copy(), hi.astype(float).copy()
-    c = b - _GOLDEN * (b - a)
-    d = a + _GOLDEN * (b - a)
-    fc, fd = fun(c), fun(d)
-    for _ in range(REFINE_STEPS):
-        left = ~(fc > fd)  # minimum in [a, d]; NaN/inf compare False -> keep left
-        b = np.where(left, d, b)
-        a = np.where(left, a, c)
-        new = np.where(left, b - _GOLDEN * (b - a), a + _GOLDEN * (b - a))
-        fnew = fun(new)
-        c, d, fc, fd = (
-            np.where(left, new, d),
-            np.where(left, c, new),
-            np.where(left, fnew, fd),
-            np.where(left, fc, fnew),
-        )
-    return np.where(fc <= fd, c, d)
+    return golden_section_minimize(fun, lo, hi, iterations=REFINE_STEPS).x
 
 
 def _shortest_path(q: FloatArray, cost: FloatArray, weight: float) -> np.ndarray:

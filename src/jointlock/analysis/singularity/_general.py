@@ -1,0 +1,191 @@
+"""Singularity analysis of any arm: the task Jacobian, its singular values, rank, ``det(J J^T)``
+and lost directions (batched SVD)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...errors import ConfigurationError, ModelError, ScenarioError
+from ...kinematics import VMWeighting, generalized_jacobian, jacobian, virtual_manipulator
+from ...model import ArmModel, FloatArray
+
+BaseKind = Literal["fixed", "floating", "virtual"]
+BASE_KINDS: tuple[str, ...] = ("fixed", "floating", "virtual")
+
+#: Rank tolerance on a singular value (raw Jacobian: m/s or rad/s per rad/s).  Exactly
+#: singular configurations of the built-in arms give sigma_min ~ 1e-15; the smallest
+#: sigma_min of 10^5 random configurations is ~ 1e-3, so 1e-8 separates them by 5 decades.
+RANK_TOL = 1e-8
+
+
+def _rng(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, int | None]:
+    if isinstance(rng, np.random.Generator):
+        return rng, None
+    if rng is not None and not isinstance(rng, (int, np.integer)):
+        raise ScenarioError(f"rng must be an int seed, a numpy Generator or None; got {rng!r}")
+    return np.random.default_rng(rng), None if rng is None else int(rng)
+
+
+def _check_base(base: str) -> None:
+    if base not in BASE_KINDS:
+        raise ScenarioError(f"base must be one of {BASE_KINDS}; got {base!r}")
+
+
+def task_jacobian(
+    model: ArmModel,
+    q: ArrayLike,
+    *,
+    base: BaseKind = "fixed",
+    weighting: VMWeighting = "segment",
+    length: float | None = None,
+) -> FloatArray:
+    """The Jacobian whose singularities are analysed.
+
+    Parameters
+    ----------
+    model
+        The arm.  ``base="floating"`` and ``"virtual"`` need a free-floating model
+        (``model.floating``).
+    q
+        (..., n) joint angles [rad] of the movable joints.
+    base
+        ``"fixed"``: geometric Jacobian of the end effector (fixed base, or a spacecraft held
+        still), root-frame components.  ``"floating"``: generalized Jacobian, zero momentum
+        (000 eq. 5).  ``"virtual"``: Jacobian ``J^_m`` of the virtual manipulator (004 eqs.
+        10-12: free-flying arm with attitude held, or eq. 14 with the measured base rate
+        subtracted).
+    weighting
+        Virtual link lengths for ``base="virtual"`` (see :func:`jointlock.virtual_link_vectors`);
+        ``"segment"`` is 004's formula.
+    length
+        Characteristic length ``L`` [m]: the linear rows are divided by it.  ``None``: raw.
+
+    Returns
+    -------
+    (..., 6, n): twist ``(v, omega)`` of the end-effector origin, root-frame components.
+    """
+    _check_base(base)
+    if base != "fixed" and not model.floating:
+        raise ModelError(
+            f"base={base!r} needs a free-floating model (a spacecraft base); {model.name!r} has a fixed "
+            "base — load it with base='floating' or use base='fixed'"
+        )
+    if base == "fixed":
+        jac = jacobian(model, q)
+    elif base == "floating":
+        jac = generalized_jacobian(model, q)
+    else:
+        jac = virtual_manipulator(model, q, weighting=weighting).jacobian
+    if length is not None:
+        if not (math.isfinite(length) and length > 0):
+            raise ScenarioError(f"length must be a positive number of metres; got {length!r}")
+        jac = jac.copy()
+        jac[..., :3, :] /= length
+    return jac
+
+
+@dataclass(frozen=True)
+class SingularityAnalysis:
+    """Singular values, rank and lost task directions of a batch of Jacobians.
+
+    Attributes
+    ----------
+    jacobian
+        (..., 6, n) the analysed Jacobian (see :func:`task_jacobian`).
+    singular_values
+        (..., k) descending, ``k = min(6, n)``.
+    directions
+        (..., 6, 6) left singular vectors (columns), in the order of ``singular_values``;
+        columns ``k..5`` (only when ``n < 6``) span the directions the arm can never move in.
+    sigma_min
+        (...,) smallest singular value ``sigma_k``.
+    rank
+        (...,) number of singular values above ``tol``.
+    det_jjt
+        (...,) ``det(J J^T)`` (004's numerical test, Table 3); exactly 0 when ``n < 6``.
+    singular
+        (...,) ``rank < k``: the arm lost a direction it normally has.
+    lost
+        (..., 6) boolean mask over the columns of ``directions``: the lost directions
+        (``j < k`` and ``sigma_j <= tol``).  Each satisfies ``J^T u ~ 0``.
+    tol, base, weighting, length
+        The settings that produced it.
+    """
+
+    jacobian: FloatArray
+    singular_values: FloatArray
+    directions: FloatArray
+    sigma_min: FloatArray
+    rank: np.ndarray
+    det_jjt: FloatArray
+    singular: np.ndarray
+    lost: np.ndarray
+    tol: float
+    base: str
+    weighting: str
+    length: float | None
+
+    def lost_directions(self, index: tuple[int, ...] = ()) -> FloatArray:
+        """(6, r) lost directions of one configuration of the batch (``index`` into the
+        batch shape; ``()`` for an unbatched analysis), unit columns."""
+        return self.directions[index][:, self.lost[index]]
+
+
+def singularity_of_jacobian(
+    jac: ArrayLike,
+    *,
+    tol: float = RANK_TOL,
+    base: str = "given",
+    weighting: str = "",
+    length: float | None = None,
+) -> SingularityAnalysis:
+    """:class:`SingularityAnalysis` of given Jacobians (..., 6, n) (batched SVD)."""
+    jac = np.asarray(jac, dtype=float)
+    if jac.ndim < 2 or jac.shape[-2] != 6:
+        raise ConfigurationError(f"jac must have shape (..., 6, n); got {jac.shape}")
+    if not (math.isfinite(tol) and tol >= 0):
+        raise ScenarioError(f"tol must be a finite number >= 0; got {tol!r}")
+    u, s, _ = np.linalg.svd(jac, full_matrices=True)
+    k = s.shape[-1]
+    rank = np.count_nonzero(s > tol, axis=-1)
+    lost = np.zeros(jac.shape[:-2] + (6,), dtype=bool)
+    lost[..., :k] = s <= tol
+    return SingularityAnalysis(
+        jacobian=jac,
+        singular_values=s,
+        directions=u,
+        sigma_min=s[..., -1],
+        rank=rank,
+        det_jjt=np.linalg.det(jac @ np.swapaxes(jac, -1, -2)),
+        singular=rank < k,
+        lost=lost,
+        tol=float(tol),
+        base=base,
+        weighting=weighting,
+        length=length,
+    )
+
+
+def analyse_singularity(
+    model: ArmModel,
+    q: ArrayLike,
+    *,
+    base: BaseKind = "fixed",
+    weighting: VMWeighting = "segment",
+    tol: float = RANK_TOL,
+    length: float | None = None,
+) -> SingularityAnalysis:
+    """sigma_min, rank, det(J J^T) and lost directions of ``model`` at ``q`` (..., n) [rad].
+
+    The Jacobian is :func:`task_jacobian` (``base``, ``weighting``, ``length`` as there).
+    ``tol`` is the rank tolerance on singular values (units of the analysed matrix).  The lost
+    directions are left singular vectors: task-space twists ``(v, omega)`` (root frame) the
+    end effector cannot produce to first order.
+    """
+    jac = task_jacobian(model, q, base=base, weighting=weighting, length=length)
+    return singularity_of_jacobian(jac, tol=tol, base=base, weighting=weighting, length=length)

@@ -1,0 +1,125 @@
+"""Writing result files: atomic writes, JSON-safe conversion, figures as PNG/SVG bytes.
+
+Every file a job or a run writes goes through :func:`atomic_write_bytes` (a temporary file
+in the same folder, then a rename), so an interrupted run never leaves a half-written file.
+Figures are rendered from a :class:`matplotlib.figure.Figure` without pyplot, so writing
+files never touches the user's plotting backend.
+"""
+
+from __future__ import annotations
+
+import io
+import json
+import math
+import os
+import tempfile
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+#: Resolution of every PNG written [dots per inch].
+PNG_DPI = 110
+
+
+def to_plain(obj: Any) -> Any:
+    """``obj`` as plain JSON data: arrays -> lists, numpy scalars -> Python numbers, tuples ->
+    lists, dictionary keys -> strings, non-finite floats -> ``None`` (JSON has no NaN)."""
+    if isinstance(obj, np.ndarray):
+        return to_plain(obj.tolist())
+    if isinstance(obj, (np.floating, float)):
+        value = float(obj)
+        return value if math.isfinite(value) else None
+    if isinstance(obj, np.bool_):
+        return bool(obj)
+    if isinstance(obj, np.integer):
+        return int(obj)
+    if isinstance(obj, dict):
+        return {str(k): to_plain(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [to_plain(v) for v in obj]
+    return obj
+
+
+def json_text(obj: Any) -> str:
+    """``obj`` as indented JSON text (see :func:`to_plain`), with a final newline."""
+    return json.dumps(to_plain(obj), indent=2, allow_nan=False) + "\n"
+
+
+def _umask() -> int:
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` via a temporary file and a rename, so an interrupted run
+    never leaves a half-written file (parent folders are created)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.chmod(tmp, 0o666 & ~_umask())  # mkstemp makes 0600; give the usual permissions
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """:func:`atomic_write_bytes` of ``text`` encoded as UTF-8."""
+    atomic_write_bytes(path, text.encode("utf-8"))
+
+
+def atomic_write_json(path: str | Path, obj: Any) -> None:
+    """:func:`atomic_write_text` of :func:`json_text` (non-finite floats written as null)."""
+    atomic_write_text(path, json_text(obj))
+
+
+def csv_text(columns: dict[str, np.ndarray], fmt: str = "{:.9g}") -> str:
+    """A CSV table, one column per ``{header: (rows,) values}``, header line first."""
+    header = ",".join(columns)
+    rows = np.column_stack([np.asarray(v, dtype=float) for v in columns.values()])
+    body = "\n".join(",".join(fmt.format(v) for v in row) for row in rows)
+    return header + "\n" + body + "\n"
+
+
+def npz_bytes(**arrays: Any) -> bytes:
+    """``np.savez`` of ``arrays`` into bytes (to write atomically)."""
+    buf = io.BytesIO()
+    np.savez(buf, **arrays)
+    return buf.getvalue()
+
+
+def figure_png(fig: Any, dpi: int = PNG_DPI) -> bytes:
+    """The figure as PNG bytes (tight bounding box)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
+    return buf.getvalue()
+
+
+def figure_svg(fig: Any) -> bytes:
+    """The figure as SVG (text kept as paths, so it renders the same everywhere)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="svg", bbox_inches="tight")
+    return buf.getvalue()
+
+
+def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = PNG_DPI, svg: bool = True) -> bytes:
+    """Write ``folder/stem.png`` (and ``folder/stem.svg`` unless ``svg=False``) atomically;
+    returns the PNG bytes (to embed in a report).  The figure is left open."""
+    png = figure_png(fig, dpi=dpi)
+    atomic_write_bytes(Path(folder) / f"{stem}.png", png)
+    if svg:
+        atomic_write_bytes(Path(folder) / f"{stem}.svg", figure_svg(fig))
+    return png
+
+
+def write_png(fig: Any, path: str | Path, *, dpi: int = PNG_DPI) -> None:
+    """``fig.savefig(path, dpi=dpi)`` as PNG (the figure's own bounding box), written
+    atomically.  The figure is left open."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    atomic_write_bytes(path, buf.getvalue())

@@ -1,0 +1,105 @@
+"""What every job result shares, and the input helpers the jobs use.
+
+A *job* is one library call that takes typed inputs and returns a typed result: a frozen
+dataclass deriving from :class:`JobResult`, picklable (it crosses process boundaries in
+campaigns), with
+
+- ``to_dict()``: plain JSON data (the object ``jointlock COMMAND --json`` prints: same keys,
+  same units),
+- ``summary()``: the lines ``jointlock COMMAND`` prints,
+- ``write(out)``: the files ``jointlock COMMAND --out DIR`` writes (plots, time series,
+  ``result.json``), atomically; returns their names,
+
+and plots through :mod:`jointlock.plots`.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..errors import ScenarioError
+from ..io.files import json_text, to_plain
+from ..model import ArmModel
+
+
+class JobResult:
+    """Base of every job's result (mix into a frozen dataclass)."""
+
+    #: Name of the job (``"halt"``, ``"jump"``, ...), as in scenario files.
+    job: ClassVar[str] = ""
+
+    def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every result overrides it
+        raise NotImplementedError
+
+    def summary(self) -> list[str]:  # pragma: no cover - every result overrides it
+        raise NotImplementedError
+
+    def write(self, out: str | Path) -> list[str]:  # pragma: no cover - every result overrides it
+        raise NotImplementedError
+
+    def to_json(self) -> str:
+        """:meth:`to_dict` as JSON text (non-finite numbers as null)."""
+        return json_text(self.to_dict())
+
+    def plain(self) -> dict[str, Any]:
+        """:meth:`to_dict` with arrays as lists and NaN as None (what JSON holds)."""
+        return to_plain(self.to_dict())
+
+
+def locked_deg(model: ArmModel) -> dict[str, float]:
+    """``{"J": angle [deg]}`` of the locked joints, for JSON output."""
+    return {str(lj.number): math.degrees(lj.angle) for lj in model.locked}
+
+
+def locked_text(locked: dict[str, float]) -> str:
+    """``"joint J at DEG deg, ..."`` (or ``"none"``) from :func:`locked_deg`'s mapping."""
+    return ", ".join(f"joint {k} at {v:g} deg" for k, v in locked.items()) or "none"
+
+
+def joint_vector_deg(
+    model: ArmModel, values: Any, option: str, *, rates: bool = False
+) -> np.ndarray:
+    """Angles [rad] of the movable joints from degrees (or, with ``rates=True``, rates
+    [rad/s] or accelerations [rad/s^2] from deg/s or deg/s^2); ``option`` names the option or
+    field in error messages.
+
+    Accepts either one value per movable joint, or one per joint of the full arm: the locked
+    joints' entries must then equal their lock angles (angles) or be 0 (``rates=True``: a
+    locked joint does not move).  ``None`` gives zeros.
+    """
+    if values is None:
+        return np.zeros(model.dof)
+    arr = np.radians(np.asarray(values, dtype=float))
+    if not np.all(np.isfinite(arr)):
+        raise ScenarioError(f"{option} must be finite numbers [deg]; got {list(values)}")
+    if arr.size == model.dof:
+        return arr
+    if arr.size == model.full_dof and model.locked and rates:
+        bad = [lj.number for lj in model.locked if not abs(arr[lj.number - 1]) <= 1e-9]
+        if bad:
+            raise ScenarioError(
+                f"{option}: the entries of locked joints {bad} must be 0 (a locked joint does not "
+                "move; or give only the movable joints)"
+            )
+        return model.healthy(arr)
+    if arr.size == model.full_dof and model.locked:
+        full_locked = model.expand(model.healthy(arr))
+        if not np.allclose(full_locked, arr, atol=1e-9):
+            bad = [
+                lj.number
+                for lj in model.locked
+                if not math.isclose(arr[lj.number - 1], lj.angle, abs_tol=1e-9)
+            ]
+            raise ScenarioError(
+                f"{option}: the entries of locked joints {bad} must equal their lock angles "
+                "(or give only the movable joints)"
+            )
+        return model.healthy(arr)
+    raise ScenarioError(
+        f"{option} needs {model.dof} values (movable joints {list(model.joint_numbers)}) "
+        f"[deg]; got {arr.size}"
+    )

@@ -1,0 +1,329 @@
+"""Job ``workspace``: Monte Carlo workspace of the full arm and of the locked arm (002 Figs. 2-3).
+
+Joint angles are sampled uniformly within the limits (capped to +-180 deg); the end-effector
+positions of the full arm and, with a lock, of the arm with that joint locked give each
+volume by voxel occupancy on one common grid, and the share of the full workspace that the
+locked arm keeps (:mod:`jointlock.analysis.workspace` does the sampling; this job adds the
+settings, the checks and the outputs).  The command ``jointlock workspace`` is this call plus
+printing.
+"""
+
+from __future__ import annotations
+
+import io
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..analysis.workspace import (
+    MIN_SAMPLES,
+    MIN_SAMPLES_PER_VOXEL,
+    Workspace,
+    WorkspaceComparison,
+    _auto_voxel,
+    compare_workspaces,
+    projection_extent,
+    sample_workspace,
+)
+from ..errors import ScenarioError
+from ..io import files as _files
+from ..io.files import atomic_write_json, write_png
+from ..model import ArmModel
+from ..progress import Progress
+from ..robots import load_robot
+from ._common import JobResult
+
+#: Points of each cloud drawn in the projections, and in the 3-D clouds.
+PROJECTION_POINTS = 20000
+CLOUD_POINTS = 5000
+
+#: Size of the projections figure [inch], and of the clouds figure.
+PROJECTIONS_FIGSIZE = (14.0, 4.5)
+CLOUDS_FIGSIZE = (11.0, 5.0)
+
+
+class VoxelTooSmallError(ScenarioError):
+    """A given voxel holds fewer than :data:`~jointlock.analysis.workspace.MIN_SAMPLES_PER_VOXEL`
+    samples on average: the volume would be about ``samples x voxel^3``, not the workspace's.
+
+    Attributes
+    ----------
+    voxel
+        The voxel side given [m].
+    samples
+        Configurations per arm.
+    density
+        Mean samples per occupied voxel [-].
+    auto_voxel
+        The automatic voxel side for these samples [m].
+    """
+
+    def __init__(self, voxel: float, samples: int, density: float, auto_voxel: float) -> None:
+        self.voxel, self.samples, self.density, self.auto_voxel = voxel, samples, density, auto_voxel
+        super().__init__(self.message("voxel"))
+
+    def message(self, option: str) -> str:
+        """The error's text, naming the parameter or option ``option`` (e.g. ``"--voxel"``)."""
+        return (
+            f"{option} {self.voxel:g} m is too small for {self.samples} samples: only {self.density:.2g} samples "
+            f"per occupied voxel on average, so the volume is about samples x voxel^3, not the workspace's; use a "
+            f"larger {option} (automatic for these samples: {self.auto_voxel:.3g} m) or more samples"
+        )
+
+    def __reduce__(self) -> tuple[Any, ...]:
+        return (type(self), (self.voxel, self.samples, self.density, self.auto_voxel))
+
+
+@dataclass(frozen=True)
+class WorkspaceStudy(JobResult):
+    """The Monte Carlo workspace of an arm, and of the arm with one joint locked.
+
+    Attributes
+    ----------
+    robot
+        Name of the arm.
+    samples
+        Configurations per arm.
+    seed
+        The seed the samples were drawn with (None when a Generator was passed).
+    workspace
+        Without a lock: the full arm's :class:`~jointlock.analysis.workspace.Workspace`
+        (``points`` (N, 3) [m], ``voxel`` [m], ``volume`` [m^3]).  With one: the
+        :class:`~jointlock.analysis.workspace.WorkspaceComparison` (``full`` (N, 3), ``locked``
+        (N, 3) [m], both volumes, the share kept and its half-sample estimate).
+    """
+
+    job: ClassVar[str] = "workspace"
+
+    robot: str
+    samples: int
+    seed: int | None
+    workspace: Workspace | WorkspaceComparison
+
+    @property
+    def locked(self) -> bool:
+        """A joint was locked (the study compares two workspaces)."""
+        return isinstance(self.workspace, WorkspaceComparison)
+
+    @property
+    def full_points(self) -> np.ndarray:
+        """(N, 3) end-effector positions of the full arm [m]."""
+        ws = self.workspace
+        return ws.full if isinstance(ws, WorkspaceComparison) else ws.points
+
+    @property
+    def locked_points(self) -> np.ndarray | None:
+        """(N, 3) end-effector positions of the locked arm [m], or None."""
+        ws = self.workspace
+        return ws.locked if isinstance(ws, WorkspaceComparison) else None
+
+    @property
+    def samples_per_voxel(self) -> float:
+        """Mean full-arm samples per occupied voxel [-]."""
+        return self.workspace.samples_per_voxel
+
+    def warnings(self) -> list[str]:
+        """Why the share kept should not be trusted to its digits (empty without a lock, or when
+        it looks converged)."""
+        ws = self.workspace
+        return ws.warnings() if isinstance(ws, WorkspaceComparison) else []
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object of ``jointlock workspace --json`` (without ``files``)."""
+        ws = self.workspace
+        if isinstance(ws, WorkspaceComparison):
+            out = {
+                "robot": self.robot,
+                "samples": self.samples,
+                "seed": self.seed,
+                "lock": {"joint": ws.joint, "angle_deg": math.degrees(ws.angle)},
+                "voxel_m": ws.voxel,
+                "volume_full_m3": ws.volume_full,
+                "volume_locked_m3": ws.volume_locked,
+                "share_kept": ws.share_kept,
+                "share_kept_half_samples": ws.share_kept_half,
+                "voxel_half_samples_m": ws.voxel_half,
+                "locked_voxels_outside_full": ws.outside,
+                "extent_full_m": projection_extent(ws.full),
+                "extent_locked_m": projection_extent(ws.locked),
+                "samples_per_voxel": ws.samples_per_voxel,
+                "warnings": ws.warnings(),
+            }
+        else:
+            out = {
+                "robot": self.robot,
+                "samples": self.samples,
+                "seed": self.seed,
+                "lock": None,
+                "voxel_m": ws.voxel,
+                "volume_full_m3": ws.volume,
+                "extent_full_m": projection_extent(ws.points),
+                "samples_per_voxel": ws.samples_per_voxel,
+            }
+        return out
+
+    def summary(self) -> list[str]:
+        """The lines ``jointlock workspace`` prints on stdout (the warnings, which it prints on
+        stderr, are :meth:`warnings`)."""
+        ws = self.workspace
+        density = self.samples_per_voxel
+        lines = [
+            f"{self.robot}: {self.samples} samples per arm (seed {self.seed}), voxel {ws.voxel:.3g} m "
+            f"({density:.3g} samples per occupied voxel)"
+        ]
+        if isinstance(ws, WorkspaceComparison):
+            warnings = ws.warnings()
+            lines += [
+                f"  full arm volume   : {ws.volume_full:.3g} m^3",
+                f"  locked arm volume : {ws.volume_locked:.3g} m^3 (joint {ws.joint} at "
+                f"{math.degrees(ws.angle):g} deg)",
+                f"  share kept        : {100 * ws.share_kept:.0f} % (from half the samples: "
+                f"{100 * ws.share_kept_half:.0f} %)"
+                + ("; not converged, see the warnings" if warnings else ""),
+                f"  locked voxels outside the full cloud (sampling): {100 * ws.outside:.1f} %",
+            ]
+        else:
+            lines.append(f"  full arm volume   : {ws.volume:.3g} m^3")
+        return lines
+
+    def file_names(self) -> list[str]:
+        """The names :meth:`write` writes (its JSON lists them as paths)."""
+        return ["projections.png", "clouds.png", "points.npz", "workspace.json"]
+
+    def write(self, out: str | Path) -> list[str]:
+        """Write ``projections.png`` (xy, xz, yz), ``clouds.png`` (002 Figs. 2-3),
+        ``points.npz`` (``full`` (N, 3) and, with a lock, ``locked`` [m]; compressed) and
+        ``workspace.json`` (:meth:`to_dict`) to the folder ``out``; returns their paths
+        (``str(out / name)``)."""
+        from ..plots._common import offscreen_figure
+        from ..plots.workspace import plot_workspace_clouds, plot_workspace_projections
+
+        folder = Path(out)
+        folder.mkdir(parents=True, exist_ok=True)
+        full, locked = self.full_points, self.locked_points
+        files = []
+        fig = plot_workspace_projections(full, locked, fig=offscreen_figure(PROJECTIONS_FIGSIZE))
+        write_png(fig, folder / "projections.png", dpi=110)
+        files.append(str(folder / "projections.png"))
+        fig = plot_workspace_clouds(full, locked, fig=offscreen_figure(CLOUDS_FIGSIZE))
+        write_png(fig, folder / "clouds.png", dpi=110)
+        files.append(str(folder / "clouds.png"))
+        arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
+        buf = io.BytesIO()
+        np.savez_compressed(buf, **arrays)
+        _files.atomic_write_bytes(folder / "points.npz", buf.getvalue())  # looked up here: spies see it
+        files.append(str(folder / "points.npz"))
+        atomic_write_json(folder / "workspace.json", self.to_dict())
+        files.append(str(folder / "workspace.json"))
+        return files
+
+
+def _seed(rng: int | np.random.Generator | None) -> int | np.random.Generator:
+    """``rng`` as given when it is a seed or a Generator; None: a fresh seed (recorded)."""
+    if rng is None:
+        return int(np.random.SeedSequence().generate_state(1)[0])
+    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
+        if rng < 0:
+            raise ScenarioError(f"rng must be a seed >= 0 or a numpy Generator; got {rng}")
+        return int(rng)
+    if isinstance(rng, np.random.Generator):
+        return rng
+    raise ScenarioError(f"rng must be a seed >= 0, a numpy Generator or None; got {rng!r}")
+
+
+def study_workspace(
+    model: ArmModel,
+    locked: tuple[int, float] | None = None,
+    *,
+    samples: int = 200_000,
+    voxel: float | None = None,
+    rng: int | np.random.Generator | None = 0,
+    progress: bool = False,
+) -> WorkspaceStudy:
+    """Monte Carlo workspace of ``model`` and, with ``locked``, of ``model`` with that joint
+    locked (002 Figs. 2-3).
+
+    Parameters
+    ----------
+    model
+        The healthy arm.
+    locked
+        ``(joint, angle)``: the joint to lock (1-based) and its angle [rad]; None: the full
+        arm alone.
+    samples
+        Configurations per arm, >= :data:`~jointlock.analysis.workspace.MIN_SAMPLES`.
+    voxel
+        Voxel side [m] of the volume estimate, > 0; None: automatic (about
+        :data:`~jointlock.analysis.workspace.SAMPLES_PER_VOXEL` samples per voxel).
+    rng
+        Seed (integer >= 0) or Generator; None draws a fresh seed, which is recorded
+        (``result.seed``).  The full arm's samples come first, then the locked arm's.
+    progress
+        Show a progress bar on stderr (when it is a terminal).
+
+    Returns
+    -------
+    WorkspaceStudy
+
+    Raises
+    ------
+    ScenarioError
+        A parameter out of range (the message names it).
+    VoxelTooSmallError
+        A given ``voxel`` holds too few samples for a meaningful volume.
+    """
+    if not (isinstance(samples, (int, np.integer)) and samples >= MIN_SAMPLES):
+        raise ScenarioError(
+            f"samples must be an integer >= {MIN_SAMPLES} (a voxel-occupancy volume from fewer samples says "
+            f"little); got {samples}"
+        )
+    if voxel is not None and not (math.isfinite(voxel) and voxel > 0):
+        raise ScenarioError(f"voxel must be a finite number > 0 [m]; got {voxel}")
+    seed = _seed(rng)
+    samples = int(samples)
+    with Progress(1, "workspace", enabled=None if progress else False) as bar:
+        if locked is not None:
+            joint, angle = locked
+            ws: Workspace | WorkspaceComparison = compare_workspaces(
+                model, joint, angle, samples=samples, voxel=voxel, rng=seed
+            )
+            points = ws.full
+        else:
+            ws = sample_workspace(model, samples=samples, voxel=voxel, rng=seed)
+            points = ws.points
+        bar.update()
+    density = ws.samples_per_voxel
+    if voxel is not None and not density >= MIN_SAMPLES_PER_VOXEL:
+        raise VoxelTooSmallError(float(voxel), samples, density, _auto_voxel(points))
+    return WorkspaceStudy(
+        robot=model.name,
+        samples=samples,
+        seed=None if isinstance(seed, np.random.Generator) else seed,
+        workspace=ws,
+    )
+
+
+def workspace_from_scenario(
+    data: Mapping[str, Any], previous: Mapping[str, JobResult], *, progress: bool = False
+) -> WorkspaceStudy:
+    """Run the job for a resolved scenario (``Scenario.data``: the top-level ``robot``, ``base``,
+    ``seed`` and ``[failure]`` (optional), and the ``[workspace]`` table); ``previous`` is not
+    used.  Same result as ``jointlock workspace`` with the scenario's options."""
+    failure = data.get("failure", {})
+    lk = None
+    if failure.get("joint") is not None and failure.get("angle_deg") is not None:
+        lk = (int(failure["joint"]), math.radians(float(failure["angle_deg"])))
+    t = data["workspace"]
+    model = load_robot(data["robot"], base=data["base"])
+    return study_workspace(
+        model,
+        lk,
+        samples=int(t["samples"]),
+        voxel=None if t["voxel"] is None else float(t["voxel"]),
+        rng=int(data["seed"]),
+        progress=progress,
+    )

@@ -1,0 +1,190 @@
+"""The limits of one halt problem (000 eq. 33): exact feasible ``k`` interval, violations,
+least-violating ``k`` and the smallest feasible halt time."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+from scipy.optimize import minimize_scalar
+
+from ..._search1d import bisect_boundary
+from ...model import FloatArray
+from ._constants import LIMIT_RTOL, LimitKind
+from ._problem import HaltProblem
+
+
+@dataclass(frozen=True)
+class Violation:
+    """One violated limit: joint number (1-based), which limit, the limit, the worst value
+    reached, by how much it is exceeded (same unit, > 0), and when [s].  Values in SI
+    (rad, rad/s, rad/s^2)."""
+
+    joint: int
+    kind: LimitKind
+    limit: float
+    value: float
+    excess: float
+    time: float
+
+    def describe(self) -> str:
+        unit = {"angle": "deg", "velocity": "deg/s", "acceleration": "deg/s^2"}[self.kind]
+        return (
+            f"joint {self.joint} {self.kind} reaches {math.degrees(self.value):.3f} {unit} at "
+            f"t = {self.time:.3f} s: limit {math.degrees(self.limit):.3f} {unit} exceeded by "
+            f"{math.degrees(self.excess):.3f} {unit} ({100 * self.excess / abs(self.limit):.1f} %)"
+        )
+
+
+def _limits(problem: HaltProblem) -> tuple[FloatArray, FloatArray]:
+    """(3, n) lower and upper limits for angle, velocity, acceleration."""
+    lo = np.stack([problem.q_min, -problem.dq_max, -problem.ddq_max])
+    hi = np.stack([problem.q_max, problem.dq_max, problem.ddq_max])
+    return lo, hi
+
+
+def _slack(lo: FloatArray, hi: FloatArray) -> FloatArray:
+    """Round-off slack of each limit (relative to its finite ends; an infinite end -- no
+    limit -- needs none)."""
+    lo, hi = np.where(np.isfinite(lo), lo, 0.0), np.where(np.isfinite(hi), hi, 0.0)
+    return LIMIT_RTOL * np.maximum(np.maximum(np.abs(lo), np.abs(hi)), 1.0)
+
+
+def feasible_k_intervals(problem: HaltProblem) -> FloatArray:
+    """Exact feasible interval of ``k`` for every joint on the check grid.
+
+    Each limit at each time is affine in ``k`` (``g0(t) + k phi(t)``), so every joint's
+    feasible set is an interval; for a shared ``k`` (000) intersect them
+    (:func:`shared_k_interval`).
+
+    Returns
+    -------
+    (n, 2) ``[k_min, k_max]`` per joint [rad/s^6]; ``k_min > k_max`` (or NaN-free
+    ``+inf/-inf``) when empty.
+    """
+    t = problem.times(problem.n_check)
+    base = np.stack(problem.base_profile(t))  # (3, n_t, n)
+    shape = np.stack(problem.k_shape(t))[:, :, None]  # (3, n_t, 1)
+    lo, hi = _limits(problem)
+    sl = _slack(lo, hi)
+    lo_s, hi_s = (lo - sl)[:, None, :], (hi + sl)[:, None, :]
+    nz = np.abs(shape) > 0
+    safe = np.where(nz, shape, 1.0)
+    b1 = (lo[:, None, :] - base) / safe  # exact limits, so that k on a bound is within the slack
+    b2 = (hi[:, None, :] - base) / safe
+    kmin = np.where(nz, np.minimum(b1, b2), -np.inf)
+    kmax = np.where(nz, np.maximum(b1, b2), np.inf)
+    # where phi^(j)(t) = 0 the value does not depend on k: it must already be within limits
+    fixed_bad = (~nz) & ((base < lo_s) | (base > hi_s))
+    kmin = np.where(fixed_bad, np.inf, kmin)
+    kmax = np.where(fixed_bad, -np.inf, kmax)
+    return np.stack([kmin.max(axis=(0, 1)), kmax.min(axis=(0, 1))], axis=-1)
+
+
+def shared_k_interval(problem: HaltProblem) -> tuple[float, float]:
+    """Feasible interval of one shared ``k`` [rad/s^6]; empty when ``lo > hi``."""
+    per = feasible_k_intervals(problem)
+    return float(per[:, 0].max()), float(per[:, 1].min())
+
+
+def relative_violation(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
+    """Largest limit excess relative to its limit (0 when feasible), for a batch of ``k``:
+    (...) [-]; a number per candidate, max over joints, limits and the check grid."""
+    t = problem.times(problem.n_check)
+    lo, hi = _limits(problem)
+    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint), axis=-3)  # (..., 3, n_t, n)
+    scale = np.maximum(np.abs(lo), np.abs(hi))
+    scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
+    excess = np.maximum(traj - hi[:, None, :], lo[:, None, :] - traj) / scale
+    return np.maximum(excess.max(axis=(-3, -2, -1)), 0.0)
+
+
+def constraint_violations(
+    problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False
+) -> tuple[Violation, ...]:
+    """Every violated (joint, limit) pair for one ``k`` (scalar, or (n,) with
+    ``per_joint=True``), worst first; empty when the halt is within all limits (eq. 33)."""
+    t = problem.times(problem.n_check)
+    lo, hi = _limits(problem)
+    sl = _slack(lo, hi)
+    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint))  # (3, n_t, n)
+    over = traj - hi[:, None, :]
+    under = lo[:, None, :] - traj
+    out = []
+    for kind_i, kind in enumerate(("angle", "velocity", "acceleration")):
+        for j in range(problem.dof):
+            for arr, lim in ((over, hi), (under, lo)):
+                i_t = int(np.argmax(arr[kind_i, :, j]))
+                excess = float(arr[kind_i, i_t, j])
+                if excess > sl[kind_i, j]:
+                    out.append(
+                        Violation(
+                            joint=problem.model.joint_numbers[j],
+                            kind=kind,  # type: ignore[arg-type]
+                            limit=float(lim[kind_i, j]),
+                            value=float(traj[kind_i, i_t, j]),
+                            excess=excess,
+                            time=float(t[i_t]),
+                        )
+                    )
+    return tuple(sorted(out, key=lambda v: -v.excess / max(abs(v.limit), 1e-300)))
+
+
+def least_violating_k(problem: HaltProblem) -> float:
+    """Shared ``k`` [rad/s^6] minimising the largest relative limit excess (a convex,
+    piecewise-linear function of ``k``): dense scan, then bounded refinement."""
+    per = feasible_k_intervals(problem)
+    ends = per[np.isfinite(per)]
+    span = max(float(np.abs(ends).max()) if ends.size else 0.0, 1e-12)
+    grid = np.linspace(-2 * span, 2 * span, 801)
+    viol = np.concatenate([relative_violation(problem, grid[i : i + 100]) for i in range(0, grid.size, 100)])
+    i = int(np.argmin(viol))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    res = minimize_scalar(
+        lambda x: float(relative_violation(problem, x)),
+        bounds=(a, b),
+        method="bounded",
+        options={"xatol": 1e-12 * span + 1e-15},
+    )
+    return float(res.x) if res.fun <= viol[i] else float(grid[i])
+
+
+def _start_breaks_limits(problem: HaltProblem) -> bool:
+    """The state at failure itself is outside a limit (beyond the round-off slack): the halt
+    starts from it (the ``k``-part and its first two derivatives vanish at ``t = 0``)."""
+    lo, hi = _limits(problem)
+    start = np.stack([problem.q0, problem.dq0, problem.ddq0])
+    sl = _slack(lo, hi)
+    return bool(np.any((start < lo - sl) | (start > hi + sl)))
+
+
+def minimum_halt_time(
+    problem: HaltProblem, *, t_min: float = 0.5, t_max: float | None = None, tol: float = 1e-3
+) -> float | None:
+    """Smallest halt time ``T`` [s] for which a feasible shared ``k`` exists.
+
+    Scans ``T`` on a grid of 0.25 s steps from ``t_min`` to ``t_max`` (default
+    ``max(10 T, 120 s)``), then bisects the first infeasible-to-feasible bracket to
+    ``tol`` [s].  Returns None when no ``T`` in the range is feasible, at once when the state
+    at failure itself breaks a limit (every halt starts from it, whatever ``T`` and ``k``).
+    """
+    if _start_breaks_limits(problem):
+        return None  # the halt starts from this state whatever T and k: no T helps
+    t_max = max(10 * problem.T, 120.0) if t_max is None else t_max
+    grid = np.arange(t_min, t_max + 1e-9, 0.25)
+
+    def ok(T: float) -> bool:
+        lo, hi = shared_k_interval(problem.with_time(T))
+        return lo <= hi
+
+    prev = None
+    for T in grid:
+        if ok(float(T)):
+            if prev is None:
+                return float(T)
+            # infeasible at prev, feasible at T: bisect the bracket to tol
+            return float(bisect_boundary(lambda x: ok(float(x)), prev, float(T), xtol=tol).true_end)
+        prev = float(T)
+    return None

@@ -1,0 +1,63 @@
+"""The objective (000 eq. 32): base disturbance torque by batched Newton-Euler and its
+time average."""
+
+from __future__ import annotations
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...dynamics import rnea
+from ...errors import ScenarioError
+from ...model import FloatArray
+from ._constants import CHUNK_SAMPLES
+from ._problem import HaltProblem
+
+
+def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
+    """Time average over the last axis of uniformly sampled values (odd count), Simpson's rule."""
+    n = values.shape[-1]
+    w = np.ones(n)
+    w[1:-1:2] = 4.0
+    w[2:-1:2] = 2.0
+    return values @ w / (3.0 * (n - 1))
+
+
+def base_torque_history(
+    problem: HaltProblem, k: ArrayLike, t: ArrayLike | None = None, *, per_joint: bool = False
+) -> FloatArray:
+    """Base disturbance torque ``tau_b(t; k)`` (000 eq. 31), (..., n_t, 3) [N m], root frame."""
+    q, dq, ddq = problem.trajectory(k, t, per_joint=per_joint)
+    return rnea(problem.model, q, dq, ddq, base=problem.base).base_moment
+
+
+def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
+    """Global base disturbance torque of 000 eq. 32 for a batch of ``k``.
+
+    ``tau_bar(k) = (1/T) int_0^T ||tau_b(t; k)||_2 dt``, Simpson's rule on
+    ``problem.n_samples`` points.  Candidates are processed in chunks of at most
+    :data:`CHUNK_SAMPLES` (candidate, time) samples, each chunk one batched :func:`rnea` call.
+
+    Parameters
+    ----------
+    k
+        (...) shared ``k`` [rad/s^6], or (..., n) with ``per_joint=True``.
+
+    Returns
+    -------
+    (...) [N m].
+    """
+    k = np.asarray(k, dtype=float)
+    if per_joint and (k.ndim == 0 or k.shape[-1] != problem.dof):
+        raise ScenarioError(
+            f"k with per_joint=True must have shape (..., {problem.dof}) (one k per healthy joint "
+            f"{list(problem.model.joint_numbers)}) [rad/s^6]; got shape {k.shape}"
+        )
+    batch = k.shape[:-1] if per_joint else k.shape
+    flat = k.reshape((-1, problem.dof) if per_joint else (-1,))
+    t = problem.times()
+    step = max(1, CHUNK_SAMPLES // t.size)
+    out = np.empty(flat.shape[0])
+    for start in range(0, flat.shape[0], step):  # chunks of candidates, not samples
+        torque = base_torque_history(problem, flat[start : start + step], t, per_joint=per_joint)
+        out[start : start + step] = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
+    return out.reshape(batch)

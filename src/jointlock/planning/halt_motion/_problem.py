@@ -1,0 +1,173 @@
+"""The halt-motion problem (000 eq. 34): :class:`HaltProblem` and its input checks."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...dynamics import BaseMode
+from ...errors import ScenarioError
+from ...model import ArmModel, FloatArray
+from ._constants import MIN_SAMPLES
+from ._polynomial import halt_coefficients, k_shape, polynomial_profile
+
+
+def _angle_limit(value: ArrayLike, n: int, name: str) -> FloatArray:
+    """Angle limits (n,) [rad]: finite, or -inf/+inf for a joint without a limit (a continuous
+    joint: its angle constraint is absent); NaN is refused."""
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or np.any(np.isnan(arr)):
+        raise ScenarioError(
+            f"{name} must be one value or {n} values [rad], -inf/+inf for no limit, not NaN; "
+            f"got {arr.tolist()}"
+        )
+    out = arr.copy()
+    out.setflags(write=False)
+    return out
+
+
+def _vec(value: ArrayLike, n: int, name: str, unit: str, *, positive: bool = False) -> FloatArray:
+    arr = np.asarray(value, dtype=float)
+    if arr.ndim == 0:
+        arr = np.full(n, float(arr))
+    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+        raise ScenarioError(f"{name} must be one finite value or {n} values [{unit}]; got {arr.tolist()}")
+    if positive and not np.all(arr > 0):
+        raise ScenarioError(f"{name} must be > 0 [{unit}]; got {arr.tolist()}")
+    out = arr.copy()
+    out.setflags(write=False)
+    return out
+
+
+@dataclass(frozen=True)
+class HaltProblem:
+    """A halt-motion problem (000 eq. 34), in SI units and radians.
+
+    Attributes
+    ----------
+    model
+        The locked arm (healthy joints only); for ``base="floating"`` it must carry a spacecraft.
+    q0, dq0, ddq0
+        (n,) state at failure [rad, rad/s, rad/s^2].
+    qf
+        (n,) halt configuration [rad] (000: ``q_best``).
+    T
+        Halt time [s].
+    dq_max, ddq_max
+        (n,) speed and acceleration limits [rad/s, rad/s^2] (symmetric).
+    q_min, q_max
+        (n,) angle limits [rad]; default the model's.  ``-inf``/``+inf`` (a continuous
+        joint): no angle constraint for that joint.
+    base
+        ``"fixed"`` (000) or ``"floating"`` base for the disturbance torque.
+    n_samples
+        Time samples of the objective (odd; Simpson's rule).
+    n_check
+        Time samples of the constraint check.
+    """
+
+    model: ArmModel
+    q0: FloatArray
+    dq0: FloatArray
+    ddq0: FloatArray
+    qf: FloatArray
+    T: float
+    dq_max: FloatArray
+    ddq_max: FloatArray
+    q_min: FloatArray | None = None
+    q_max: FloatArray | None = None
+    base: BaseMode = "fixed"
+    n_samples: int = 501
+    n_check: int = 2001
+
+    def __post_init__(self) -> None:
+        n = self.model.dof
+        for name, unit in (("q0", "rad"), ("dq0", "rad/s"), ("ddq0", "rad/s^2"), ("qf", "rad")):
+            object.__setattr__(self, name, _vec(getattr(self, name), n, name, unit))
+        object.__setattr__(self, "dq_max", _vec(self.dq_max, n, "dq_max", "rad/s", positive=True))
+        object.__setattr__(self, "ddq_max", _vec(self.ddq_max, n, "ddq_max", "rad/s^2", positive=True))
+        lo = self.model.lower if self.q_min is None else self.q_min
+        hi = self.model.upper if self.q_max is None else self.q_max
+        lo, hi = _angle_limit(lo, n, "q_min"), _angle_limit(hi, n, "q_max")
+        if np.any(lo > hi):
+            raise ScenarioError(f"q_min must be <= q_max [rad]; got {lo.tolist()} and {hi.tolist()}")
+        object.__setattr__(self, "q_min", lo)
+        object.__setattr__(self, "q_max", hi)
+        T = float(self.T)
+        if not (math.isfinite(T) and T > 0):
+            raise ScenarioError(f"halt time T must be a finite number > 0 [s]; got {self.T}")
+        object.__setattr__(self, "T", T)
+        if self.base not in ("fixed", "floating"):
+            raise ScenarioError(f"base must be 'fixed' or 'floating'; got {self.base!r}")
+        if self.base == "floating" and not self.model.floating:
+            raise ScenarioError(
+                "base='floating' needs a model with a spacecraft (load it with base='floating')"
+            )
+        for name in ("n_samples", "n_check"):
+            v = getattr(self, name)
+            if isinstance(v, bool) or not isinstance(v, (int, np.integer)):
+                raise ScenarioError(f"{name} must be an integer; got {v!r}")
+        if self.n_samples < MIN_SAMPLES or self.n_samples % 2 == 0:
+            raise ScenarioError(f"n_samples must be odd and >= {MIN_SAMPLES}; got {self.n_samples}")
+        if self.n_check < 3:
+            raise ScenarioError(f"n_check must be >= 3; got {self.n_check}")
+
+    @property
+    def dof(self) -> int:
+        return self.model.dof
+
+    def with_time(self, T: float) -> HaltProblem:
+        """The same problem with another halt time [s]."""
+        return replace(self, T=T)
+
+    def times(self, n: int | None = None) -> FloatArray:
+        """(n,) uniform time grid on [0, T] [s] (``n_samples`` points by default)."""
+        return np.linspace(0.0, self.T, self.n_samples if n is None else n)
+
+    def base_profile(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """The ``k = 0`` (quintic) part: q, dq, ddq each (n_t, n)."""
+        coef = halt_coefficients(self.q0, self.dq0, self.ddq0, self.qf, self.T, 0.0)
+        return polynomial_profile(coef, t)
+
+    def k_shape(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """``phi(t) = t^3 (t - T)^3`` and its first two derivatives, each (n_t,) [s^6, s^5, s^4]."""
+        return k_shape(t, self.T)
+
+    def trajectory(
+        self, k: ArrayLike, t: ArrayLike | None = None, *, per_joint: bool = False
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """Joint angles, rates and accelerations of the halt for one or many ``k``.
+
+        Parameters
+        ----------
+        k
+            [rad/s^6]: shape (...) for one shared ``k`` per candidate (000), or (..., n) with
+            ``per_joint=True`` (one per joint).
+        t
+            (n_t,) times [s]; default :meth:`times`.
+
+        Returns
+        -------
+        q, dq, ddq
+            each (..., n_t, n) [rad, rad/s, rad/s^2].
+        """
+        t = self.times() if t is None else np.asarray(t, dtype=float)
+        k = _k_array(k, self.dof, per_joint)
+        base = self.base_profile(t)
+        shape = self.k_shape(t)
+        kk = k[..., None, :]
+        return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+
+
+def _k_array(k: ArrayLike, n: int, per_joint: bool) -> FloatArray:
+    k = np.asarray(k, dtype=float)
+    if per_joint:
+        if k.ndim == 0 or k.shape[-1] != n:
+            raise ScenarioError(f"per-joint k must have shape (..., {n}) [rad/s^6]; got {k.shape}")
+        return k
+    return np.broadcast_to(k[..., None], k.shape + (n,))

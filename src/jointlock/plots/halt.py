@@ -1,0 +1,148 @@
+"""Figures of a halt motion (000 §4-§5.2): global base torque vs k (Fig. 8), joint profiles
+(Fig. 9) and the base torque over the halt."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from ..planning.halt_motion import K_UNIT_SCALE, HaltMotion, base_torque_history, global_base_torque
+from ._common import new_axes, new_figure
+
+#: 1 deg/s^6 in rad/s^6 (k is shown in deg/s^6, 000's reading).
+_K_DEG = K_UNIT_SCALE["deg/s^6"]
+
+
+def k_label(res: HaltMotion) -> str:
+    """What the reported k is: the optimum, or the least-violating k of an infeasible halt."""
+    if not res.feasible:
+        return "least-violating k (infeasible)"
+    return "optimal k per joint" if res.per_joint else "optimal k*"
+
+
+def k_text(res: HaltMotion, digits: int = 6) -> str:
+    """The reported k in deg/s^6, ``digits`` significant digits, with the unit."""
+    kd = np.atleast_1d(np.asarray(res.k, dtype=float) / _K_DEG)
+    body = ", ".join(f"{v:.{digits}g}" for v in kd)
+    return (f"[{body}]" if res.per_joint else body) + " deg/s^6"
+
+
+def _k_star(res: HaltMotion) -> float:
+    """The chosen k [rad/s^6] (the mean of the per-joint k of the vector solver)."""
+    return float(np.mean(res.k)) if res.per_joint else float(res.k)
+
+
+def global_torque_curve(res: HaltMotion, n: int = 201) -> tuple[np.ndarray, np.ndarray]:
+    """The global base torque of eq. (32) over a k range covering 0, the chosen k and the
+    feasible interval: ``(k (n,) [rad/s^6], torque (n,) [N m])`` (one shared k)."""
+    k_star = _k_star(res)
+    lo, hi = res.k_interval
+    span = [0.0, max(0.01 * _K_DEG, 1.5 * abs(k_star))]
+    if lo <= hi:
+        span = [min(span[0], lo - 0.2 * (hi - lo)), max(span[1], hi + 0.2 * (hi - lo))]
+    span = [min(span[0], 1.5 * k_star), span[1]]  # a negative k* is on the plot too
+    grid = np.linspace(span[0], span[1], n)
+    return grid, global_base_torque(res.problem, grid)
+
+
+def plot_global_torque_vs_k(res: HaltMotion, *, ax: Any | None = None) -> Any:
+    """000 Fig. 8: global base disturbance torque vs k, the feasible k band, the chosen k and
+    the curve's own minimum when it lies elsewhere.  Returns the axis."""
+    ax = new_axes(ax, (7, 4))
+    p = res.problem
+    label = k_label(res)
+    k_star = _k_star(res)
+    lo, hi = res.k_interval
+    grid, tau = global_torque_curve(res)
+    ax.plot(grid / _K_DEG, tau, label=r"$\bar\tau_b(k)$, shared k")
+    if lo <= hi:
+        ax.axvspan(
+            lo / _K_DEG,
+            hi / _K_DEG,
+            color="g",
+            alpha=0.15,
+            label=f"feasible k: [{lo / _K_DEG:.4g}, {hi / _K_DEG:.4g}] deg/s$^6$",
+        )
+    else:  # a legend line saying so (no band to shade)
+        ax.plot([], [], " ", label=f"no feasible k: every k breaks a limit (T = {p.T:g} s)")
+    i_min = int(np.argmin(tau))
+    star_text = f"{label} = {k_star / _K_DEG:.4g} deg/s$^6$"
+    if res.per_joint:
+        star_text = f"{label} (at their mean {k_star / _K_DEG:.4g} deg/s$^6$)"
+    ax.plot([k_star / _K_DEG], [res.global_torque], "r*", ms=12, label=star_text)
+    if abs(grid[i_min] - k_star) > 1.5 * (grid[1] - grid[0]):  # the curve's own minimum elsewhere
+        where = "feasible" if lo <= grid[i_min] <= hi else "breaks a limit"
+        ax.plot(
+            [grid[i_min] / _K_DEG],
+            [tau[i_min]],
+            "o",
+            mfc="none",
+            mec="k",
+            ms=8,
+            label=f"minimum on this range: k = {grid[i_min] / _K_DEG:.4g} deg/s$^6$ ({where})",
+        )
+    ax.set_xlabel("k [deg/s$^6$]")
+    ax.set_ylabel("global base torque [N m]")
+    verdict = "" if res.feasible else ", INFEASIBLE"
+    ax.set_title(f"global base disturbance torque vs k ({p.base} base{verdict})")
+    ax.legend(fontsize=8)
+    return ax
+
+
+def plot_joint_profiles(res: HaltMotion, *, fig: Any | None = None) -> Any:
+    """000 Fig. 9: angle, velocity and acceleration of every healthy joint over the halt, at
+    the chosen k and at k = 0, with the limits.  Returns the figure (3 x n axes)."""
+    p = res.problem
+    n = p.dof
+    fig = new_figure(fig, (3 * n, 7))
+    label = k_label(res)
+    t = p.times()
+    q, dq, ddq = res.trajectory(t)
+    q0_, dq0_, ddq0_ = p.trajectory(0.0, t)
+    axes = fig.subplots(3, n, sharex=True, squeeze=False)
+    for j in range(n):
+        for row, (a, b, lim, ylabel) in enumerate(
+            (
+                (q, q0_, None, "angle [deg]"),
+                (dq, dq0_, p.dq_max[j], "velocity [deg/s]"),
+                (ddq, ddq0_, p.ddq_max[j], "acc. [deg/s$^2$]"),
+            )
+        ):
+            ax = axes[row, j]
+            ax.plot(t, np.degrees(a[:, j]), label=label)
+            ax.plot(t, np.degrees(b[:, j]), "--", lw=0.8, label="k = 0")
+            if lim is not None:
+                for sgn in (-1, 1):
+                    ax.axhline(sgn * math.degrees(lim), color="r", lw=0.6, label="limit" if sgn > 0 else None)
+            if j == 0:
+                ax.set_ylabel(ylabel)
+        axes[0, j].set_title(f"joint {p.model.joint_numbers[j]}")
+        axes[2, j].set_xlabel("t [s]")
+    axes[1, 0].legend(fontsize=7)
+    if not res.feasible:
+        fig.suptitle(f"INFEASIBLE halt: {label} = {k_text(res, 4)}, limits broken", color="r")
+    return fig
+
+
+def plot_base_torque_vs_time(res: HaltMotion, *, ax: Any | None = None) -> Any:
+    """Norm of the base disturbance torque over the halt, at k = 0 and at the chosen k (mean
+    values in the legend).  Returns the axis."""
+    ax = new_axes(ax, (7, 4))
+    p = res.problem
+    t = p.times()
+    tb = base_torque_history(p, res.k, t, per_joint=res.per_joint)
+    tb0 = base_torque_history(p, 0.0, t)
+    ax.plot(t, np.linalg.norm(tb0, axis=-1), label=f"k = 0 (mean {res.global_torque_k0:.4g} N m)")
+    ax.plot(
+        t,
+        np.linalg.norm(tb, axis=-1),
+        label=f"{k_label(res)} = {k_text(res, 4).replace('^6', '$^6$')} (mean {res.global_torque:.4g} N m)",
+    )
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel(r"$\|\tau_b\|$ [N m]")
+    if not res.feasible:
+        ax.set_title("INFEASIBLE halt: every k breaks a limit", color="r")
+    ax.legend(fontsize=8)
+    return ax

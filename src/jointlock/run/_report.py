@@ -1,0 +1,530 @@
+"""The sections of a scenario run's ``report.html``: the scenario, the failure, the decisions,
+the limits kept or broken, the arm in 3-D, the summary and paper-style figures, the
+assumptions and readings.  Built from a :class:`~jointlock.run.RunResult` (its results.json
+content and typed job results); summary figures are written to ``out/figures``."""
+
+from __future__ import annotations
+
+import html
+import math
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..io.files import save_figure
+from ..locking import lock
+from ..plots._common import offscreen_figure
+from ..plots.arm import plot_arm
+from ..plots.summary import plot_halt_base_torque, plot_jump_vs_failure_time, plot_replan_error
+from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
+from ..robots import load_robot
+from ..scenario import JOB_PAPER, Scenario
+from ._summary import _pct, _pct0
+
+#: Unit of kappa: qdot [rad/s] = kappa * grad w, w = sqrt(det(J J^T)) [m^3] (docs/jump.md).
+KAPPA_UNIT = "rad^2/(s m^3)"
+
+
+def _points_text(points: list) -> str:
+    """001's segment points [s]; NaN (kappa falls back to 0 over the whole task) -> none."""
+    vals = [np.nan if p is None else float(p) for p in points]
+    if not any(np.isfinite(vals)):
+        return "none (kappa = 0 everywhere)"
+    return ", ".join(f"{v:.3g} s" if np.isfinite(v) else "none" for v in vals)
+
+#: Row labels of the report's limits table (``[limits]`` field -> words and unit).
+LIMIT_LABELS = {
+    "vmax_deg": "speed limit [deg/s]",
+    "amax_deg": "acceleration limit [deg/s^2]",
+    "eps_m": "position-deviation threshold [m]",
+}
+
+
+def _condition_verdict(name: str, sufficient: bool) -> str:
+    """Verdict of one singularity condition: 004's Cond1-Cond5 are reproduced or not;
+    ``cond1f`` is jointlock's own condition, so it is only sufficient or not."""
+    if name == "cond1f":
+        return "sufficient (ours)" if sufficient else "not sufficient (ours)"
+    return "reproduced" if sufficient else "not reproduced: not sufficient"
+
+
+def halt_k_label(r: dict[str, Any]) -> str:
+    """Legend of the halt's chosen k, by feasibility: ``k*`` only when it keeps every limit."""
+    k_text = f"{float(np.ravel(r['k'])[0]):.3g} deg/s^6"
+    if r["feasible"]:
+        return f"k* = {k_text} (feasible)"
+    return f"least-violating k = {k_text} (INFEASIBLE: breaks a limit)"
+
+
+def is_000_case(scenario: Scenario, model: Any) -> bool:
+    """halt7 with joint 4 locked at 0 deg: 000 §5's scenario, whose headline numbers the halt
+    report compares against."""
+    lk = scenario.lock
+    return model.name == "halt7" and lk is not None and lk[0] == 4 and math.isclose(lk[1], 0.0, abs_tol=1e-9)
+
+
+def _job_images(folder: Path, limit: int = 8) -> list[tuple[str, bytes]]:
+    if not folder.is_dir():
+        return []
+    return [(f"{folder.name}/{p.name}", p.read_bytes()) for p in sorted(folder.glob("*.png"))[:limit]]
+
+
+def report_sections(
+    scenario: Scenario, results: dict[str, Any], typed: dict[str, Any], out: Path
+) -> list[Section]:
+    """The report's sections: scenario, failure, decisions, limits, 3-D drawing, figures,
+    assumptions, from results.json's content (``results``) and the typed job results
+    (``typed``).  Summary figures are written to ``out/figures`` as PNG and SVG; each job's own
+    figures are read from ``out/<job>`` (written before the report)."""
+    jobs = results["jobs"]
+    full = load_robot(scenario.data["robot"], base="fixed")
+    lk = scenario.lock
+    locked = None if lk is None else lock(full, lk[0], math.radians(lk[1]))
+    return [
+        *_scenario_section(scenario, jobs, full, locked, results["versions"]),
+        *_failure_section(scenario, jobs, full, locked),
+        *_decisions_section(scenario, jobs, full, locked),
+        *_limits_section(scenario, jobs, full, locked),
+        *_figure_sections(scenario, jobs, full, locked, typed, out),
+        Section("Assumptions and readings", notes=assumptions(scenario, full)),
+    ]
+
+
+def _scenario_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any, versions: dict[str, str]) -> list[Section]:
+    """The scenario: robot, model, base, seed, jobs, versions and the equivalent commands."""
+    d = scenario.data
+    sections: list[Section] = []
+    facts: list[tuple[str, Any]] = [
+        ("robot", f"{full.name}: {full.dof} joints"),
+        ("model", full.description),
+        ("base", d["base"]),
+        ("seed", d["seed"]),
+        ("jobs", ", ".join(f"{j} ({JOB_PAPER[j]})" for j in scenario.jobs)),
+        ("versions", ", ".join(f"{k} {v}" for k, v in versions.items() if k != "platform")),
+    ]
+    sections.append(
+        Section(
+            "Scenario",
+            paragraphs=[html.escape(d["description"])] if d.get("description") else [],
+            facts=facts,
+            code=[jobs[j]["command"] for j in scenario.jobs],
+            notes=["The command lines above reproduce each job on its own (same options, same seed)."],
+        )
+    )
+    return sections
+
+
+def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any) -> list[Section]:
+    """The failure: which joint, when, the state at failure and the limits given and applied."""
+    d = scenario.data
+    sections: list[Section] = []
+    # the failure
+    fail = d["failure"]
+    ffacts: list[tuple[str, Any]] = []
+    if fail["joint"] is None:
+        ffacts.append(("locked joint", "none: no locked joint in this scenario (no [failure] table)"))
+    if fail["joint"] is not None:
+        ffacts.append(("joint that locks", fail["joint"]))
+    if fail["angle_deg"] is not None:
+        ffacts.append(("locked angle [deg]", fail["angle_deg"]))
+    if scenario.failure_overridden():
+        changed = {
+            k.split(".", 1)[1]: v["file"]
+            for k, v in scenario.overrides.items()
+            if k in ("failure.joint", "failure.angle_deg") and v["file"] != v["value"]
+        }
+        ffacts.append(
+            (
+                "overridden on the command line",
+                "the file gives " + ", ".join(f"{k} = {v}" for k, v in changed.items()),
+            )
+        )
+    if "jump" in jobs:
+        r = jobs["jump"]["result"]
+        ffacts.append(
+            (
+                "failure time [s]",
+                r["fail_time_s"] if r["mode"] == "fail_at" else "unknown: every control step",
+            )
+        )
+    tables = []
+    st = d["state"]
+    if locked is not None and st["q0_deg"] is not None:
+        n_h = locked.dof
+
+        def healthy(v: list[float] | None) -> list[Any]:
+            if v is None:
+                return [None] * n_h
+            return list(v) if len(v) == n_h else [x for i, x in enumerate(v) if i + 1 != fail["joint"]]
+
+        rows = [
+            [num, a, b, c]
+            for num, a, b, c in zip(
+                locked.joint_numbers, healthy(st["q0_deg"]), healthy(st["dq0_deg"]), healthy(st["ddq0_deg"])
+            )
+        ]
+        tables.append((["joint", "q [deg]", "dq [deg/s]", "ddq [deg/s^2]"], rows, "state at failure"))
+    lim_rows = [[LIMIT_LABELS.get(k, k), v] for k, v in d["limits"].items() if v is not None]
+    if lim_rows:
+        tables.append((["limit", "value"], lim_rows, "limits given in the scenario"))
+    if "halt" in jobs and "velocity_limit_deg_s" in jobs["halt"]["result"]:
+        # what the halt actually applied: the scenario's limits capped by the model's
+        r = jobs["halt"]["result"]
+
+        def per_joint(value: Any, j: int) -> Any:
+            return value[j] if isinstance(value, (list, tuple)) else value
+
+        rows = [
+            [
+                num,
+                round(r["velocity_limit_deg_s"][j], 6),
+                per_joint(r.get("velocity_limit_source", ""), j),
+                round(r["acceleration_limit_deg_s2"][j], 6),
+                per_joint(r.get("acceleration_limit_source", ""), j),
+            ]
+            for j, num in enumerate(r["joint_numbers"])
+        ]
+        tables.append(
+            (
+                ["joint", "speed limit [deg/s]", "from", "acceleration limit [deg/s^2]", "from"],
+                rows,
+                "limits applied by the halt",
+            )
+        )
+    sections.append(Section("The failure", facts=ffacts, tables=tables))
+    return sections
+
+
+def _decisions_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any) -> list[Section]:
+    """What was decided: halt configuration, k, kappa(t), gamma, volumes, conditions."""
+    d = scenario.data
+    sections: list[Section] = []
+    # decisions
+    decisions: list[tuple[str, Any]] = []
+    dtables = []
+    if "halt_config" in jobs:
+        r = jobs["halt_config"]["result"]
+        decisions.append(("halt configuration [deg]", [round(v, 3) for v in r["best"]["q_deg"]]))
+        decisions.append(
+            (
+                "CP at it (best sample, refinement gain)",
+                f"{r['best']['cp']:.5f} ({r['best_sample']['cp']:.5f}, {r['refinement']['gain']:+.5f})",
+            )
+        )
+        w = r["weights"]
+        dtables.append(
+            (
+                ["weights", *w["combined"].keys()],
+                [[k, *v.values()] for k, v in w.items()],
+                "index weights (AHP + entropy)",
+            )
+        )
+    if "halt" in jobs:
+        r = jobs["halt"]["result"]
+        source = r.get("qf_source", "")
+        if "halt_config" in jobs and d["halt"]["qf_deg"] is None and not d["halt"]["paper_qf"]:
+            source = "the optimal halt configuration above (halt_config job)"
+        decisions.append(("halt configuration source", source))
+        decisions.append(("halt time T [s]", r["T_s"]))
+        verdict = "feasible" if r["feasible"] else "INFEASIBLE: no k keeps every limit"
+        decisions.append(("verdict", verdict))
+        decisions.append(("k* [deg/s^6]" if r["feasible"] else "least-violating k [deg/s^6]", r["k"]))
+        decisions.append(
+            (
+                "global base torque k = 0 -> " + ("k*" if r["feasible"] else "least-violating k") + " [N m]",
+                f"{r['global_torque_k0_Nm']:.5g} -> {r['global_torque_Nm']:.5g} ({_pct(r['reduction'])} lower)",
+            )
+        )
+        if r["minimum_T_s"] is not None:
+            decisions.append(("smallest feasible halt time [s]", r["minimum_T_s"]))
+    if "jump" in jobs:
+        r = jobs["jump"]["result"]
+        if "kappa_fit" in r:
+            f = r["kappa_fit"]
+            decisions.append(
+                (
+                    f"kappa(t) [{KAPPA_UNIT}]",
+                    f"polynomial of order {f['order']} in tau = t/T, segment points "
+                    f"{_points_text(f['segment_points_s'])}",
+                )
+            )
+            decisions.append(
+                (
+                    f"kappa(t) coefficients (tau^0 first) [{KAPPA_UNIT}]",
+                    [float(f"{c:.4g}") for c in f["coefficients_tau"]],
+                )
+            )
+        elif r["mode"] == "fail_at":
+            decisions.append((f"optimal kappa at the failure [{KAPPA_UNIT}]", r["kappa"]))
+        elif np.ndim(r["kappa"]) == 0:
+            decisions.append((f"constant kappa [{KAPPA_UNIT}]", r["kappa"]))
+        decisions.append(
+            (
+                "mean jump reduction / share improved",
+                f"{_pct(r['mean_reduction'])} / {_pct(r['share_improved'])}",
+            )
+        )
+    if "tolerance_angle" in jobs:
+        r = jobs["tolerance_angle"]["result"]
+        ch = r["chosen"]
+        decisions.append(("tolerance angle gamma [deg]", None if ch is None else ch["gamma_deg"]))
+        if ch is not None:
+            decisions.append(("q at gamma [deg]", [round(v, 4) for v in ch["q_deg"]]))
+    if "replan" in jobs:
+        r = jobs["replan"]["result"]
+        decisions.append(
+            (
+                "re-plan",
+                f"{r['absorbed_waypoints']}/{r['waypoints']} waypoints absorb the lock; gamma {r['gamma_deg_range'][0]:.3f}..{r['gamma_deg_range'][1]:.3f} deg; max tracking error {1e3 * r['max_tracking_position_error_m']:.3f} mm",
+            )
+        )
+    if "workspace" in jobs:
+        r = jobs["workspace"]["result"]
+        if r.get("volume_locked_m3") is None:
+            decisions.append(("workspace volume [m^3]", f"{r['volume_full_m3']:.3g}"))
+        else:
+            decisions.append(
+                (
+                    "workspace volume full / locked [m^3]",
+                    f"{r['volume_full_m3']:.3g} / {r['volume_locked_m3']:.3g} (kept {_pct0(r.get('share_kept'))}; "
+                    f"from half the samples {_pct0(r.get('share_kept_half_samples'))})",
+                )
+            )
+            for w in r.get("warnings", []):
+                decisions.append(("workspace: warning", w))
+    if "singular" in jobs:
+        r = jobs["singular"]["result"]
+        if isinstance(r.get("conditions"), dict) and "cond1" in r["conditions"]:
+            conds = {**r["conditions"], **r.get("refined_conditions", {})}
+            dtables.append(
+                (
+                    ["condition", "samples", "singular", "fraction", "median sigma_min", "verdict"],
+                    [
+                        [
+                            k,
+                            c["samples"],
+                            c["singular"],
+                            c["fraction_singular"],
+                            c["sigma_min_median"],
+                            _condition_verdict(k, c["sufficient"]),
+                        ]
+                        for k, c in conds.items()
+                    ],
+                    "004's conditions: is every sampled configuration singular? (cond1f = S4 = 0 and F = 0, ours)",
+                )
+            )
+        elif "families" in r:
+            decisions.append(("singular families found", len(r["families"])))
+        else:
+            decisions.append(("sigma_min / rank", f"{r['sigma_min']:.4g} / {r['rank']}"))
+    sections.append(Section("Decisions", facts=decisions, tables=dtables))
+    return sections
+
+
+def _limits_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any) -> list[Section]:
+    """The limits kept or broken by the halt and the jump."""
+    sections: list[Section] = []
+    # limits kept or broken
+    ltables = []
+    if "halt" in jobs:
+        r = jobs["halt"]["result"]
+        nums = r["joint_numbers"]
+        rows = limits_rows(nums, r["peak_velocity_deg_s"], r["velocity_limit_deg_s"], "velocity", "deg/s")
+        rows += limits_rows(
+            nums, r["peak_acceleration_deg_s2"], r["acceleration_limit_deg_s2"], "acceleration", "deg/s^2"
+        )
+        ltables.append(
+            (
+                LIMITS_HEADER,
+                rows,
+                "halt motion at k*" if r["feasible"] else "halt motion at the least-violating k",
+            )
+        )
+        if r["violations"]:
+            ltables.append(
+                (
+                    ["joint", "limit", "limit value", "worst value", "excess", "at t [s]"],
+                    [
+                        [
+                            v["joint"],
+                            v["limit"],
+                            v["limit_value_deg"],
+                            v["value_deg"],
+                            v["excess_deg"],
+                            v["time_s"],
+                        ]
+                        for v in r["violations"]
+                    ],
+                    "limits broken (deg, deg/s, deg/s^2)",
+                )
+            )
+    if "jump" in jobs:
+        r = jobs["jump"]["result"]
+        for key in ("verification", "verification_fixed", "limits_after"):
+            if key not in r:
+                continue
+            v = r[key]
+            lim = v["limits"] if "limits" in v else v
+            sc = r["scenario"]
+            label = key if key != "verification_fixed" else f"verification with {v['fix']}"
+            ltables.append(
+                (
+                    ["quantity", "worst value", "limit", "status"],
+                    [
+                        [quantity, worst, limit, limit_status(worst, limit)]
+                        for quantity, worst, limit in (
+                            ("joint speed [deg/s]", lim["max_velocity_deg_s"], sc["vmax_deg_s"]),
+                            (
+                                "joint acceleration [deg/s^2]",
+                                lim["max_acceleration_deg_s2"],
+                                sc["amax_deg_s2"],
+                            ),
+                            ("position deviation [mm]", lim["max_deviation_mm"], 1e3 * sc["eps_m"]),
+                        )
+                    ],
+                    f"jump: {label}",
+                )
+            )
+    sections.append(
+        Section(
+            "Limits kept or broken",
+            tables=ltables,
+            paragraphs=[] if ltables else ["No job of this scenario checks joint limits."],
+        )
+    )
+    return sections
+
+
+def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any, typed: dict[str, Any], out: Path) -> list[Section]:
+    """The arm in 3-D, the summary figures (PNG and SVG in ``out/figures``) and each job's own figures."""
+    d = scenario.data
+    sections: list[Section] = []
+    figdir = out / "figures"
+    # 3-D drawing
+    images = []
+    configs: dict[str, np.ndarray] = {}
+    draw_model = locked
+    if "halt" in jobs:
+        r = jobs["halt"]["result"]
+        configs = {
+            "at failure": np.radians(r["q_initial_deg"]),
+            "halt configuration": np.radians(r["q_final_deg"]),
+        }
+    elif "halt_config" in jobs:
+        configs = {"halt configuration": np.radians(jobs["halt_config"]["result"]["best"]["q_deg"])}
+    elif "replan" in jobs:
+        r = jobs["replan"]["result"]
+        draw_model = full
+        configs = {"start": np.radians(r["q_start_deg"]), "goal (re-planned)": np.radians(r["q_goal_deg"])}
+    elif "jump" in jobs:
+        draw_model = full
+        configs = {"task start": np.radians(jobs["jump"]["result"]["scenario"]["q0_deg"])}
+    else:
+        draw_model = full
+        q = d.get("singular", {}).get("q_deg")
+        configs = {
+            "q = 0" if q is None else "analysed configuration": np.radians(q) if q else np.zeros(full.dof)
+        }
+    if draw_model is not None and configs:
+        fig = offscreen_figure((6.0, 5.0))
+        plot_arm(
+            draw_model, configs, title=f"{full.name}: " + " / ".join(configs), ax=fig.add_subplot(projection="3d")
+        )
+        images.append(
+            (
+                "arm at " + ", ".join(configs) + " (x = link centres of mass, * = end effector)",
+                save_figure(fig, figdir, "arm"),
+            )
+        )
+    # summary figures
+    if (
+        "jump" in jobs
+        and "jump_before" in jobs["jump"]["result"]
+        and np.ndim(jobs["jump"]["result"]["jump_before"])
+    ):
+        r = jobs["jump"]["result"]
+        fig = offscreen_figure((7, 3.6))
+        plot_jump_vs_failure_time(
+            r["verification_t_s"], _floats(r["jump_before"]), _floats(r["jump_after"]), ax=fig.add_subplot()
+        )
+        images.append(("velocity jump vs failure time", save_figure(fig, figdir, "jump_vs_failure_time")))
+    if "halt" in jobs:
+        ts = typed["halt"].time_series()
+        fig = offscreen_figure((7, 3.6))
+        plot_halt_base_torque(
+            ts["t"], ts["tau_b"], ts["tau_b_k0"], label=halt_k_label(jobs["halt"]["result"]), ax=fig.add_subplot()
+        )
+        images.append(("base disturbance torque during the halt", save_figure(fig, figdir, "base_torque")))
+    if "replan" in jobs:
+        tr = jobs["replan"]["result"].get("trajectory", {})
+        if tr:
+            fig = offscreen_figure((7, 3.6))
+            plot_replan_error(tr["time_s"], tr["position_error_m"], tr["gamma_deg"], ax=fig.add_subplot())
+            images.append(("re-plan: tracking error and gamma", save_figure(fig, figdir, "replan_error")))
+    sections.append(Section("The arm and summary figures", images=images))
+    # paper-style figures of each job
+    for job in scenario.jobs:
+        imgs = _job_images(out / job)
+        if imgs:
+            sections.append(Section(f"Figures: {job} ({JOB_PAPER[job]})", images=imgs, level=3))
+    return sections
+
+
+def _floats(values: Any) -> np.ndarray:
+    """A JSON list of numbers (null = NaN) as a float array."""
+    return np.array([np.nan if v is None else v for v in values], dtype=float)
+
+
+def assumptions(scenario: Scenario, model: Any) -> list[str]:
+    """The readings of the seed papers and the assumptions behind this run."""
+    d = scenario.data
+    notes = [f"{model.name}: {model.description}"]
+    if model.name == "halt7":
+        notes.append(
+            "halt7 (000 Tables 6-7): modified DH; the theta column is the initial configuration, not an "
+            "offset (adding it makes 000's own q_best and q_sub singular); 000 gives no spacecraft: ours is "
+            "a 2000 kg, 2 m cube 1 m below the mount."
+        )
+    if model.name == "canadarm7":
+        notes.append(
+            "canadarm7 (004 §5): frames inferred from 004's eq. (15); inertias are assumed (004 gives none); "
+            "it stands in for 001's SSRMS-type arm, whose table was lost."
+        )
+    if model.name == "puma6":
+        notes.append(
+            "puma6 (002 Table 1): standard DH despite the header, theta column not added; a2 = 0.985 m, "
+            "d4 = -0.765 m, d6 = 0.382 m recovered from 002's worked examples; masses illustrative."
+        )
+    jobs = scenario.jobs
+    if "halt_config" in jobs:
+        hc = d["halt_config"]
+        notes.append(
+            f"Halt configuration: {hc['samples']} Monte Carlo samples, {hc['jacobian']} Jacobian, AHP reading "
+            f"'{hc['assignment']}', weights {'renormalised' if hc['renormalize'] else 'summed as eq. (18)'}; "
+            f"{'no refinement' if hc['no_refine'] else 'best samples refined by L-BFGS-B'} (docs/halt-config.md)."
+        )
+    if "halt" in jobs:
+        notes.append(
+            "Halt motion: 000 eq. (27) with one shared k, k read in deg/s^6 (000's reading); objective = "
+            "time average of the base torque about the spacecraft's centre of mass (Simpson's rule); limits "
+            "checked on a 2001-point grid (docs/halt-motion.md)."
+            + (" 000's headline numbers are not reproduced." if is_000_case(scenario, model) else "")
+        )
+    if "jump" in jobs:
+        notes.append(
+            "Jump compensation: 001 lost its equations; NOTES-001's reconstruction is implemented "
+            "(docs/jump.md): position-only task, w = sqrt(det(J J^T)), feed-forward per step."
+        )
+    if {"tolerance_angle", "replan", "workspace"} & set(jobs):
+        notes.append(
+            "002: gamma rotates the target about the tool x axis (T Rx(gamma)); closed-form IK with two "
+            "printed equations corrected (docs/replan.md); 002 prints truncated, not rounded, numbers."
+        )
+    if "singular" in jobs:
+        notes.append(
+            "004: virtual link lengths by 004's formula (S_i/M) L_i unless weighting = 'vafa-dubowsky'; "
+            "Cond1 (S4 = 0) is necessary, not sufficient (docs/readings/canadarm7-004.md)."
+        )
+    notes.append(f"Seed {d['seed']} drives every stochastic step (Monte Carlo, GA, sampling).")
+    return notes

@@ -1,0 +1,237 @@
+"""Running a scenario in-process: :func:`run_scenario` -> :class:`RunResult`.
+
+Each job of the scenario (in :data:`~jointlock.scenario.JOB_ORDER`) is one library call
+(``jointlock.jobs.<job>.<job>_from_scenario``) that receives the resolved scenario and the typed
+results of the jobs before it (the halt uses the halt configuration found by ``halt_config``).
+Nothing is parsed from a command line or read back from printed text.
+
+:meth:`RunResult.write` writes what ``jointlock run`` writes: ``results.json`` (the resolved
+scenario, seed, versions, each job's result dictionary and equivalent command, the headline
+``summary``, the ``files``), each job's own files under ``<job>/``, the summary figures under
+``figures/`` and a self-contained ``report.html``; every file atomically, ``results.json`` and
+``report.html`` last.
+"""
+
+from __future__ import annotations
+
+import importlib
+import platform
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..errors import JointlockError
+from ..io.files import atomic_write_json, atomic_write_text, to_plain
+from ..jobs._common import JobResult
+from ..scenario import JOB_PAPER, Scenario
+from ._commands import job_argv, job_command, jump_task_toml
+from ._summary import summarize, summary_lines
+
+#: The library call of each job: (module, function) taking ``(data, previous, *, progress)``.
+JOB_RUNNERS: dict[str, tuple[str, str]] = {
+    "halt_config": ("jointlock.jobs.halt_config", "halt_config_from_scenario"),
+    "halt": ("jointlock.jobs.halt", "halt_from_scenario"),
+    "jump": ("jointlock.jobs.jump", "jump_from_scenario"),
+    "tolerance_angle": ("jointlock.jobs.tolerance_angle", "tolerance_angle_from_scenario"),
+    "replan": ("jointlock.jobs.replan", "replan_from_scenario"),
+    "workspace": ("jointlock.jobs.workspace", "workspace_from_scenario"),
+    "singular": ("jointlock.jobs.singular", "singular_from_scenario"),
+}
+
+
+def job_runner(job: str) -> Callable[..., JobResult]:
+    """The ``<job>_from_scenario`` function of ``job`` (imported on first use)."""
+    module, name = JOB_RUNNERS[job]
+    return getattr(importlib.import_module(module), name)
+
+
+def versions() -> dict[str, str]:
+    """Versions of jointlock, Python and the core dependencies."""
+    import matplotlib
+    import scipy
+
+    from .._version import __version__
+
+    return {
+        "jointlock": __version__,
+        "python": platform.python_version(),
+        "numpy": np.__version__,
+        "scipy": scipy.__version__,
+        "matplotlib": matplotlib.__version__,
+        "platform": platform.platform(),
+    }
+
+
+def default_out_dir(scenario: Scenario) -> Path:
+    """The output folder of a scenario: its ``out`` field, else ``<file stem>-results``."""
+    if scenario.data.get("out"):
+        return Path(scenario.data["out"])
+    return Path(f"{Path(scenario.source).stem}-results")
+
+
+def run_title(scenario: Scenario) -> str:
+    """The file's title (else its name); when an override changed the failure, the file's
+    title no longer describes the run: it is marked, with the failure actually run."""
+    title = scenario.data.get("title") or Path(scenario.source).stem
+    if not scenario.failure_overridden():
+        return title
+    lk = scenario.lock
+    fail = scenario.data["failure"]
+    what = (
+        f"joint {lk[0]} locked at {lk[1]:g} deg"
+        if lk is not None
+        else (f"joint {fail['joint']} locks" if fail["joint"] is not None else "no locked joint")
+    )
+    return f"{title} [failure overridden: {what}]"
+
+
+def run_scenario(scenario: Scenario, *, progress: bool = False) -> RunResult:
+    """Run every job of ``scenario`` in-process, each on the typed results of those before it.
+
+    Parameters
+    ----------
+    scenario
+        A validated scenario (:func:`jointlock.scenario.load_scenario` or
+        :func:`~jointlock.scenario.scenario_from_dict`).
+    progress
+        Show progress bars on stderr.
+
+    Raises
+    ------
+    JointlockError
+        From a job, with the scenario's source and the job's name in front of the message.
+    """
+    results: dict[str, JobResult] = {}
+    for job in scenario.jobs:
+        try:
+            results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
+        except JointlockError as exc:
+            raise type(exc)(f"{scenario.source}: job [{job}]: {exc}") from exc
+    return RunResult(scenario, results, versions())
+
+
+#: Keys before which a command's JSON lists its ``files`` (else they come last).
+_FILES_BEFORE = ("trajectory", "found")
+
+
+def _with_files(data: dict[str, Any], files: list[str]) -> dict[str, Any]:
+    """``data`` with ``"files"`` where the command's ``--json --out`` output has it."""
+    out: dict[str, Any] = {}
+    for key, value in data.items():
+        if key in _FILES_BEFORE and "files" not in out:
+            out["files"] = files
+        out[key] = value
+    out.setdefault("files", files)
+    return out
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """The results of one scenario run (picklable).
+
+    Attributes
+    ----------
+    scenario
+        The scenario that ran.
+    jobs
+        Each job's typed result, in the order they ran.
+    versions
+        Versions of jointlock, Python and the core dependencies.
+    """
+
+    scenario: Scenario
+    jobs: Mapping[str, JobResult]
+    versions: Mapping[str, str] = field(default_factory=dict)
+
+    @property
+    def title(self) -> str:
+        return run_title(self.scenario)
+
+    @property
+    def seed(self) -> int:
+        return self.scenario.data["seed"]
+
+    def __getitem__(self, job: str) -> JobResult:
+        return self.jobs[job]
+
+    def _job_dicts(self, out: Path) -> dict[str, dict[str, Any]]:
+        jobs: dict[str, dict[str, Any]] = {}
+        for job, result in self.jobs.items():
+            previous = {k: v["result"] for k, v in jobs.items()}
+            argv = job_argv(job, self.scenario, out, previous, quiet=True)
+            data = result.to_dict()
+            if hasattr(result, "file_names") and "--out" in argv:  # its command's JSON lists its files
+                data = _with_files(data, [str(out / job / name) for name in result.file_names()])
+            jobs[job] = {
+                "paper": JOB_PAPER[job],
+                "command": job_command(job, self.scenario, out, previous),
+                "exit_code": 0,
+                "result": to_plain(data),
+            }
+        return jobs
+
+    def to_dict(self, out: str | Path | None = None) -> dict[str, Any]:
+        """results.json's content without ``files``: plain JSON data.  ``out`` is the output
+        folder the equivalent commands name (default: :func:`default_out_dir`)."""
+        out = Path(out) if out is not None else default_out_dir(self.scenario)
+        jobs = self._job_dicts(out)
+        return {
+            "title": self.title,
+            "scenario_file": self.scenario.source,
+            "overrides": to_plain(dict(self.scenario.overrides)),
+            "scenario": to_plain(self.scenario.to_dict()),
+            "seed": self.seed,
+            "versions": dict(self.versions),
+            "jobs": jobs,
+            "summary": to_plain(summarize(jobs)),
+        }
+
+    def summary(self) -> list[str]:
+        """The lines ``jointlock run`` prints (a few per job)."""
+        return summary_lines(self.to_dict())
+
+    def write(
+        self,
+        out: str | Path,
+        *,
+        title: str | None = None,
+        extra: Mapping[str, Any] | None = None,
+        extra_sections: Sequence[Any] = (),
+    ) -> dict[str, Any]:
+        """Write every output to ``out`` (see the module docstring); returns results.json's
+        content (with ``files``).  ``title``, ``extra`` (more top-level keys of results.json)
+        and ``extra_sections`` (more report sections) let a caller such as the demo add to it."""
+        from .. import report as rp
+        from ._report import report_sections
+
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        results = self.to_dict(out)
+        for job, result in self.jobs.items():
+            previous = {k: results["jobs"][k]["result"] for k in list(self.jobs)[: list(self.jobs).index(job)]}
+            if job == "jump":
+                atomic_write_text(out / "jump" / "task.toml", jump_task_toml(self.scenario))
+            if "--out" in job_argv(job, self.scenario, out, previous, quiet=True):
+                result.write(out / job)
+            else:  # a job whose command writes no files of its own: its result dictionary
+                atomic_write_json(out / job / "result.json", results["jobs"][job]["result"])
+        results.update(to_plain(dict(extra or {})))
+        sections = report_sections(self.scenario, results, dict(self.jobs), out) + list(extra_sections)
+        files = {str(p.relative_to(out)) for p in out.rglob("*") if p.is_file() and not p.name.startswith(".")}
+        results["files"] = sorted(files | {"results.json", "report.html"})
+        page = rp.render_html(
+            title or f"jointlock run: {results['title']}",
+            sections,
+            intro=(
+                f"Scenario <code>{rp.html.escape(self.scenario.source)}</code>, jointlock "
+                f"{self.versions.get('jointlock', '')}, seed {self.seed}. Jobs: {', '.join(self.scenario.jobs)}."
+            ),
+            toc=True,
+            footer="Generated by <code>jointlock</code>; every number is also in results.json.",
+        )
+        atomic_write_text(out / "report.html", page)
+        atomic_write_json(out / "results.json", results)
+        return results

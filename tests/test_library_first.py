@@ -1,0 +1,164 @@
+"""The library is the product: every scenario runs in-process and gives exactly what
+``jointlock run --json`` prints; ``plan_halt`` is ``jointlock halt``; results pickle; the
+library never chooses a plotting backend; imports point one way (import-linter contracts)."""
+
+from __future__ import annotations
+
+import contextlib
+import io
+import json
+import pickle
+import re
+from pathlib import Path
+
+import matplotlib
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.cli import main
+from jointlock.io.files import to_plain
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = ROOT / "examples"
+
+#: Reduced settings per example (the same as tests/test_run.py: the equality does not depend
+#: on them, and the full settings take minutes).
+FAST = {
+    "halt_000": {"halt_config.samples": 3000, "halt.n_samples": 201},
+    "jump_001": {"jump.sweep": 6},
+    "replan_002": {"workspace.samples": 4000, "replan.steps": 10},
+    "singular_004": {"singular.samples": 50},
+}
+
+
+def cli_json(*argv: str) -> dict:
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(io.StringIO()):
+        assert main(list(argv)) == 0
+    return json.loads(out.getvalue())
+
+
+#: Keys that hold wall-clock times (they differ between two runs of the same scenario).
+TIMING_KEYS = {"elapsed_s"}
+
+
+def _untimed(data):
+    if isinstance(data, dict):
+        return {k: _untimed(v) for k, v in data.items() if k not in TIMING_KEYS}
+    if isinstance(data, list):
+        return [_untimed(v) for v in data]
+    return data
+
+
+def _set_args(overrides: dict) -> list[str]:
+    return [a for k, v in overrides.items() for a in ("--set", f"{k}={v}")]
+
+
+@pytest.mark.parametrize("name", sorted(FAST))
+def test_run_json_equals_the_in_process_run(tmp_path, name):
+    path = EXAMPLES / f"{name}.toml"
+    out = tmp_path / "cli"
+    printed = cli_json("run", str(path), "--out", str(out), "--json", *_set_args(FAST[name]))
+    overrides = {k: v for k, v in FAST[name].items()} | {"out": str(out)}
+    run = jl.run_scenario(jl.load_scenario(path, overrides))
+    in_process = _untimed(run.to_dict(out))
+    assert set(printed) - set(in_process) == {"files"}
+    assert in_process == _untimed({k: v for k, v in printed.items() if k != "files"})
+    # the same files, written by the library
+    written = run.write(tmp_path / "lib")
+    assert written["files"] == printed["files"]
+    assert _untimed(json.loads((tmp_path / "lib" / "results.json").read_text())["summary"]) == _untimed(
+        printed["summary"]
+    )
+
+
+def test_run_result_pickles(tmp_path):
+    sc = jl.load_scenario(EXAMPLES / "singular_004.toml", FAST["singular_004"])
+    run = jl.run_scenario(sc)
+    back = pickle.loads(pickle.dumps(run))
+    assert _untimed(back.to_dict(tmp_path)) == _untimed(run.to_dict(tmp_path))
+    assert back.summary() == run.summary()
+
+
+def test_plan_halt_is_jointlock_halt():
+    """000's scenario: the same halt configuration, k* and torques from Python and the CLI."""
+    printed = cli_json("halt", "halt7", "--samples", "6000", "--json")
+    plan = jl.plan_halt("halt7", samples=6000)
+    assert to_plain(plan.to_dict()) == printed
+    assert plan.feasible and printed["feasible"]
+    np.testing.assert_array_equal(np.degrees(plan.problem.qf), printed["q_final_deg"])
+    assert plan.motion.global_torque == printed["global_torque_Nm"]
+    # the documented Python calls: the model with its spacecraft, locked, 000's state
+    model = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
+    state = jl.FailureState.from_degrees(model, [-180, -180, -100, -10, 20, 20], [20, 30, 15, 25, 40, 35],
+                                         [8, 10, 12, 10, -8, 6])  # fmt: skip
+    same = jl.plan_halt(model, state, T=10.0, samples=6000)  # limits: the model's 40 deg/s, 000's 20 deg/s^2
+    assert to_plain(same.to_dict()) == printed
+
+
+def test_plan_halt_text_is_the_cli_text(capsys):
+    assert main(["halt", "halt7", "--paper-qf", "--n-samples", "101"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert jl.plan_halt("halt7", paper_qf=True, n_samples=101).summary() == printed
+
+
+def test_plan_halt_needs_a_state_for_other_robots():
+    with pytest.raises(jl.ScenarioError, match="state at failure"):
+        jl.plan_halt("puma6", locks={2: 0.5}, T=5.0)
+
+
+def test_the_library_never_chooses_a_backend(tmp_path, monkeypatch):
+    def refuse(*args, **kwargs):
+        raise AssertionError("matplotlib.use called by the library")
+
+    monkeypatch.setattr(matplotlib, "use", refuse)
+    sc = jl.load_scenario(EXAMPLES / "halt_000.toml", {"halt_config.samples": 500, "halt.n_samples": 101})
+    jl.run_scenario(sc).write(tmp_path)
+    assert (tmp_path / "report.html").is_file()
+    src = ROOT / "src" / "jointlock"
+    offenders = [
+        str(p.relative_to(src))
+        for p in src.rglob("*.py")
+        if "cli" not in p.relative_to(src).parts and re.search(r"matplotlib\.use\(", p.read_text())
+    ]
+    assert offenders == []
+
+
+def test_plot_functions_draw_on_the_axes_given(tmp_path):
+    from matplotlib.figure import Figure
+
+    plan = jl.plan_halt("halt7", paper_qf=True, n_samples=101)
+    fig = Figure()
+    ax = fig.add_subplot()
+    assert jl.plots.halt.plot_global_torque_vs_k(plan.motion, ax=ax) is ax
+    assert ax.lines and ax.get_xlabel() == "k [deg/s$^6$]"
+    fig = Figure()
+    assert jl.plots.halt.plot_joint_profiles(plan.motion, fig=fig) is fig
+    assert len(fig.axes) == 3 * plan.problem.dof
+
+
+def _lint(tmp_path: Path, layers: list[str] | None = None) -> int:
+    from importlinter.cli import lint_imports
+
+    config = ROOT / "pyproject.toml"
+    if layers is not None:  # a copy of the contract with another layer order
+        text = config.read_text()
+        block = re.search(r"layers = \[\n(.*?)\n\]", text, re.S)
+        assert block is not None
+        text = text.replace(block.group(1), "\n".join(f'    "{name}",' for name in layers))
+        config = tmp_path / "pyproject.toml"
+        config.write_text(text)
+    with contextlib.redirect_stdout(io.StringIO()):
+        return lint_imports(config_filename=str(config), no_cache=True)
+
+
+def test_import_layers_hold(tmp_path):
+    pytest.importorskip("importlinter")
+    assert _lint(tmp_path) == 0
+
+
+def test_import_layer_contract_catches_an_upward_import(tmp_path):
+    pytest.importorskip("importlinter")
+    # kinematics imports model: with model placed above kinematics the contract must break
+    assert _lint(tmp_path, ["jointlock.model", "jointlock.kinematics"]) != 0
