@@ -18,8 +18,8 @@ from jointlock.planning.halt_config import (
     ReachabilityBound,
     evaluate_cp,
     optimal_halt_configuration,
-    section_figures,
 )
+from jointlock.plots.halt_config import section_figures
 
 #: 000 §5.1, healthy joints 1, 2, 3, 5, 6, 7 [deg]: q_best, q_sub, CP(q_sub), the CP gain of
 #: q_best over q_sub and the number of samples K.

@@ -85,12 +85,19 @@ _LAZY = {
     "gammas_for_lock": "jointlock.planning.replan",
     "replan_line": "jointlock.planning.replan",
     "compare_workspaces": "jointlock.analysis.workspace",
+    "ee_positions": "jointlock.kinematics",
     # jobs: one call per job, typed results with to_dict() / summary() / write()
-    "plan_halt": "jointlock.jobs.halt",
-    "HaltPlan": "jointlock.jobs.halt",
-    "FailureState": "jointlock.jobs.halt",
-    "JointLimits": "jointlock.jobs.halt",
-    "halt_limits": "jointlock.jobs.halt",
+    **{name: "jointlock.jobs" for name in (
+        "plan_halt", "HaltPlan", "FailureState", "JointLimits", "halt_limits",
+        "study_halt_configuration", "HaltConfigurationStudy",
+        "run_jump_study", "JumpJobResult",
+        "find_tolerance_angle", "ToleranceAngleResult",
+        "plan_replan", "ReplanJobResult",
+        "study_workspace", "WorkspaceStudy",
+        "study_singularity", "verify_singularity_conditions", "search_singularities",
+        "ReproductionReport",
+    )},  # fmt: skip
+    "reproduce": "jointlock.jobs.reproduce",  # the function (jointlock.jobs.reproduce is its module)
     # scenarios in-process
     "load_scenario": "jointlock.scenario",
     "scenario_from_dict": "jointlock.scenario",
