@@ -2,7 +2,7 @@
 
 Run: ``python benchmarks/bench_workspace.py [--samples 1000000] [--pin-subset 100000]``.
 
-Prints end-effector positions per second of :func:`jointlock.analysis.workspace.ee_positions`
+Prints end-effector positions per second of :func:`jointlock.kinematics.ee_positions`
 (10^6 configurations of ``puma6``, full and with joint 2 locked, plus the general
 :func:`jointlock.chain_state`) against a Python loop of Pinocchio ``forwardKinematics`` +
 ``updateFramePlacement`` on a subset, in the same run; and closed-form IK poses per second
@@ -19,8 +19,9 @@ import numpy as np
 from _info import best_of, machine_info
 
 import jointlock as jl
-from jointlock.analysis.workspace import ee_positions, sample_configurations
+from jointlock.analysis.workspace import sample_configurations
 from jointlock.ik import ik_closed_form
+from jointlock.kinematics import ee_positions
 
 
 def main() -> None:

@@ -1,0 +1,185 @@
+"""The combined weights and index CP of 000 eqs. (18)-(19), and :class:`AbilityModel`: CP with
+its normalisation and weights frozen from a sample set (the readings of 000's ambiguities are
+in :mod:`jointlock.analysis.ability`)."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...errors import ConfigurationError, ScenarioError
+from ...model import FloatArray
+from ._ahp import PAPER_JUDGMENT, AHPResult, RITable, ahp_weights
+from ._entropy import EntropyResult, entropy_weights
+from ._indices import INDEX_NAMES, KinematicIndices, Normalization, StandardizedIndices, standardize
+
+Assignment = Literal["text", "equation"]
+
+
+def ahp_to_canonical(weights: ArrayLike, assignment: Assignment) -> FloatArray:
+    """Reorder a 3-vector of AHP weights into the canonical order ``(s, kappa, w)``.
+
+    ``"text"``: the AHP vector is ``(s, w, kappa)`` (000 eq. 12 and §5.1).  ``"equation"``:
+    it is ``(s, kappa, w)`` (the index order of 000 eq. 19).
+    """
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (3,):
+        raise ConfigurationError(f"AHP weights must be 3 numbers (one per index); got shape {w.shape}")
+    if assignment == "text":
+        return w[[0, 2, 1]]
+    if assignment == "equation":
+        return w.copy()
+    raise ScenarioError(f"assignment must be 'text' or 'equation'; got {assignment!r}")
+
+
+def combine_weights(
+    ahp: ArrayLike,
+    entropy: ArrayLike,
+    *,
+    assignment: Assignment = "equation",
+    renormalize: bool = False,
+) -> FloatArray:
+    """Combined weights ``omega_C = omega_CR + omega_CP`` (000 eq. 18), canonical order.
+
+    Parameters
+    ----------
+    ahp
+        (3,) AHP weights in the judgment matrix's row order (see :func:`ahp_to_canonical`).
+    entropy
+        (3,) entropy weights in canonical order.
+    assignment
+        ``"equation"`` (default) or ``"text"``; see the module docstring.
+    renormalize
+        Divide by the sum (2) so the weights sum to 1.  Default False, as eq. (18) is printed.
+
+    Returns
+    -------
+    (3,) weights of ``(s_hat, kappa_hat, w_hat)``.
+    """
+    ent = np.asarray(entropy, dtype=float)
+    if ent.shape != (3,):
+        raise ConfigurationError(f"entropy weights must be 3 numbers; got shape {ent.shape}")
+    combined = ahp_to_canonical(ahp, assignment) + ent
+    if renormalize:
+        combined = combined / combined.sum()
+    return combined
+
+
+def combined_index(standardized: StandardizedIndices, weights: ArrayLike) -> FloatArray:
+    """CP of 000 eq. (19): ``w_1 s_hat + w_2 kappa_hat + w_3 w_hat``, shape (...).
+
+    ``weights`` is (3,) in canonical order (from :func:`combine_weights`).
+    """
+    w = np.asarray(weights, dtype=float)
+    if w.shape != (3,):
+        raise ConfigurationError(f"weights must be 3 numbers (s_hat, kappa_hat, w_hat); got shape {w.shape}")
+    return w[0] * standardized.s_hat + w[1] * standardized.kappa_hat + w[2] * standardized.w_hat
+
+
+@dataclass(frozen=True)
+class AbilityModel:
+    """CP with its normalisation and weights frozen from a sample set: a function of indices.
+
+    Build it with :func:`fit_ability_model`; call it on any :class:`KinematicIndices` to get
+    CP (...).
+
+    Attributes
+    ----------
+    normalization
+        Min-max bounds of ``s`` and ``w`` over the sample set.
+    weights
+        (3,) combined weights, canonical order.
+    ahp
+        The AHP result (weights in the judgment matrix's row order).
+    entropy
+        The entropy result (canonical order) over the sample set.
+    assignment, renormalize
+        The readings used (see the module docstring).
+    """
+
+    normalization: Normalization
+    weights: FloatArray
+    ahp: AHPResult
+    entropy: EntropyResult
+    assignment: Assignment = "equation"
+    renormalize: bool = False
+    ahp_canonical: FloatArray = field(default_factory=lambda: np.zeros(3))
+
+    def standardize(self, indices: KinematicIndices) -> StandardizedIndices:
+        """Standardise with the frozen bounds."""
+        return standardize(indices, self.normalization)
+
+    def __call__(self, indices: KinematicIndices) -> FloatArray:
+        """CP (...) of ``indices`` with the frozen normalisation and weights."""
+        return combined_index(self.standardize(indices), self.weights)
+
+    def weights_dict(self) -> dict[str, dict[str, float]]:
+        """``{"ahp" | "entropy" | "combined": {index name: weight}}``."""
+        return {
+            "ahp": dict(zip(INDEX_NAMES, map(float, self.ahp_canonical))),
+            "entropy": dict(zip(INDEX_NAMES, map(float, self.entropy.weights))),
+            "combined": dict(zip(INDEX_NAMES, map(float, self.weights))),
+        }
+
+
+def fit_ability_model(
+    indices: KinematicIndices,
+    *,
+    judgment: ArrayLike = PAPER_JUDGMENT,
+    assignment: Assignment = "equation",
+    renormalize: bool = False,
+    ri: RITable | Mapping[int, float] = "paper",
+) -> AbilityModel:
+    """Fix the normalisation and the weights of CP from a sample set (000 §3.1.2-3.1.3).
+
+    Parameters
+    ----------
+    indices
+        Indices of the K sample configurations (any shape, flattened; K >= 2).
+    judgment
+        (3, 3) AHP judgment matrix; default 000 eq. (39).  Its row order is ``(s, w, kappa)``
+        under ``assignment="text"`` and ``(s, kappa, w)`` under ``"equation"``.
+    assignment, renormalize
+        The readings of 000's ambiguities (module docstring); defaults ``"equation"``, False.
+    ri
+        RI table for the consistency test (:func:`ahp_weights`).
+
+    Returns
+    -------
+    AbilityModel
+    """
+    ahp = ahp_weights(judgment, ri=ri)
+    if ahp.weights.shape != (3,):
+        raise ScenarioError(
+            f"judgment matrix must be 3 x 3 (one row per index); got {ahp.matrix.shape[0]} x "
+            f"{ahp.matrix.shape[0]}"
+        )
+    flat = indices[...] if np.ndim(indices.sigma_min) == 1 else _flatten(indices)
+    norm = Normalization.from_samples(flat)
+    std = standardize(flat, norm)
+    ent = entropy_weights(std.stacked())
+    weights = combine_weights(ahp.weights, ent.weights, assignment=assignment, renormalize=renormalize)
+    for arr in (weights,):
+        arr.setflags(write=False)
+    return AbilityModel(
+        normalization=norm,
+        weights=weights,
+        ahp=ahp,
+        entropy=ent,
+        assignment=assignment,
+        renormalize=bool(renormalize),
+        ahp_canonical=ahp_to_canonical(ahp.weights, assignment),
+    )
+
+
+def _flatten(indices: KinematicIndices) -> KinematicIndices:
+    return KinematicIndices(
+        np.ravel(indices.sigma_min),
+        np.ravel(indices.condition_number),
+        np.ravel(indices.manipulability),
+        np.ravel(indices.inverse_condition),
+    )

@@ -1,0 +1,220 @@
+"""Every IK solution of one target (:func:`solve_ik`): the closed form for the ``puma6``
+family, Levenberg-Marquardt otherwise, and the nearest reachable pose when no exact solution
+exists (see :mod:`jointlock.ik`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .._random import resolve_seed
+from ..errors import ConfigurationError, ModelError
+from ..kinematics import ee_pose
+from ..model import ArmModel, FloatArray
+from ._numeric import ik_numeric
+from ._pose import _as_poses, wrap_angle
+from ._puma6 import ik_closed_form, puma6_geometry
+
+#: Two solutions closer than this (max wrapped joint difference) [rad] are the same.
+DUPLICATE_TOL = 1e-6
+
+
+@dataclass(frozen=True)
+class IKSolution:
+    """One IK branch.
+
+    Attributes
+    ----------
+    q
+        (n,) movable-joint angles [rad].
+    q_full
+        (full_dof,) every joint in joint-number order, locked ones included [rad].
+    branch
+        Closed-form branch index (see :func:`puma6_branches`), or the start index for the
+        numerical method.
+    position_error
+        ``|p - p_target|`` [m].
+    rotation_error
+        Rotation angle between target and reached orientation [rad].
+    exact
+        Both errors within :data:`EXACT_POSITION_TOL` / :data:`EXACT_ROTATION_TOL`.
+    """
+
+    q: FloatArray
+    q_full: FloatArray
+    branch: int
+    position_error: float
+    rotation_error: float
+    exact: bool
+
+
+@dataclass(frozen=True)
+class IKResult:
+    """Every IK solution of one target.
+
+    Attributes
+    ----------
+    target
+        (4, 4) requested pose [m].
+    method
+        ``"closed-form"`` or ``"numeric"``.
+    solutions
+        The exact solutions (distinct), best first.
+    candidates
+        Every branch computed, exact or not (closed form: all valid branches).
+    nearest
+        When no exact solution exists: the configuration whose pose is nearest to the target
+        in the metric ``sqrt(|dp|^2 + (L dtheta)^2)`` (local optimum of Levenberg-Marquardt
+        from every candidate and ``starts`` random starts); None otherwise.
+    nearest_pose
+        (4, 4) the pose reached by ``nearest`` [m], or None.
+    length_scale
+        ``L`` [m] of that metric.
+    seed
+        The seed of the numerical method's random starts (``rng`` an int, or the fresh seed
+        drawn for ``rng=None``); None when ``rng`` was a Generator (see
+        :mod:`jointlock._random`).
+    """
+
+    target: FloatArray
+    method: Literal["closed-form", "numeric"]
+    solutions: tuple[IKSolution, ...]
+    candidates: tuple[IKSolution, ...]
+    nearest: IKSolution | None
+    nearest_pose: FloatArray | None
+    length_scale: float
+    seed: int | None = None
+
+    @property
+    def reachable(self) -> bool:
+        """True when at least one exact solution exists."""
+        return bool(self.solutions)
+
+
+def _distinct(solutions: list[IKSolution]) -> list[IKSolution]:
+    out: list[IKSolution] = []
+    for s in solutions:
+        if all(np.max(np.abs(wrap_angle(s.q - o.q))) > DUPLICATE_TOL for o in out):
+            out.append(s)
+    return out
+
+
+def solve_ik(
+    model: ArmModel,
+    target: ArrayLike,
+    *,
+    method: Literal["auto", "closed-form", "numeric"] = "auto",
+    starts: int = 16,
+    rng: int | np.random.Generator | None = 0,
+    length_scale: float = 1.0,
+) -> IKResult:
+    """Every IK solution of one target, and the nearest reachable pose when there is none.
+
+    Parameters
+    ----------
+    model
+        Any arm, possibly locked.  ``"auto"`` uses the closed form when the model is of the
+        ``puma6`` family (:func:`puma6_geometry`) and Levenberg-Marquardt otherwise.
+    target
+        (4, 4) pose in the root frame [m].
+    starts, rng
+        Random starts of the numerical method (also used to search the nearest reachable
+        pose of a locked arm); ``rng`` as in :mod:`jointlock._random` (both searches start
+        from the same seed), the seed used is ``IKResult.seed``.
+    length_scale
+        ``L`` [m] of the nearest-pose metric ``sqrt(|dp|^2 + (L dtheta)^2)``.
+
+    Returns
+    -------
+    IKResult
+    """
+    if method not in ("auto", "closed-form", "numeric"):
+        raise ConfigurationError(f"method must be 'auto', 'closed-form' or 'numeric'; got {method!r}")
+    t = _as_poses(target)
+    if t.shape != (4, 4):
+        raise ConfigurationError(
+            f"target must be one 4x4 pose; got shape {t.shape} (use ik_closed_form for batches)"
+        )
+    use_closed = method == "closed-form"
+    if method == "auto":
+        try:
+            puma6_geometry(model)
+            use_closed = True
+        except ModelError:
+            use_closed = False
+    source = resolve_seed(rng)  # an int seed (fresh for None) or the caller's Generator
+    seed = None if isinstance(source, np.random.Generator) else source
+    cands, kind = _candidates(model, t, use_closed, starts, source, length_scale)
+    exact = _distinct([c for c in cands if c.exact])
+    nearest = None
+    nearest_pose = None
+    if not exact:
+        seeds = [c.q for c in cands]
+        refined = ik_numeric(
+            model,
+            t,
+            q0=np.array(seeds) if seeds else None,
+            starts=starts,
+            rng=source,
+            length_scale=length_scale,
+        )
+        metric = refined.position_error**2 + (length_scale * refined.rotation_error) ** 2
+        k = int(np.argmin(metric))
+        nearest = IKSolution(
+            refined.q[k],
+            model.expand(refined.q[k]),
+            k,
+            float(refined.position_error[k]),
+            float(refined.rotation_error[k]),
+            bool(refined.exact[k]),
+        )
+        nearest_pose = ee_pose(model, refined.q[k])
+        if nearest.exact:  # the closed form missed it (singular target): report as a solution
+            exact = [nearest]
+            nearest, nearest_pose = None, None
+    return IKResult(t, kind, tuple(exact), tuple(cands), nearest, nearest_pose, float(length_scale), seed)
+
+
+def _candidates(
+    model: ArmModel,
+    t: FloatArray,
+    use_closed: bool,
+    starts: int,
+    rng: int | np.random.Generator,
+    length_scale: float,
+) -> tuple[list[IKSolution], Literal["closed-form", "numeric"]]:
+    """Every branch of :func:`solve_ik`: the closed form's valid branches, or one per start of
+    the numerical method; and the method's name."""
+    cands: list[IKSolution] = []
+    if use_closed:
+        br = ik_closed_form(model, t)
+        for b in np.flatnonzero(br.valid):
+            cands.append(
+                IKSolution(
+                    br.q[b],
+                    br.q_full[b],
+                    int(b),
+                    float(br.position_error[b]),
+                    float(br.rotation_error[b]),
+                    bool(br.exact[b]),
+                )
+            )
+        kind: Literal["closed-form", "numeric"] = "closed-form"
+    else:
+        num = ik_numeric(model, t, starts=starts, rng=rng, length_scale=length_scale)
+        for k in range(num.q.shape[0]):
+            cands.append(
+                IKSolution(
+                    num.q[k],
+                    model.expand(num.q[k]),
+                    k,
+                    float(num.position_error[k]),
+                    float(num.rotation_error[k]),
+                    bool(num.exact[k]),
+                )
+            )
+        kind = "numeric"
+    return cands, kind
