@@ -7,6 +7,13 @@ result records the seed actually used:
 - ``None`` draws a fresh seed from the operating system's entropy and uses it like an int, so
   the run is still reproducible from its recorded seed;
 - a ``Generator`` is used as it is (its state is the caller's): the recorded seed is ``None``.
+
+Anything else (a negative int, a bool, a float, a string, a legacy ``RandomState``) raises
+:class:`~jointlock.errors.ConfigurationError` naming the parameter.  An int seed ``s`` gives the
+stream of ``numpy.random.default_rng(s)``, so ``rng=s`` and ``rng=default_rng(s)`` draw the
+same numbers (only the recorded seed differs).  A function draws its seed once, at its start,
+with :func:`resolve_rng` (or :func:`resolve_seed` when it hands the seed on to another
+stochastic function), and stores it in its result's ``seed`` field.
 """
 
 from __future__ import annotations

@@ -16,7 +16,8 @@ class ModelError(JointlockError, ValueError):
 
 
 class ConfigurationError(JointlockError, ValueError):
-    """A joint-space array (q, dq, ...) has the wrong shape or non-finite values."""
+    """A joint-space array (q, dq, ...) has the wrong shape or non-finite values, a ChainState
+    does not belong to the q given, or an ``rng`` is not a seed >= 0, a Generator or None."""
 
 
 class ScenarioError(JointlockError, ValueError):

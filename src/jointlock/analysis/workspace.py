@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._random import resolve_rng
 from ..errors import ConfigurationError
 from ..kinematics import DEFAULT_CHUNK, ee_positions
 from ..locking import lock
@@ -61,10 +62,15 @@ OUTSIDE_TOL = 0.03
 def sample_configurations(
     model: ArmModel, samples: int, rng: int | np.random.Generator | None = None
 ) -> FloatArray:
-    """(samples, n) joint angles uniform within the limits (capped to +-pi) [rad]."""
+    """(samples, n) joint angles uniform within the limits (capped to +-pi) [rad].
+
+    ``rng``: seed (int >= 0) or ``numpy.random.Generator`` (:mod:`jointlock._random`); ``None``
+    draws a fresh seed, which is not returned (pass a seed or a Generator to repeat the draw;
+    :func:`sample_workspace` and :func:`compare_workspaces` record theirs).
+    """
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ConfigurationError(f"samples must be an integer >= 1; got {samples!r}")
-    gen = np.random.default_rng(rng)
+    gen, _ = resolve_rng(rng)
     lo = np.maximum(model.lower, -math.pi)
     hi = np.minimum(model.upper, math.pi)
     return gen.uniform(lo, hi, (int(samples), model.dof))
@@ -107,7 +113,8 @@ class Workspace:
     volume
         Occupied volume [m^3] (voxel count x voxel^3).
     seed
-        The ``rng`` argument when it was a seed, else None.
+        The seed the samples were drawn with (the fresh one drawn for ``rng=None``), or None
+        when a ``Generator`` was passed.
     """
 
     points: FloatArray
@@ -131,11 +138,13 @@ def sample_workspace(
 ) -> Workspace:
     """Monte Carlo workspace of one arm (002 Fig. 2): uniform joint samples, batched FK,
     voxel-occupancy volume (``voxel=None``: about :data:`SAMPLES_PER_VOXEL` samples per
-    voxel of the bounding box)."""
-    pts = ee_positions(model, sample_configurations(model, samples, rng))
+    voxel of the bounding box).  ``rng``: seed, Generator or None (a fresh seed), recorded in
+    ``seed`` (:mod:`jointlock._random`)."""
+    gen, seed = resolve_rng(rng)
+    pts = ee_positions(model, sample_configurations(model, samples, gen))
     side = _auto_voxel(pts) if voxel is None else float(voxel)
     vol = voxel_keys(pts, side).shape[0] * side**3
-    return Workspace(pts, side, float(vol), rng if isinstance(rng, (int, np.integer)) else None)
+    return Workspace(pts, side, float(vol), seed)
 
 
 @dataclass(frozen=True)
@@ -158,7 +167,8 @@ class WorkspaceComparison:
     joint, angle
         The locked joint (1-based) and its angle [rad].
     seed
-        The ``rng`` argument used (None when a Generator was passed).
+        The seed the samples were drawn with (the fresh one drawn for ``rng=None``), or None
+        when a ``Generator`` was passed.
     share_kept_half
         The same estimate from the first half of each cloud (same voxel rule: the given
         ``voxel``, or the automatic side for half the samples) [-]; its distance to
@@ -238,9 +248,11 @@ def compare_workspaces(
         Voxel side [m] of the volume estimate; default: the side giving about
         :data:`SAMPLES_PER_VOXEL` full-arm samples per voxel of the full cloud's bounding box.
     rng
-        Seed or generator; the full arm's samples come first, then the locked arm's.
+        Seed (int >= 0), ``numpy.random.Generator`` or None (a fresh seed), recorded in
+        ``seed`` (:mod:`jointlock._random`); the full arm's samples come first, then the
+        locked arm's.
     """
-    gen = np.random.default_rng(rng)
+    gen, seed = resolve_rng(rng)
     locked_model = lock(model, joint, angle)
     full = ee_positions(model, sample_configurations(model, samples, gen))
     locked = ee_positions(locked_model, sample_configurations(locked_model, locked_samples or samples, gen))
@@ -268,7 +280,7 @@ def compare_workspaces(
         float(1.0 - inside.mean()) if inside.size else 0.0,
         int(joint),
         float(angle),
-        rng if isinstance(rng, (int, np.integer)) else None,
+        seed,
         float(share_half),
         float(voxel_half),
     )

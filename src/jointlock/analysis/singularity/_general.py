@@ -10,6 +10,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._random import resolve_rng
 from ...errors import ConfigurationError, ModelError, ScenarioError
 from ...kinematics import VMWeighting, generalized_jacobian, jacobian, virtual_manipulator
 from ...model import ArmModel, FloatArray
@@ -23,12 +24,10 @@ BASE_KINDS: tuple[str, ...] = ("fixed", "floating", "virtual")
 RANK_TOL = 1e-8
 
 
-def _rng(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, int | None]:
-    if isinstance(rng, np.random.Generator):
-        return rng, None
-    if rng is not None and not isinstance(rng, (int, np.integer)):
-        raise ScenarioError(f"rng must be an int seed, a numpy Generator or None; got {rng!r}")
-    return np.random.default_rng(rng), None if rng is None else int(rng)
+#: The package's one rng convention (:func:`jointlock._random.resolve_rng`): ``(generator,
+#: seed)``, the seed a fresh one for ``rng=None`` and None for a Generator.  (The name the
+#: singularity modules used before it was shared.)
+_rng = resolve_rng
 
 
 def _check_base(base: str) -> None:

@@ -10,10 +10,11 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._random import resolve_rng
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting, chain_state
 from ...model import ArmModel, FloatArray, as_joint_array
-from ._general import BaseKind, _rng, task_jacobian
+from ._general import BaseKind, task_jacobian
 
 log = logging.getLogger(__package__)
 
@@ -114,7 +115,8 @@ class SingularitySearch:
     families
         The clustering of ``q`` (:func:`cluster_singularities`).
     iterations, tol, base, weighting, length, seed
-        Settings; ``seed`` is the int given as ``rng`` (``None`` for a Generator).
+        Settings; ``seed`` is the seed the starts were drawn with (the int given as ``rng``,
+        the fresh one drawn for ``rng=None``; ``None`` for a Generator).
     """
 
     q_start: FloatArray
@@ -156,7 +158,8 @@ def find_singularities(
     samples
         Number of starts ``S``, drawn uniformly within the joint limits (capped to +-pi).
     rng
-        Seed or Generator for the starts.
+        Seed (int >= 0, default 0), ``numpy.random.Generator``, or None (a fresh seed) for the
+        starts, recorded in ``seed`` (:mod:`jointlock._random`).
     base, weighting, length
         Which Jacobian (:func:`task_jacobian`).
     tol
@@ -182,7 +185,7 @@ def find_singularities(
         raise ScenarioError(f"samples must be >= 1; got {samples}")
     if max_iter < 1:
         raise ScenarioError(f"max_iter must be >= 1; got {max_iter}")
-    gen, seed = _rng(rng)
+    gen, seed = resolve_rng(rng)
     if q_start is None:
         lo = np.maximum(model.lower, -np.pi)
         hi = np.minimum(model.upper, np.pi)

@@ -9,6 +9,7 @@ from typing import Literal
 
 import numpy as np
 
+from ..._random import resolve_rng
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting
 from ...model import ArmModel, FloatArray
@@ -26,7 +27,7 @@ from ._canadarm2 import (
     reference_jacobian,
     reorder_eq24,
 )
-from ._general import RANK_TOL, BaseKind, _rng, singularity_of_jacobian, task_jacobian
+from ._general import RANK_TOL, BaseKind, singularity_of_jacobian, task_jacobian
 from ._search import find_singularities
 
 
@@ -50,6 +51,9 @@ def sample_condition(
     * cond5: given phi, a planar two-link problem
       ``d C3 + e C34 = -h sin phi``, ``d S3 + e S34 = a + h cos phi``.
     * cond1f: cond1 plus ``F = 0`` solved for theta6 (``F = A S6 + B C6``).
+
+    ``rng``: seed (int >= 0, default 0), Generator or None (a fresh seed, not returned: pass a
+    seed or a Generator to repeat the draw), see :mod:`jointlock._random`.
     """
     names = CONDITIONS + REFINED_CONDITIONS
     if name not in names:
@@ -57,7 +61,7 @@ def sample_condition(
     if size < 0:
         raise ScenarioError(f"size must be >= 0; got {size}")
     lg = _lengths(lengths)
-    gen, _ = _rng(rng)
+    gen, _ = resolve_rng(rng)
     a, d, e, h = lg.a, lg.d, lg.e, lg.h
     out: list[FloatArray] = []
     have = 0
@@ -183,7 +187,10 @@ class Completeness:
 
 @dataclass(frozen=True)
 class ConditionVerification:
-    """Result of :func:`verify_conditions`: sufficiency per condition and completeness."""
+    """Result of :func:`verify_conditions`: sufficiency per condition and completeness.
+
+    ``seed`` is the seed the run started from (the fresh one drawn for ``rng=None``), or None
+    when a ``Generator`` was passed."""
 
     checks: dict[str, ConditionCheck]
     completeness: Completeness
@@ -217,9 +224,10 @@ def verify_conditions(
     ``rng``), so results do not depend on order.
 
     ``base="virtual"`` uses the virtual manipulator (needs a floating model, 004's case);
-    ``"fixed"`` the real arm.
+    ``"fixed"`` the real arm.  ``rng``: seed (int >= 0, default 0), Generator or None (a fresh
+    seed), recorded in ``seed`` (:mod:`jointlock._random`).
     """
-    gen, seed = _rng(rng)
+    gen, seed = resolve_rng(rng)
     lengths = arm_lengths(model, base=base, weighting=weighting)
     children = gen.spawn(len(CONDITIONS + REFINED_CONDITIONS) + 1)
     tb: BaseKind = base

@@ -67,7 +67,8 @@ class HaltConfiguration:
     samples
         ``K``.
     seed
-        The seed of the generator (an int) or None when a ``Generator`` was passed.
+        The seed the samples were drawn with (an int; the fresh one drawn for ``rng=None``),
+        or None when a ``Generator`` was passed.
     jacobian, base
         Jacobian used (``"generalized"`` / ``"fixed"``) and the model's base
         (``"floating"`` / ``"fixed"``); the generalized Jacobian of a fixed base is the

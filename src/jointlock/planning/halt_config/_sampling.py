@@ -1,32 +1,23 @@
-"""Where the search samples (000 eqs. 21-22): the seed, the box of joint angles (limits,
-narrowed by the reachability constraint) and the message when nothing is reachable."""
+"""Where the search samples (000 eqs. 21-22): the seed (:mod:`jointlock._random`), the box of
+joint angles (limits, narrowed by the reachability constraint) and the message when nothing is
+reachable."""
 
 from __future__ import annotations
 
 import math
-import secrets
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._random import resolve_rng
 from ...errors import ConfigurationError, InfeasibleError
 from ...model import ArmModel, FloatArray
 from ._bound import ReachabilityBound, _readonly
 from ._reachability import HaltReachability
 
-
-def _resolve_rng(rng: int | np.random.Generator | None) -> tuple[np.random.Generator, int | None]:
-    if isinstance(rng, np.random.Generator):
-        return rng, None
-    if rng is None:
-        seed = secrets.randbits(63)
-    elif isinstance(rng, (int, np.integer)) and not isinstance(rng, bool) and int(rng) >= 0:
-        seed = int(rng)
-    else:
-        raise ConfigurationError(
-            f"rng must be None, a non-negative int seed or a numpy Generator; got {rng!r}"
-        )
-    return np.random.default_rng(seed), seed
+#: The package's one rng convention (:func:`jointlock._random.resolve_rng`), under the name the
+#: halt-configuration modules imported before it was shared.
+_resolve_rng = resolve_rng
 
 
 def _sampling_box(

@@ -11,6 +11,7 @@ from collections.abc import Callable
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._random import resolve_rng
 from ...analysis.ability import (
     DEFAULT_BATCH,
     PAPER_JUDGMENT,
@@ -28,7 +29,7 @@ from ._bound import ReachabilityBound, _readonly
 from ._reachability import HaltReachability
 from ._refine import _refine
 from ._result import HaltCandidate, HaltConfiguration
-from ._sampling import _resolve_rng, _search_box
+from ._sampling import _search_box
 
 #: The name the search logs under (that of the module it was before the split).
 logger = logging.getLogger("jointlock.planning.halt_config")
@@ -85,7 +86,8 @@ def optimal_halt_configuration(
     samples
         ``K``, Monte Carlo samples (000: 36000), K >= 2.
     rng
-        Seed or ``numpy.random.Generator``; None draws a fresh seed, which is recorded.
+        Seed (int >= 0) or ``numpy.random.Generator`` (:mod:`jointlock._random`); None draws a
+        fresh seed, which is recorded in ``seed`` (a Generator records None).
     jacobian
         ``"generalized"`` (default): 000 §3.1.2 analyses the generalized Jacobian ``J~_F`` of
         the free-floating arm (eq. 5), which is also what the crippled arm's operator sees in
@@ -141,7 +143,7 @@ def optimal_halt_configuration(
         raise ConfigurationError(f"jacobian must be 'generalized' or 'fixed'; got {jacobian!r}")
     if int(refine_starts) < 1:
         raise ConfigurationError(f"refine_starts must be >= 1; got {refine_starts!r}")
-    generator, seed = _resolve_rng(rng)
+    generator, seed = resolve_rng(rng)
     lo, hi, reachability, k_range = _search_box(model_locked, lower, upper, reachability)
     exact_reach = reachability if isinstance(reachability, HaltReachability) else None
     n = model_locked.dof

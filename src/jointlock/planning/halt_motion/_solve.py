@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import minimize, minimize_scalar
 
+from ..._random import resolve_seed
 from ...errors import InfeasibleError, ScenarioError
 from ...model import FloatArray
 from ..ga import GAResult, GASettings, adaptive_ga, bits_for_precision
@@ -59,7 +60,8 @@ class HaltMotion:
     settings
         The solver's settings (grid size, GA settings, ...).
     seed
-        Seed of a stochastic solver (GA), else None.
+        Seed the GA ran with (solver ``"ga"``; the fresh one drawn for ``rng=None``), else None
+        (a deterministic solver, an infeasible problem, or a ``Generator`` passed as ``rng``).
     problem
         The :class:`HaltProblem` solved.
     ga
@@ -77,7 +79,7 @@ class HaltMotion:
     minimum_T: float | None
     solver: str
     settings: dict
-    seed: Any
+    seed: int | None
     problem: HaltProblem = field(repr=False)
     ga: GAResult | None = field(default=None, repr=False)
 
@@ -194,7 +196,7 @@ def _solve_ga(
     hi: float,
     ga_settings: GASettings | None,
     ga_precision: float | None,
-    rng: int | np.random.Generator | None,
+    rng: int | np.random.Generator,
     progress: Any,
 ) -> tuple[GAResult, GASettings]:
     """000's adaptive GA on ``[lo, hi]`` with fitness ``1 / tau_bar`` (eq. 35), and the
@@ -277,7 +279,10 @@ def optimal_halt_motion(
         GA settings; ``ga_precision`` [rad/s^6] sets the bits per gene (default: 1/1000 of
         the interval, 10 bits).
     rng
-        Seed or generator for the GA (recorded in the result).
+        Seed (int >= 0) or ``numpy.random.Generator`` of the GA (:mod:`jointlock._random`);
+        ``None`` draws a fresh seed.  The GA's seed is recorded in ``seed``; checked whatever
+        the solver (a bad value raises :class:`~jointlock.errors.ConfigurationError`), used
+        only by ``"ga"``.
     on_infeasible
         ``"report"``: return a result with ``feasible=False``, the least-violating ``k``, the
         violations and the smallest feasible ``T``; ``"raise"``: raise
@@ -294,6 +299,7 @@ def optimal_halt_motion(
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 1:
         raise ScenarioError(f"n_scan must be an integer >= 1 (grid points of the scan); got {n_scan!r}")
     bounds_k = _check_k_bounds(k_bounds)
+    rng = resolve_seed(rng)  # None -> a fresh int seed, recorded by the GA
     per = feasible_k_intervals(problem)
     lo, hi = _search_interval(per, bounds_k)
     tau0 = float(global_base_torque(problem, 0.0))
