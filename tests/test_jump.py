@@ -22,7 +22,7 @@ from jointlock.planning.jump import (
     fit_pieces,
     jump_reduction,
     jump_table,
-    load_scenario,
+    load_jump_task,
     ramp_schedule,
     scenario_from_mapping,
     search_kappa,
@@ -202,9 +202,9 @@ def test_deterministic(arm):
 def test_scenario_file_and_errors(tmp_path):
     f = tmp_path / "s.toml"
     f.write_text("q0_deg = [0, 30, -60, 90, -60, 30, 0]\ndx_m = [0.5, 0, 0]\nduration_s = 6.0\nkp = 1.5\n")
-    sc = load_scenario(f)
+    sc = load_jump_task(f)
     assert sc.duration == 6.0 and sc.kp == 1.5 and sc.q0[1] == pytest.approx(math.radians(30))
-    assert sc == load_scenario(f)
+    assert sc == load_jump_task(f)
     with pytest.raises(jl.ScenarioError, match="did you mean 'duration_s'"):
         scenario_from_mapping({"duraton_s": 3.0})
     with pytest.raises(jl.ScenarioError, match="'kp' must be a number"):
@@ -364,13 +364,13 @@ def test_reduction_is_undefined_without_a_jump(arm):
     np.testing.assert_array_equal(jump_reduction([1.0, 0.0], [0.5, 0.0]), [0.5, np.nan])
 
 
-def test_load_scenario_unreadable_files(tmp_path):
+def test_load_jump_task_unreadable_files(tmp_path):
     with pytest.raises(jl.ScenarioError, match="cannot read scenario file .*: Is a directory"):
-        load_scenario(tmp_path)
+        load_jump_task(tmp_path)
     bad = tmp_path / "latin1.toml"
     bad.write_bytes("kp = 1.5 # \xe9\n".encode("latin-1"))
     with pytest.raises(jl.ScenarioError, match="is not UTF-8 text"):
-        load_scenario(bad)
+        load_jump_task(bad)
 
 
 # -- UX review: the default task on another robot, run-scenario files --------------------------------
@@ -381,20 +381,20 @@ def test_default_task_on_another_robot_says_where_q0_comes_from():
         jl.planning.jump.jump_table(jl.load_robot("puma6"))
 
 
-def test_load_scenario_refuses_a_run_scenario_file(tmp_path):
+def test_load_jump_task_refuses_a_run_scenario_file(tmp_path):
     from pathlib import Path
 
     example = Path(__file__).resolve().parents[1] / "examples" / "jump_001.toml"
     with pytest.raises(jl.ScenarioError) as err:
-        load_scenario(example)
+        load_jump_task(example)
     msg = str(err.value)
     assert "`jointlock run` scenario file" in msg and "[jump]" in msg and "unknown field" not in msg
     f = tmp_path / "task.toml"
     f.write_text('title = "x"\nq0_deg = [0, 0, 0, 0, 0, 0, 0]\n')
     with pytest.raises(jl.ScenarioError, match="title"):
-        load_scenario(f)
+        load_jump_task(f)
     f.write_text('q0_deg = [10, 40, -70, 100, -60, 30, 20]\nbase = "fixed"\n')  # a task file: fine
-    assert load_scenario(f).base == "fixed"
+    assert load_jump_task(f).base == "fixed"
 
 
 def test_kappa_unit_is_in_the_figures(tmp_path, monkeypatch):

@@ -5,6 +5,8 @@ from __future__ import annotations
 
 import json
 import math
+import tomllib
+import warnings
 from pathlib import Path
 
 import pytest
@@ -221,8 +223,10 @@ def test_every_field_has_a_meaning_in_the_schema_and_the_docs():
     for line in rows:
         cells = [c.strip() for c in line.replace("\\|", "/").strip("|").split("|")]
         assert cells[-1], line  # the "meaning" cell
-    assert "`limits.vmax_deg` is a speed **[deg/s]**" in doc
-    assert "`limits.amax_deg` an acceleration **[deg/s²]**" in doc
+    # one name per quantity: the limits' units are in their names, the former names documented
+    assert "`vmax_deg_s` **[deg/s]**" in doc and "`amax_deg_s2` **[deg/s²]**" in doc
+    assert "| `limits.vmax_deg` | `limits.vmax_deg_s` |" in doc
+    assert "| `limits.amax_deg` | `limits.amax_deg_s2` |" in doc
 
 
 def test_overrides_are_recorded_with_the_files_values(tmp_path):
@@ -233,3 +237,128 @@ def test_overrides_are_recorded_with_the_files_values(tmp_path):
     assert sc.overrides["seed"] == {"file": None, "value": 3}
     assert sc.failure_overridden()
     assert not load_scenario(path, {"failure.angle_deg": 59.4}).failure_overridden()  # same value
+
+
+# -- one name per quantity: former field names are deprecated aliases ------------------------
+
+LIMITS_HEAD = 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0\n[halt]\n'
+OLD_LIMITS = "[limits]\nvmax_deg = 30.0\namax_deg = 15.0\neps_m = 0.002\n"
+NEW_LIMITS = "[limits]\nvmax_deg_s = 30.0\namax_deg_s2 = 15.0\neps_m = 0.002\n"
+
+
+@pytest.fixture
+def fresh_warnings(monkeypatch):
+    """Forget which former names warned already (they warn once per process)."""
+    import jointlock.scenario._read as read
+
+    monkeypatch.setattr(read, "_WARNED", set())
+
+
+def former_name_warnings(record: list[warnings.WarningMessage]) -> list[str]:
+    return [str(w.message) for w in record if issubclass(w.category, FutureWarning)]
+
+
+def test_new_limit_names_resolve_to_the_same_keys(tmp_path, fresh_warnings):
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # the new names do not warn
+        sc = load_scenario(write(tmp_path, LIMITS_HEAD + NEW_LIMITS))
+    assert sc.data["limits"] == {"vmax_deg": 30.0, "amax_deg": 15.0, "eps_m": 0.002}
+
+
+def test_former_limit_names_work_and_warn_once(tmp_path, fresh_warnings):
+    new = load_scenario(write(tmp_path, LIMITS_HEAD + NEW_LIMITS, "new.toml"))
+    path = write(tmp_path, LIMITS_HEAD + OLD_LIMITS, "old.toml")
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")  # count every warning given, not Python's own once-filter
+        first = load_scenario(path)
+        second = load_scenario(path, {"limits.vmax_deg": 30.0})  # an override by the former name
+    assert first.data == second.data == new.data and first.jobs == new.jobs
+    assert list(first.data["limits"]) == list(new.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m"]
+    assert former_name_warnings(record) == [
+        f"{path}: limits.vmax_deg is deprecated: write limits.vmax_deg_s instead (the same quantity, "
+        "in deg/s); the old name still works for now",
+        f"{path}: limits.amax_deg is deprecated: write limits.amax_deg_s2 instead (the same quantity, "
+        "in deg/s^2); the old name still works for now",
+    ]
+    assert all(w.filename == __file__ for w in record)  # points at the caller, not the package
+
+
+def test_both_names_of_one_quantity_are_an_error(tmp_path, fresh_warnings):
+    path = write(tmp_path, LIMITS_HEAD + "[limits]\namax_deg_s2 = 15.0\namax_deg = 15.0\n")
+    with pytest.raises(ScenarioError) as err:
+        load_scenario(path)
+    msg = str(err.value)
+    assert str(path) in msg and "[limits]" in msg and "'amax_deg_s2'" in msg and "'amax_deg'" in msg
+    ok = write(tmp_path, LIMITS_HEAD + NEW_LIMITS, "ok.toml")
+    with pytest.raises(ScenarioError, match="'limits.vmax_deg' and 'limits.vmax_deg_s' set the same"):
+        load_scenario(ok, {"limits.vmax_deg": 1.0, "limits.vmax_deg_s": 2.0})
+
+
+@pytest.mark.parametrize("file_limits", [OLD_LIMITS, NEW_LIMITS])
+@pytest.mark.parametrize("key", ["limits.vmax_deg_s", "limits.vmax_deg"])
+def test_an_override_replaces_the_files_value_under_either_name(tmp_path, fresh_warnings, file_limits, key):
+    path = write(tmp_path, LIMITS_HEAD + file_limits)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", FutureWarning)
+        sc = load_scenario(path, {key: 12.5})
+    assert sc.data["limits"] == {"vmax_deg": 12.5, "amax_deg": 15.0, "eps_m": 0.002}
+    assert list(sc.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m"]  # the file's order
+    assert sc.overrides == {key: {"file": 30.0, "value": 12.5}}
+
+
+def test_limit_names_in_errors_and_hints(tmp_path, fresh_warnings):
+    cases = [
+        (
+            "[limits]\nvmax_dg = 1\n",
+            ["[limits]", "'vmax_dg'", "did you mean 'vmax_deg_s'", "allowed: vmax_deg_s, amax_deg_s2, eps_m"],
+        ),
+        ("[limits]\namax_deg_s2 = -1\n", ["limits.amax_deg_s2 must be a finite number > 0 [deg/s^2]"]),
+        ("[limits]\nvmax_deg = -1\n", ["limits.vmax_deg must be a finite number > 0 [deg/s]"]),
+        ("[jump]\nvmax_deg = 1\n", ["[jump] unknown field 'vmax_deg'", "did you mean 'vmax_deg_s'"]),
+    ]
+    for i, (table, words) in enumerate(cases):
+        path = write(tmp_path, 'robot = "canadarm7"\n' + table, f"c{i}.toml")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", FutureWarning)
+            with pytest.raises(ScenarioError) as err:
+                load_scenario(path)
+        for w in words:
+            assert w in str(err.value), (w, str(err.value))
+    top = write(tmp_path, 'robot = "halt7"\namax_deg = 1\n[workspace]\n', "top.toml")
+    with pytest.raises(ScenarioError, match=r"unknown key 'amax_deg' \(it belongs in \[limits\]\)"):
+        load_scenario(top)
+
+
+def test_examples_use_the_current_names(fresh_warnings):
+    from jointlock.scenario import DEPRECATED_FIELDS
+
+    for path in sorted(EXAMPLES.glob("*.toml")):
+        raw = tomllib.loads(path.read_text())
+        for table, former in DEPRECATED_FIELDS.items():
+            assert not set(raw.get(table, {})) & set(former), path
+        with warnings.catch_warnings():
+            warnings.simplefilter("error")
+            load_scenario(path)
+
+
+# -- two readers, two names: jump task files are read by load_jump_task ----------------------
+
+
+def test_load_jump_task_and_its_former_name(tmp_path, monkeypatch):
+    import jointlock.planning.jump._task as task
+    from jointlock.planning.jump import load_jump_task
+    from jointlock.planning.jump import load_scenario as former
+
+    monkeypatch.setattr(task, "_warned_load_scenario", False)
+    f = write(tmp_path, "q0_deg = [0, 30, -60, 90, -60, 30, 0]\ndx_m = [0.5, 0, 0]\nduration_s = 6.0\n")
+    with warnings.catch_warnings(record=True) as record:
+        warnings.simplefilter("always")
+        assert former(f) == load_jump_task(f) == former(f)
+    assert former_name_warnings(record) == [
+        "jointlock.planning.jump.load_scenario is deprecated: use jointlock.planning.jump.load_jump_task "
+        "(the same jump task-file reader; jointlock.load_scenario reads `jointlock run` scenario files)"
+    ]
+    assert record[0].filename == __file__
+    import jointlock.planning.jump as jump
+
+    assert "load_jump_task" in jump.__all__ and "load_scenario" not in jump.__all__

@@ -97,9 +97,10 @@ from ._simulate import _limit_report as _limit_report
 from ._simulate import _table as _table
 from ._study import JumpAtTime, JumpStudy, jump_at_time, study_jump
 from ._task import _RUN_SCENARIO_KEYS as _RUN_SCENARIO_KEYS
-from ._task import SCENARIO_FIELDS, Base, JumpScenario, load_scenario, scenario_from_mapping
+from ._task import SCENARIO_FIELDS, Base, JumpScenario, load_jump_task, scenario_from_mapping
 from ._task import _is_number as _is_number
 from ._task import _refuse_run_scenario as _refuse_run_scenario
+from ._task import load_scenario as load_scenario  # deprecated alias of load_jump_task
 from ._verify import Verification, feasible_band, ramp_schedule, verify_kappa
 from ._verify import _step_limits as _step_limits
 
@@ -128,7 +129,7 @@ __all__ = [
     "jump_at_time",
     "jump_reduction",
     "jump_table",
-    "load_scenario",
+    "load_jump_task",
     "merge_searches",
     "ramp_schedule",
     "sample_failure_times",

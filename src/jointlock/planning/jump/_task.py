@@ -1,9 +1,12 @@
-"""The jump task (:class:`JumpScenario`) and the task-file reader (flat TOML table)."""
+"""The jump task (:class:`JumpScenario`) and the task-file reader (flat TOML table):
+:func:`load_jump_task` (formerly ``load_scenario``, a name it shared with
+:func:`jointlock.scenario.load_scenario`, the reader of ``jointlock run`` scenario files)."""
 
 from __future__ import annotations
 
 import difflib
 import math
+import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -203,8 +206,12 @@ def scenario_from_mapping(data: Mapping[str, Any], *, source: str = "scenario") 
     return JumpScenario(**kwargs)
 
 
-def load_scenario(path: str | Path) -> JumpScenario:
-    """Read a scenario TOML file (flat table, fields of :data:`SCENARIO_FIELDS`)."""
+def load_jump_task(path: str | Path) -> JumpScenario:
+    """Read a jump task file: a flat TOML table, the fields of :data:`SCENARIO_FIELDS`.
+
+    Not a ``jointlock run`` scenario file (tables such as ``[jump]``): those are read by
+    :func:`jointlock.scenario.load_scenario`, and refused here with a message saying so.
+    """
     try:
         import tomllib
     except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
@@ -223,6 +230,25 @@ def load_scenario(path: str | Path) -> JumpScenario:
         raise ScenarioError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
     _refuse_run_scenario(data, str(path))
     return scenario_from_mapping(data, source=str(path))
+
+
+#: Whether the deprecated :func:`load_scenario` has warned in this process (it warns once).
+_warned_load_scenario = False
+
+
+def load_scenario(path: str | Path) -> JumpScenario:
+    """Deprecated alias of :func:`load_jump_task` (warns once per process, ``FutureWarning``)."""
+    global _warned_load_scenario
+    if not _warned_load_scenario:
+        _warned_load_scenario = True
+        warnings.warn(
+            "jointlock.planning.jump.load_scenario is deprecated: use jointlock.planning.jump."
+            "load_jump_task (the same jump task-file reader; jointlock.load_scenario reads "
+            "`jointlock run` scenario files)",
+            FutureWarning,
+            stacklevel=2,
+        )
+    return load_jump_task(path)
 
 
 #: Top-level keys of a ``jointlock run`` scenario file that a jump task file never has.

@@ -1,0 +1,195 @@
+"""Cross-field checks of a scenario: bases, the robot file, the failure, joint vectors, jobs."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+from ..errors import JointlockError, ScenarioError
+from ..robots import BUILTIN_ROBOTS
+from ._defaults import _defaults_000
+from ._fields import _BASE2, NEEDS_LOCK, _hint
+from ._jump import _check_jump
+
+
+def _inherit_singular_base(out: dict[str, Any], jobs: tuple[str, ...], *, given_base: bool) -> None:
+    """``singular.base`` falls back to the top-level ``base`` when the file gives one, as every
+    other job's base does (with ``verify_conditions``, a floating base is analysed on 004's
+    virtual manipulator, the free-floating arm's equivalent).  Without either, the ``singular``
+    command's own default holds (virtual with ``verify_conditions``, fixed otherwise)."""
+    if "singular" not in jobs or not given_base:
+        return
+    s = out["singular"]
+    if s["base"] is None:
+        top = out["base"]
+        s["base"] = "virtual" if top == "floating" and s["verify_conditions"] else top
+
+
+def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
+    name = out["robot"]
+    if name in BUILTIN_ROBOTS:
+        return
+    suffix = Path(name).suffix.lower()
+    if suffix not in (".toml", ".urdf"):
+        raise ScenarioError(
+            f"{source}: robot must be a built-in name ({', '.join(BUILTIN_ROBOTS)}) or a .toml/.urdf "
+            f"model file; got {name!r}{_hint(name, BUILTIN_ROBOTS)}"
+        )
+    path = Path(name)
+    if not path.is_absolute():
+        path = (base_dir / path).resolve()
+    if not path.is_file():
+        raise ScenarioError(f"{source}: robot: model file {name!r} not found (looked for {path})")
+    out["robot"] = str(path)
+
+
+def _load(out: dict[str, Any], base: str, source: str, cache: dict) -> Any:
+    from ..robots import load_robot
+
+    key = (out["robot"], base)
+    if key not in cache:
+        try:
+            cache[key] = load_robot(out["robot"], base=base)  # type: ignore[arg-type]
+        except JointlockError as exc:
+            field = "base" if base == "floating" and "base" in str(exc) else "robot"
+            raise ScenarioError(
+                f"{source}: {field}: cannot load {out['robot']!r} ({base} base): {exc}"
+            ) from None
+        except Exception as exc:  # a reader failing on a malformed file it did not anticipate
+            raise ScenarioError(
+                f"{source}: robot: malformed model file {out['robot']!r}: {type(exc).__name__}: {exc}"
+            ) from None
+    return cache[key]
+
+
+def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) -> None:
+    """Cross-field checks of ``out`` (in place: a few defaults depend on other fields).
+
+    Over 100 lines: one flat list of independent rules, each a few lines, in the order the
+    tables appear; splitting it would scatter the rules without making any of them simpler.
+    """
+    from ..locking import lock
+
+    cache: dict = {}
+    model = _load(out, out["base"], source, cache)
+    for job in jobs:
+        b = out[job].get("base")
+        if b in _BASE2:
+            _load(out, b, source, cache)
+    fail = out["failure"]
+    n = model.dof
+    if fail["joint"] is not None and not 1 <= fail["joint"] <= n:
+        raise ScenarioError(
+            f"{source}: failure.joint must be a joint number 1..{n} of {model.name}; got {fail['joint']}"
+        )
+    if fail["angle_deg"] is not None and fail["joint"] is None:
+        raise ScenarioError(f"{source}: failure.angle_deg needs failure.joint (the joint that locks, 1..{n})")
+    if fail["joint"] is not None and fail["angle_deg"] is None and set(jobs) - {"jump"}:
+        raise ScenarioError(
+            f"{source}: failure.joint needs failure.angle_deg (the locked angle [deg]); only [jump] "
+            "works without it"
+        )
+    for job in jobs:
+        if job in NEEDS_LOCK and fail["angle_deg"] is None:
+            raise ScenarioError(
+                f"{source}: job [{job}] needs the failure: set failure.joint (1..{n}) and failure.angle_deg"
+            )
+    locked = None
+    if fail["joint"] is not None and fail["angle_deg"] is not None:
+        locked = lock(model, fail["joint"], math.radians(fail["angle_deg"]))
+    _defaults_000(out, jobs, model)
+
+    def vector(
+        where: str, values: list[float] | None, *, full_only: bool = False, rates: bool = False
+    ) -> None:
+        """Check a joint vector's length; with every joint given (and a lock), the locked
+        joint's entry must equal its lock angle (angles) or be 0 (``rates``: rates and
+        accelerations, as a locked joint does not move)."""
+        if values is None:
+            return
+        sizes = {n} if full_only or locked is None else {locked.dof, n}
+        if len(values) not in sizes:
+            want = " or ".join(str(s) for s in sorted(sizes))
+            what = (
+                "every joint of the arm" if full_only or locked is None else "healthy joints, or every joint"
+            )
+            raise ScenarioError(
+                f"{source}: {where} needs {want} values ({what} of {model.name}); got {len(values)}"
+            )
+        if locked is not None and not full_only and len(values) == n:
+            j = fail["joint"] - 1
+            if rates:
+                if not math.isclose(values[j], 0.0, abs_tol=1e-9):
+                    raise ScenarioError(
+                        f"{source}: {where}: entry {j + 1} (the locked joint) must be 0, as a locked "
+                        f"joint does not move; got {values[j]:g} (or give only the healthy joints)"
+                    )
+                return
+            if not math.isclose(values[j], fail["angle_deg"], abs_tol=1e-9):
+                raise ScenarioError(
+                    f"{source}: {where}: entry {j + 1} (the locked joint) must equal failure.angle_deg = "
+                    f"{fail['angle_deg']:g}; got {values[j]:g} (or give only the healthy joints)"
+                )
+
+    for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
+        vector(f"state.{key}", out["state"][key], rates=key != "q0_deg")
+    if "halt" in jobs:
+        h = out["halt"]
+        vector("halt.qf_deg", h["qf_deg"])
+        if h["paper_qf"] and h["qf_deg"] is not None:
+            raise ScenarioError(f"{source}: halt.paper_qf and halt.qf_deg exclude each other; give one")
+        if h["paper_qf"] and model.name != "halt7":
+            raise ScenarioError(f"{source}: halt.paper_qf is 000's q_best for halt7 only; give halt.qf_deg")
+        if h["n_samples"] % 2 == 0:
+            raise ScenarioError(
+                f"{source}: halt.n_samples must be odd (Simpson's rule); got {h['n_samples']}"
+            )
+        for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
+            if out["state"][key] is None:
+                raise ScenarioError(f"{source}: job [halt] needs state.{key} (the state at failure)")
+        if h["T"] is None:
+            raise ScenarioError(f"{source}: job [halt] needs halt.T (halt time [s], 000: 10)")
+    if "halt_config" in jobs and out["halt_config"]["reachable"] is None:
+        hc = out["halt_config"]
+        has_time = hc["halt_time"] is not None or out.get("halt", {}).get("T") is not None
+        hc["reachable"] = out["state"]["q0_deg"] is not None and has_time
+    if "halt_config" in jobs and out["halt_config"]["reachable"]:
+        hc = out["halt_config"]
+        if out["state"]["q0_deg"] is None:
+            raise ScenarioError(f"{source}: halt_config.reachable needs state.q0_deg")
+        if hc["halt_time"] is None and out.get("halt", {}).get("T") is None:
+            raise ScenarioError(f"{source}: halt_config.reachable needs halt_config.halt_time or halt.T")
+    if "jump" in jobs:
+        _check_jump(out, source, model)
+    if "tolerance_angle" in jobs:
+        t = out["tolerance_angle"]
+        if t["q_target_deg"] is None:
+            raise ScenarioError(
+                f"{source}: job [tolerance_angle] needs tolerance_angle.q_target_deg ({n} values)"
+            )
+        vector("tolerance_angle.q_target_deg", t["q_target_deg"], full_only=True)
+    if "replan" in jobs:
+        r = out["replan"]
+        for key in ("from_deg", "to_deg"):
+            if r[key] is None:
+                raise ScenarioError(f"{source}: job [replan] needs replan.{key} ({n} values)")
+            vector(f"replan.{key}", r[key], full_only=True)
+    if "singular" in jobs:
+        s = out["singular"]
+        if s["verify_conditions"] and s["search"]:
+            raise ScenarioError(
+                f"{source}: singular.verify_conditions and singular.search exclude each other"
+            )
+        if s["verify_conditions"] and s["base"] == "floating":
+            raise ScenarioError(
+                f"{source}: singular.verify_conditions needs base 'virtual' or 'fixed'; got 'floating'"
+            )
+        if s["verify_conditions"] and locked is not None:
+            raise ScenarioError(
+                f"{source}: singular.verify_conditions analyses the whole 7-joint arm; remove [failure] "
+                "or set verify_conditions = false"
+            )
+        if s["base"] in (None, "virtual") and (s["verify_conditions"] or s["base"] == "virtual"):
+            _load(out, "floating", source, cache)
+        vector("singular.q_deg", s["q_deg"])

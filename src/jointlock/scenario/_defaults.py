@@ -1,0 +1,22 @@
+"""000's defaults: halt7 with joint 4 locked gets 000 §5.2's state, limits and halt time."""
+
+from __future__ import annotations
+
+from typing import Any
+
+
+def _defaults_000(out: dict[str, Any], jobs: tuple[str, ...], model: Any) -> None:
+    """halt7 with joint 4 locked: 000 §5's state and limits where the file gives none."""
+    fail = out["failure"]
+    if model.name != "halt7" or fail["joint"] != 4 or not ({"halt", "halt_config"} & set(jobs)):
+        return
+    from ..papers.p000 import SCENARIO as PAPER_SCENARIO
+
+    for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
+        if out["state"][key] is None:
+            out["state"][key] = list(PAPER_SCENARIO[key])
+    for key in ("vmax_deg", "amax_deg"):
+        if out["limits"][key] is None:
+            out["limits"][key] = PAPER_SCENARIO[key]
+    if "halt" in jobs and out["halt"]["T"] is None:
+        out["halt"]["T"] = PAPER_SCENARIO["T"]

@@ -1,0 +1,309 @@
+"""The scenario schema: jobs, field specifications and the tables of a scenario file."""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+#: Jobs a scenario can run, in the order they run (a halt uses the halt configuration found
+#: before it).
+JOB_ORDER: tuple[str, ...] = (
+    "halt_config",
+    "halt",
+    "jump",
+    "tolerance_angle",
+    "replan",
+    "workspace",
+    "singular",
+)
+
+#: Which seed paper each job implements (for reports).
+JOB_PAPER: dict[str, str] = {
+    "halt_config": "000 §3 (HCOM)",
+    "halt": "000 §4 (HMOM)",
+    "jump": "001 (NOTES-001)",
+    "tolerance_angle": "002 (tolerance angle)",
+    "replan": "002 (re-planning)",
+    "workspace": "002 (workspace)",
+    "singular": "004 (singularity)",
+}
+
+#: Largest |angle| accepted in an ``*_deg`` field [deg] (one turn either way).
+MAX_ABS_DEG = 360.0
+
+#: Fewest ``workspace.samples`` (:data:`jointlock.analysis.workspace.MIN_SAMPLES`).
+WORKSPACE_MIN_SAMPLES = 1000
+
+
+@dataclass(frozen=True)
+class Field:
+    """Schema of one scenario field.
+
+    ``kind``: ``"int"``, ``"number"``, ``"bool"``, ``"str"``, ``"choice"``, ``"numbers"``
+    (list of numbers), ``"strings"`` (list of choices).  ``lo``/``hi`` bound numbers
+    (``lo_open``: strictly greater); ``choices`` lists allowed strings.
+    """
+
+    kind: str
+    default: Any = None
+    lo: float | None = None
+    hi: float | None = None
+    lo_open: bool = False
+    choices: tuple[str, ...] = ()
+    length: int | None = None
+    unit: str = ""
+    help: str = ""
+
+    def allowed(self) -> str:
+        """What the field accepts, in words."""
+        unit = f" [{self.unit}]" if self.unit else ""
+        if self.kind == "bool":
+            return "true or false"
+        if self.kind == "str":
+            return "a string" + unit
+        if self.kind in ("choice", "strings"):
+            opts = ", ".join(repr(c) for c in self.choices)
+            return ("one of " if self.kind == "choice" else "a list of ") + opts
+        what = {"int": "an integer", "number": "a finite number", "numbers": "a list of finite numbers"}[
+            self.kind
+        ]
+        if self.length is not None:
+            what = f"a list of {self.length} finite numbers"
+        rng = []
+        if self.lo is not None:
+            rng.append(f"{'>' if self.lo_open else '>='} {self.lo:g}")
+        if self.hi is not None:
+            rng.append(f"<= {self.hi:g}")
+        each = " each" if self.kind == "numbers" else ""
+        return what + (f"{each} " + " and ".join(rng) if rng else "") + unit
+
+
+def _deg(help_: str, *, unit: str = "deg", lo: float = -MAX_ABS_DEG, hi: float = MAX_ABS_DEG) -> Field:
+    return Field("numbers", lo=lo, hi=hi, unit=unit, help=help_)
+
+
+def _pos(unit: str, help_: str, default: Any = None) -> Field:
+    return Field("number", default, lo=0.0, lo_open=True, unit=unit, help=help_)
+
+
+#: Top-level scalar fields.
+TOP_FIELDS: dict[str, Field] = {
+    "title": Field("str", "", help="a title for the report"),
+    "description": Field("str", "", help="free text shown in the report"),
+    "robot": Field("str", None, help="built-in name or model file (.toml DH table, .urdf)"),
+    "base": Field("choice", "fixed", choices=("fixed", "floating"), help="spacecraft held or free-floating"),
+    "seed": Field("int", 0, lo=0, help="seed of every stochastic job (Monte Carlo, GA)"),
+    "out": Field("str", None, help="output folder (default: <scenario name>-results); --out overrides"),
+    "jobs": Field("strings", None, choices=JOB_ORDER, help="jobs to run (default: every job table given)"),
+}
+
+#: Tables shared by the jobs.
+SHARED_TABLES: dict[str, dict[str, Field]] = {
+    "failure": {
+        "joint": Field("int", None, lo=1, help="the joint that locks, numbered from 1"),
+        "angle_deg": Field(
+            "number", None, lo=-MAX_ABS_DEG, hi=MAX_ABS_DEG, unit="deg", help="angle it locks at"
+        ),
+        "time_s": Field("number", None, lo=0.0, unit="s", help="time it locks during a task (jump)"),
+    },
+    "state": {
+        "q0_deg": _deg("angles at failure (healthy joints, or the full arm)"),
+        "dq0_deg": _deg("rates at failure", unit="deg/s", lo=-1e4, hi=1e4),
+        "ddq0_deg": _deg("accelerations at failure", unit="deg/s^2", lo=-1e5, hi=1e5),
+    },
+    "limits": {
+        "vmax_deg_s": _pos("deg/s", "joint speed limit (halt, halt_config, jump); formerly vmax_deg"),
+        "amax_deg_s2": _pos(
+            "deg/s^2", "joint acceleration limit (halt, halt_config, jump); formerly amax_deg"
+        ),
+        "eps_m": _pos("m", "end-effector position-deviation threshold (jump)"),
+    },
+}
+
+_BASE2 = ("fixed", "floating")
+
+#: Job tables: field name (as the CLI option, dashes -> underscores) -> schema.
+JOB_TABLES: dict[str, dict[str, Field]] = {
+    "halt_config": {
+        "samples": Field("int", 36000, lo=2, hi=5_000_000, help="Monte Carlo samples K (000: 36000)"),
+        "jacobian": Field(
+            "choice",
+            "generalized",
+            choices=("generalized", "fixed"),
+            help="Jacobian of the indices: 000's generalized J_F (free-floating; differs from fixed "
+            "only with base 'floating') or the fixed-base one",
+        ),
+        "assignment": Field(
+            "choice",
+            "equation",
+            choices=("equation", "text"),
+            help="which index gets AHP weight 1/2: the condition number (000 eq. 19) or the "
+            "manipulability (000 §5.1 text)",
+        ),
+        "renormalize": Field(
+            "bool", False, help="divide the combined weights by their sum (000 eq. 18 does not)"
+        ),
+        "length": _pos("m", "characteristic length dividing the linear rows"),
+        "no_refine": Field("bool", False, help="plain Monte Carlo, as 000"),
+        "reachable": Field(
+            "bool",
+            None,
+            help="require the halt configuration to be reachable by the halt polynomial from [state] "
+            "within halt.T (or halt_time) under the limits; default: yes when the state and a halt "
+            "time are given",
+        ),
+        "halt_time": _pos("s", "halt time of the reachability bound (default: halt.T)"),
+        "base": Field("choice", None, choices=_BASE2, help="base of this job (default: the top-level base)"),
+    },
+    "halt": {
+        "T": _pos("s", "halt time (000: 10)"),
+        "qf_deg": _deg("halt configuration (default: from halt_config, or a Monte Carlo search)"),
+        "paper_qf": Field("bool", False, help="000's printed q_best (halt7 only)"),
+        "solver": Field(
+            "choice",
+            "scan",
+            choices=("scan", "ga", "vector"),
+            help="scan: exact search of the shared k; ga: 000's adaptive GA; vector: one k per "
+            "joint (extension)",
+        ),
+        "samples": Field("int", 36000, lo=2, hi=5_000_000, help="Monte Carlo samples when no halt_config"),
+        "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
+        "generations": Field("int", 100, lo=1, hi=100_000, help="GA generations"),
+        "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
+        "base": Field(
+            "choice",
+            None,
+            choices=_BASE2,
+            help="base of the disturbance torque: 'fixed' = spacecraft held, as 000 (default: the "
+            "top-level base)",
+        ),
+    },
+    "jump": {
+        "fail_at": Field("number", None, lo=0.0, unit="s", help="one failure time (default failure.time_s)"),
+        "sweep": Field("int", None, lo=1, hi=10_000, help="sampled failure times (default 40)"),
+        "kappa": Field("number", None, unit="rad^2/(s m^3)", help="constant kappa instead of the search"),
+        "order": Field("int", 5, lo=1, hi=9, help="polynomial order of kappa(t)"),
+        "fix": Field(
+            "choice",
+            "auto",
+            choices=("auto", "clip", "ramp", "clip+ramp", "none"),
+            help="fix of kappa(t) verified as well: clip to the feasible band, ramp (rate-limit "
+            "kappa), both, none; auto = clip+ramp only when kappa(t) breaks a limit",
+        ),
+        "q0_deg": _deg("task start, every joint of the arm"),
+        "dx_m": Field(
+            "numbers", None, lo=-1e3, hi=1e3, length=3, unit="m", help="straight-line displacement"
+        ),
+        "duration_s": _pos("s", "task time"),
+        "blend_s": _pos("s", "parabolic blend time"),
+        "dt_s": _pos("s", "control step"),
+        "vmax_deg_s": _pos("deg/s", "joint speed limit (default limits.vmax_deg_s, else 10)"),
+        "amax_deg_s2": _pos("deg/s^2", "joint acceleration limit (default limits.amax_deg_s2, else 5)"),
+        "eps_m": _pos("m", "position-deviation threshold (default limits.eps_m, else 0.001)"),
+        "kp": Field("number", None, lo=0.0, unit="1/s", help="feedback gain"),
+        "rest_transitions": Field(
+            "bool", None, help="also check the start from rest and the stop at the end (default false)"
+        ),
+        "feedforward": Field(
+            "choice",
+            None,
+            choices=("step", "instant"),
+            help="feed-forward over a control step: nominal displacement / dt (step, default) or "
+            "the nominal velocity at the step's start (instant)",
+        ),
+        "base": Field("choice", None, choices=_BASE2, help="base of this job (default: the top-level base)"),
+    },
+    "tolerance_angle": {
+        "q_target_deg": _deg("desired joints, every joint of the arm"),
+        "gamma_limit_deg": Field(
+            "number", 180.0, lo=0.0, lo_open=True, hi=180.0, unit="deg", help="sweep |gamma| <= this"
+        ),
+        "zoom_deg": Field(
+            "number",
+            2.0,
+            lo=0.0,
+            lo_open=True,
+            hi=180.0,
+            unit="deg",
+            help="half-width of the second, narrow gamma range (002 Fig. 6: 2)",
+        ),
+        "step_deg": Field("number", 0.1, lo=0.0, lo_open=True, hi=180.0, unit="deg", help="gamma sweep step"),
+    },
+    "replan": {
+        "from_deg": _deg("start joints, every joint of the arm"),
+        "to_deg": _deg("goal joints, every joint of the arm"),
+        "steps": Field("int", 40, lo=1, hi=100_000, help="interior points N of 002 eq. (19)"),
+        "cycle": _pos("s", "time between points (002: 0.25)", 0.25),
+        "tolerance_deg": Field("number", 0.0, lo=0.0, hi=180.0, unit="deg", help="largest |gamma|"),
+    },
+    "workspace": {
+        "samples": Field(
+            "int",
+            200_000,
+            lo=WORKSPACE_MIN_SAMPLES,
+            hi=20_000_000,
+            help="configurations per arm (fewer than 1000 say little about a volume)",
+        ),
+        "voxel": _pos("m", "voxel side (default automatic)"),
+    },
+    "singular": {
+        "verify_conditions": Field("bool", False, help="check 004's Cond1-Cond5"),
+        "search": Field("bool", False, help="search for singular configurations"),
+        "base": Field(
+            "choice",
+            None,
+            choices=("fixed", "floating", "virtual"),
+            help="Jacobian: fixed, floating (generalized) or virtual (004's virtual manipulator); "
+            "default: the top-level base if given (floating -> virtual with verify_conditions), "
+            "else virtual with verify_conditions and fixed otherwise",
+        ),
+        "weighting": Field(
+            "choice",
+            "segment",
+            choices=("segment", "vafa-dubowsky"),
+            help="virtual link lengths: 004's formula (segment) or the exact Vafa-Dubowsky one",
+        ),
+        "q_deg": _deg("configuration analysed (default zeros)"),
+        "tol": _pos("", "rank tolerance on singular values", 1e-8),
+        "length": _pos("m", "characteristic length"),
+        "samples": Field("int", None, lo=1, hi=1_000_000, help="samples per condition / search starts"),
+    },
+}
+
+#: Jobs that need ``[failure] joint`` and ``angle_deg``.
+NEEDS_LOCK = ("halt_config", "halt", "tolerance_angle", "replan")
+
+ALL_TABLES: dict[str, dict[str, Field]] = {**SHARED_TABLES, **JOB_TABLES}
+
+#: Former field names still read from files and overrides (table -> {old name: new name}): an
+#: old name works as the new one and warns once per process (``FutureWarning``); giving both
+#: names of one quantity is an error.  One name per quantity: ``[limits]`` now spells its rates
+#: as ``[jump]`` does.
+DEPRECATED_FIELDS: dict[str, dict[str, str]] = {
+    "limits": {"vmax_deg": "vmax_deg_s", "amax_deg": "amax_deg_s2"},
+}
+
+#: Fields stored under another key in :attr:`Scenario.data` (table -> {field: key}): the
+#: resolved limits keep the keys the jobs read (``data["limits"]["vmax_deg"]``).
+RESOLVED_KEYS: dict[str, dict[str, str]] = {
+    "limits": {"vmax_deg_s": "vmax_deg", "amax_deg_s2": "amax_deg"},
+}
+
+
+def _spellings(table: str, name: str) -> tuple[str, ...]:
+    """Every name of one field of ``table`` in a file: the current name, then its former ones."""
+    old = DEPRECATED_FIELDS.get(table, {})
+    new = old.get(name, name)
+    return (new, *(o for o, n in old.items() if n == new))
+
+
+def _hint(key: str, allowed: Sequence[str]) -> str:
+    close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.6)
+    if close:
+        return f" (did you mean {close[0]!r}?)"
+    owners = [t for t, fields in ALL_TABLES.items() if key in fields or key in DEPRECATED_FIELDS.get(t, {})]
+    if owners:
+        return f" (it belongs in [{owners[0]}])"
+    return ""

@@ -1,0 +1,61 @@
+"""The validated scenario (:class:`Scenario`): resolved plain data, its jobs and overrides."""
+
+from __future__ import annotations
+
+import copy
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """A validated scenario.
+
+    Attributes
+    ----------
+    data
+        The resolved scenario: every table with its defaults, file paths absolute; plain
+        data (str, int, float, bool, lists, dicts) in file units (degrees).
+    jobs
+        Jobs to run, in :data:`JOB_ORDER`.
+    source
+        The file it came from (or a label such as ``"built-in demo scenario"``).
+    overrides
+        The command-line overrides applied to the file: ``{"table.field": {"file": value in
+        the file or None, "value": value used}}`` (empty when none).
+    """
+
+    data: dict[str, Any]
+    jobs: tuple[str, ...]
+    source: str
+    base_dir: Path = field(default_factory=Path.cwd)
+    overrides: Mapping[str, Any] = field(default_factory=dict)
+
+    def failure_overridden(self) -> bool:
+        """Whether an override changed the file's failure (joint or angle)."""
+        return any(
+            key in ("failure.joint", "failure.angle_deg") and item["file"] != item["value"]
+            for key, item in self.overrides.items()
+        )
+
+    def to_dict(self) -> dict[str, Any]:
+        return copy.deepcopy(self.data) | {"jobs": list(self.jobs)}
+
+    def table(self, name: str) -> dict[str, Any]:
+        return dict(self.data.get(name, {}))
+
+    @property
+    def lock(self) -> tuple[int, float] | None:
+        """(joint number, angle [deg]) of the failure, or None."""
+        f = self.data.get("failure", {})
+        if f.get("joint") is None or f.get("angle_deg") is None:
+            return None
+        return int(f["joint"]), float(f["angle_deg"])
+
+
+def job_lock_args(scenario: Scenario) -> list[str]:
+    """``["--lock", "J=DEG"]`` for the failure, or ``[]``."""
+    lk = scenario.lock
+    return [] if lk is None else ["--lock", f"{lk[0]}={lk[1]!r}"]
