@@ -43,7 +43,7 @@ def test_jump_uses_the_scenario_files_base_unless_base_is_given(tmp_path, capsys
     out = jump_json(capsys, *common)
     assert out["scenario"]["base"] == "floating"
     model = jl.load_robot("canadarm7", base="floating")
-    sc = jl.planning.jump.load_scenario(f)
+    sc = jl.planning.jump.load_jump_task(f)
     ref = jl.planning.jump.jump_at_time(model, sc, 0.5, kappa=0.001)
     assert out["jump_after"] == pytest.approx(ref.jump_after, rel=1e-12)
     assert jump_json(capsys, *common, "--base", "fixed")["scenario"]["base"] == "fixed"

@@ -480,7 +480,7 @@ def test_halt_of_a_model_with_a_continuous_joint(capsys):
 
 
 def _figures(monkeypatch):
-    import jointlock.jobs.halt as halt_job  # HaltPlan.write renders its figures there
+    import jointlock.jobs.halt._result as halt_job  # HaltPlan.write renders its figures there
 
     figs = []
     real = halt_job.figure_png

@@ -21,7 +21,7 @@ from jointlock.jobs.jump import (
     task_as_the_command_reads_it,
 )
 from jointlock.planning.jump import JumpScenario
-from jointlock.planning.jump import load_scenario as load_task
+from jointlock.planning.jump import load_jump_task as load_task
 from jointlock.plots.jump import (
     plot_joint_rates,
     plot_jump_vs_failure_time,

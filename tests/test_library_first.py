@@ -17,6 +17,7 @@ import pytest
 
 import jointlock as jl
 from jointlock.cli import main
+from jointlock.ik import pose_from_zyx
 from jointlock.io.files import to_plain
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -162,3 +163,25 @@ def test_import_layer_contract_catches_an_upward_import(tmp_path):
     pytest.importorskip("importlinter")
     # kinematics imports model: with model placed above kinematics the contract must break
     assert _lint(tmp_path, ["jointlock.model", "jointlock.kinematics"]) != 0
+
+
+@pytest.mark.parametrize(
+    "argv, call",
+    [
+        (["kinematics", "halt7", "--lock", "4=0", "--q-deg", "-180", "-180", "-100", "-10", "20", "20"],
+         lambda: jl.describe_configuration(jl.lock(jl.load_robot("halt7"), 4, 0.0),
+                                           np.radians([-180, -180, -100, -10, 20, 20]))),
+        (["kinematics", "canadarm7", "--base", "floating"],
+         lambda: jl.describe_configuration(jl.load_robot("canadarm7", base="floating"))),
+        (["ik", "puma6", "--lock", "2=30", "--pose", "0.5", "0.3", "0.8", "10", "20", "30"],
+         lambda: jl.inverse_kinematics(jl.lock(jl.load_robot("puma6"), 2, np.radians(30.0)),
+                                       pose_from_zyx([0.5, 0.3, 0.8], np.radians([10, 20, 30])))),
+    ],
+)  # fmt: skip
+def test_kinematics_and_ik_jobs_are_their_commands(argv, call, capsys):
+    report = call()
+    assert main([*argv, "--json"]) == 0
+    assert to_plain(report.to_dict()) == json.loads(capsys.readouterr().out)
+    assert main(argv) == 0
+    assert report.summary() == capsys.readouterr().out.splitlines()
+    assert to_plain(pickle.loads(pickle.dumps(report)).to_dict()) == to_plain(report.to_dict())

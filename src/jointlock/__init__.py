@@ -96,6 +96,7 @@ _LAZY = {
         "study_workspace", "WorkspaceStudy",
         "study_singularity", "verify_singularity_conditions", "search_singularities",
         "ReproductionReport",
+        "describe_configuration", "KinematicsReport", "inverse_kinematics", "InverseKinematicsReport",
     )},  # fmt: skip
     "reproduce": "jointlock.jobs.reproduce",  # the function (jointlock.jobs.reproduce is its module)
     # scenarios in-process

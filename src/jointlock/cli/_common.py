@@ -9,12 +9,10 @@ import sys
 from pathlib import Path
 from typing import Any
 
-import numpy as np
-
 from ..errors import ScenarioError
 from ..io.files import json_text, write_png  # noqa: F401  (write_png re-exported)
 from ..io.files import to_plain as _plain  # noqa: F401  (old name)
-from ..jobs._common import joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
+from ..jobs._common import format_matrix, joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..robots import BUILTIN_ROBOTS, load_robot
@@ -139,12 +137,3 @@ def model_from_args(args: argparse.Namespace) -> ArmModel:
 def print_json(obj: Any) -> None:
     """Print one JSON object (non-finite floats become null)."""
     sys.stdout.write(json_text(obj))
-
-
-def format_matrix(mat: np.ndarray, fmt: str = "{:>11.5f}", col_labels: list[str] | None = None) -> str:
-    lines = []
-    if col_labels is not None:
-        lines.append(" ".join(f"{c:>11}" for c in col_labels))
-    for row in np.atleast_2d(mat):
-        lines.append(" ".join(fmt.format(v) for v in row))
-    return "\n".join(lines)

@@ -96,7 +96,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--seed", type=seed_arg, default=0, help="seed of the GA and the Monte Carlo search (default 0)"
     )
     p.add_argument(
-        "--samples", type=int, default=36000, help="Monte Carlo samples for the halt configuration"
+        "--samples", type=int, default=p000.SAMPLES, help="Monte Carlo samples for the halt configuration"
     )
     p.add_argument(
         "--no-reachability",

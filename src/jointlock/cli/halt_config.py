@@ -10,6 +10,7 @@ from pathlib import Path
 from ..errors import ScenarioError
 from ..jobs.halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
 from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, ReachabilitySettings, study_halt_configuration
+from ..papers import p000
 from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
 from .halt import LIMITS_HELP
 
@@ -27,7 +28,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     add_robot_arguments(p)
-    p.add_argument("--samples", type=int, default=36000, help="Monte Carlo samples K (default 36000, as 000)")
+    p.add_argument(
+        "--samples", type=int, default=p000.SAMPLES, help=f"Monte Carlo samples K (default {p000.SAMPLES}, as 000)"
+    )
     p.add_argument("--seed", type=seed_arg, default=None, help="random seed (default: fresh, printed)")
     p.add_argument(
         "--jacobian",

@@ -1,24 +1,16 @@
-"""``jointlock ik``: every inverse-kinematics branch of an arm, full or with a locked joint."""
+"""``jointlock ik``: every inverse-kinematics branch of an arm, full or with a locked joint
+(a thin shell over :func:`jointlock.jobs.ik.inverse_kinematics`)."""
 
 from __future__ import annotations
 
 import argparse
-import math
 
 import numpy as np
 
 from ..errors import ScenarioError
-from ..ik import pose_from_zyx, solve_ik, zyx_angles
-from ._common import (
-    add_robot_arguments,
-    format_matrix,
-    locked_deg,
-    locked_text,
-    model_from_args,
-    print_json,
-    require_finite,
-    seed_arg,
-)
+from ..ik import pose_from_zyx
+from ..jobs.ik import inverse_kinematics
+from ._common import add_robot_arguments, model_from_args, print_json, require_finite, seed_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -80,68 +72,17 @@ def _target(args: argparse.Namespace) -> np.ndarray:
     return mat
 
 
-def _solution(sol) -> dict:
-    return {
-        "branch": sol.branch,
-        "q_deg": np.degrees(sol.q_full),
-        "position_error_m": sol.position_error,
-        "rotation_error_deg": math.degrees(sol.rotation_error),
-        "exact": sol.exact,
-    }
-
-
 def run(args: argparse.Namespace) -> int:
     require_finite(args, "length_scale")
     if not args.length_scale > 0:
         raise ScenarioError(f"--length-scale must be > 0 [m]; got {args.length_scale}")
     model = model_from_args(args)
-    target = _target(args)
-    res = solve_ik(model, target, method=args.method, rng=args.seed, length_scale=args.length_scale)
-    out = {
-        "robot": model.name,
-        "locked": locked_deg(model),
-        "method": res.method,
-        "target": target,
-        "target_position_m": target[:3, 3],
-        "target_zyx_deg": np.degrees(zyx_angles(target[:3, :3])),
-        "reachable": res.reachable,
-        "solutions": [_solution(s) for s in res.solutions],
-        "candidates": [_solution(s) for s in res.candidates],
-        "nearest": None,
-    }
-    if res.nearest is not None:
-        near = res.nearest_pose
-        out["nearest"] = {
-            **_solution(res.nearest),
-            "pose": near,
-            "position_m": near[:3, 3],
-            "zyx_deg": np.degrees(zyx_angles(near[:3, :3])),
-            "distance_position_m": res.nearest.position_error,
-            "distance_rotation_deg": math.degrees(res.nearest.rotation_error),
-            "length_scale_m": res.length_scale,
-        }
+    report = inverse_kinematics(
+        model, _target(args), method=args.method, rng=args.seed, length_scale=args.length_scale
+    )
     if args.json:
-        print_json(out)
+        print_json(report.to_dict())
         return 0
-    locked = locked_text(out["locked"])
-    print(f"{model.name}: {res.method} IK, locked: {locked}")
-    print("target T_base_ee [m]:")
-    print(format_matrix(target, "{:>11.6f}"))
-    if res.reachable:
-        print(
-            f"\n{len(res.solutions)} solution(s), q [deg] (all joints), position error [m], rotation error [deg]:"
-        )
-        for s in res.solutions:
-            q = " ".join(f"{v:9.4f}" for v in np.degrees(s.q_full))
-            print(f"  branch {s.branch}: {q}   {s.position_error:.2e}  {math.degrees(s.rotation_error):.2e}")
-    else:
-        n = out["nearest"]
-        print("\nnot reachable by this arm" + (" with the locked joint" if model.locked else ""))
-        if n is not None:
-            print("nearest reachable pose [m]:")
-            print(format_matrix(n["pose"], "{:>11.6f}"))
-            print(
-                f"distance: {n['distance_position_m']:.6g} m, {n['distance_rotation_deg']:.6g} deg; "
-                "q [deg]: " + " ".join(f"{v:.4f}" for v in n["q_deg"])
-            )
+    for line in report.summary():
+        print(line)
     return 0

@@ -28,13 +28,15 @@ from ..jobs.jump import (  # noqa: F401  (KAPPA_UNIT, MAX_ORDER and the text hel
     _points_text,
     run_jump_study,
 )
-from ..planning.jump import JumpScenario, load_scenario, scenario_from_mapping
+from ..papers import p001
+from ..planning.jump import JumpScenario, scenario_from_mapping
+from ..planning.jump import load_jump_task as load_scenario
 from ..robots import load_robot
 from ._common import add_robot_arguments, check_out_dir, print_json, require_finite
 
 #: A start of the example task shown when a robot needs its own q0_deg (NOTES-001's start,
 #: cut or padded with zeros to the robot's joints).
-_EXAMPLE_Q0 = (10.0, 40.0, -70.0, 100.0, -60.0, 30.0, 20.0)
+_EXAMPLE_Q0 = p001.TASK["q0_deg"]
 
 
 def register(sub: argparse._SubParsersAction) -> None:

@@ -101,6 +101,7 @@ def _inertial(link: ET.Element) -> Body:
     return body.transformed(frame)
 
 
+# Over 100 lines: parse, walk the tree, merge fixed links and build share the link/joint maps.
 def read_urdf(
     source: str | Path,
     *,

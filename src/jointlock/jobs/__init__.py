@@ -17,6 +17,8 @@ workspace                   :func:`study_workspace`                             
 singular                    :func:`study_singularity`, :func:`verify_singularity_conditions`,
                             :func:`search_singularities`                        004
 reproduce                   :func:`reproduce` (every seed's headline figures)
+kinematics                  :func:`describe_configuration` (pose, Jacobian, σ)
+ik                          :func:`inverse_kinematics` (every branch, nearest)  002
 ==========================  ==================================================  =====
 
 The job modules are imported on first use.
@@ -46,6 +48,8 @@ _NAMES: dict[str, tuple[str, ...]] = {
         "SingularitySearchResult",
     ),
     "reproduce": ("reproduce", "ReproductionReport"),
+    "kinematics": ("describe_configuration", "KinematicsReport"),
+    "ik": ("inverse_kinematics", "InverseKinematicsReport"),
 }
 _WHERE = {name: module for module, names in _NAMES.items() for name in names}
 

@@ -103,3 +103,15 @@ def joint_vector_deg(
         f"{option} needs {model.dof} values (movable joints {list(model.joint_numbers)}) "
         f"[deg]; got {arr.size}"
     )
+
+
+def format_matrix(mat: np.ndarray, fmt: str = "{:>11.5f}", col_labels: list[str] | None = None) -> str:
+    """The rows of ``mat`` (one line each, every entry formatted with ``fmt``) under
+    right-aligned column labels 11 characters wide when ``col_labels`` is given: the matrix
+    layout the commands print."""
+    lines = []
+    if col_labels is not None:
+        lines.append(" ".join(f"{c:>11}" for c in col_labels))
+    for row in np.atleast_2d(mat):
+        lines.append(" ".join(fmt.format(v) for v in row))
+    return "\n".join(lines)

@@ -25,6 +25,7 @@ from ..errors import ConfigurationError
 from ..io.files import atomic_write_bytes, atomic_write_json, figure_png
 from ..locking import lock_joints
 from ..model import ArmModel
+from ..papers import p000
 from ..planning.halt_config import (
     HaltConfiguration,
     HaltReachability,
@@ -266,7 +267,7 @@ def _fmt_q(q: np.ndarray) -> str:
 def study_halt_configuration(
     model: ArmModel,
     *,
-    samples: int = 36000,
+    samples: int = p000.SAMPLES,
     rng: int | np.random.Generator | None = None,
     jacobian: JacobianKind = "generalized",
     assignment: Assignment = "equation",
@@ -287,7 +288,7 @@ def study_halt_configuration(
     model
         The arm after the lock (:func:`jointlock.lock`), with at least one locked joint.
     samples
-        Monte Carlo samples ``K`` (000: 36000), >= 2.
+        Monte Carlo samples ``K`` (000's, :data:`jointlock.papers.p000.SAMPLES`), >= 2.
     rng
         Seed or ``numpy.random.Generator``; None draws a fresh seed (recorded in the result).
     jacobian

@@ -19,6 +19,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from .._random import resolve_seed
 from ..analysis.workspace import (
     MIN_SAMPLES,
     MIN_SAMPLES_PER_VOXEL,
@@ -222,19 +223,6 @@ class WorkspaceStudy(JobResult):
         return files
 
 
-def _seed(rng: int | np.random.Generator | None) -> int | np.random.Generator:
-    """``rng`` as given when it is a seed or a Generator; None: a fresh seed (recorded)."""
-    if rng is None:
-        return int(np.random.SeedSequence().generate_state(1)[0])
-    if isinstance(rng, (int, np.integer)) and not isinstance(rng, bool):
-        if rng < 0:
-            raise ScenarioError(f"rng must be a seed >= 0 or a numpy Generator; got {rng}")
-        return int(rng)
-    if isinstance(rng, np.random.Generator):
-        return rng
-    raise ScenarioError(f"rng must be a seed >= 0, a numpy Generator or None; got {rng!r}")
-
-
 def study_workspace(
     model: ArmModel,
     locked: tuple[int, float] | None = None,
@@ -273,6 +261,8 @@ def study_workspace(
     ------
     ScenarioError
         A parameter out of range (the message names it).
+    ConfigurationError
+        ``rng`` is not None, an integer seed >= 0 or a numpy Generator.
     VoxelTooSmallError
         A given ``voxel`` holds too few samples for a meaningful volume.
     """
@@ -283,7 +273,7 @@ def study_workspace(
         )
     if voxel is not None and not (math.isfinite(voxel) and voxel > 0):
         raise ScenarioError(f"voxel must be a finite number > 0 [m]; got {voxel}")
-    seed = _seed(rng)
+    seed = resolve_seed(rng)  # None: a fresh seed, recorded in the result
     samples = int(samples)
     with Progress(1, "workspace", enabled=None if progress else False) as bar:
         if locked is not None:

@@ -10,6 +10,7 @@ one ``results.json`` (``robots``: the overview; ``jobs``, ``summary``, ``scenari
 
 from __future__ import annotations
 
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -20,7 +21,7 @@ from ..dynamics import mass_matrix
 from ..io.files import atomic_write_bytes, figure_png
 from ..kinematics import generalized_jacobian, jacobian, link_poses, virtual_link_vectors
 from ..locking import lock
-from ..papers import p000
+from ..papers import p000, p001
 from ..plots._common import offscreen_figure
 from ..plots.arm import arm_points, draw_arm, set_equal_3d
 from ..report import Section
@@ -36,16 +37,25 @@ DEMO_SCENARIO: dict[str, Any] = {
     "seed": 0,
     "failure": {"joint": 4, "angle_deg": 0.0},
     "state": {k: list(p000.SCENARIO[k]) for k in ("q0_deg", "dq0_deg", "ddq0_deg")},
-    "limits": {"vmax_deg": p000.SCENARIO["vmax_deg"], "amax_deg": p000.SCENARIO["amax_deg"]},
-    "halt_config": {"samples": 36000, "jacobian": "generalized"},
+    "limits": {"vmax_deg_s": p000.SCENARIO["vmax_deg"], "amax_deg_s2": p000.SCENARIO["amax_deg"]},
+    "halt_config": {"samples": p000.SAMPLES, "jacobian": "generalized"},
     "halt": {"T": p000.SCENARIO["T"], "base": "fixed", "solver": "scan"},
 }
+
+def _with_locked(q_deg: Sequence[float], lock: Mapping[int, float]) -> list[float]:
+    """All joints' angles [deg]: the healthy joints' ``q_deg`` with each locked joint's angle
+    (``lock``: {joint number: angle [deg]}) inserted at its place."""
+    q = list(q_deg)
+    for joint, angle in sorted(lock.items()):
+        q.insert(joint - 1, angle)
+    return q
+
 
 #: Reference configurations [deg]: 000 §5 start (joint 4 at its lock angle 0), NOTES-001's
 #: start, 002's terminal example.
 REFERENCE_Q_DEG = {
-    "halt7": [-180.0, -180.0, -100.0, 0.0, -10.0, 20.0, 20.0],
-    "canadarm7": [10.0, 40.0, -70.0, 100.0, -60.0, 30.0, 20.0],
+    "halt7": _with_locked(p000.SCENARIO["q0_deg"], p000.SCENARIO["lock"]),
+    "canadarm7": list(p001.TASK["q0_deg"]),
     "puma6": [5.0, 60.0, 65.0, 10.0, -120.0, 90.0],
 }
 

@@ -20,18 +20,7 @@ from ..plots.summary import plot_halt_base_torque, plot_jump_vs_failure_time, pl
 from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
 from ..robots import load_robot
 from ..scenario import JOB_PAPER, Scenario
-from ._summary import _pct, _pct0
-
-#: Unit of kappa: qdot [rad/s] = kappa * grad w, w = sqrt(det(J J^T)) [m^3] (docs/jump.md).
-KAPPA_UNIT = "rad^2/(s m^3)"
-
-
-def _points_text(points: list) -> str:
-    """001's segment points [s]; NaN (kappa falls back to 0 over the whole task) -> none."""
-    vals = [np.nan if p is None else float(p) for p in points]
-    if not any(np.isfinite(vals)):
-        return "none (kappa = 0 everywhere)"
-    return ", ".join(f"{v:.3g} s" if np.isfinite(v) else "none" for v in vals)
+from ._decisions import _condition_verdict, _decisions_section  # noqa: F401  (re-exported)
 
 #: Row labels of the report's limits table (``[limits]`` field -> words and unit).
 LIMIT_LABELS = {
@@ -39,14 +28,6 @@ LIMIT_LABELS = {
     "amax_deg": "acceleration limit [deg/s^2]",
     "eps_m": "position-deviation threshold [m]",
 }
-
-
-def _condition_verdict(name: str, sufficient: bool) -> str:
-    """Verdict of one singularity condition: 004's Cond1-Cond5 are reproduced or not;
-    ``cond1f`` is jointlock's own condition, so it is only sufficient or not."""
-    if name == "cond1f":
-        return "sufficient (ours)" if sufficient else "not sufficient (ours)"
-    return "reproduced" if sufficient else "not reproduced: not sufficient"
 
 
 def halt_k_label(r: dict[str, Any]) -> str:
@@ -193,132 +174,6 @@ def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
             )
         )
     sections.append(Section("The failure", facts=ffacts, tables=tables))
-    return sections
-
-
-def _decisions_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any) -> list[Section]:
-    """What was decided: halt configuration, k, kappa(t), gamma, volumes, conditions."""
-    d = scenario.data
-    sections: list[Section] = []
-    # decisions
-    decisions: list[tuple[str, Any]] = []
-    dtables = []
-    if "halt_config" in jobs:
-        r = jobs["halt_config"]["result"]
-        decisions.append(("halt configuration [deg]", [round(v, 3) for v in r["best"]["q_deg"]]))
-        decisions.append(
-            (
-                "CP at it (best sample, refinement gain)",
-                f"{r['best']['cp']:.5f} ({r['best_sample']['cp']:.5f}, {r['refinement']['gain']:+.5f})",
-            )
-        )
-        w = r["weights"]
-        dtables.append(
-            (
-                ["weights", *w["combined"].keys()],
-                [[k, *v.values()] for k, v in w.items()],
-                "index weights (AHP + entropy)",
-            )
-        )
-    if "halt" in jobs:
-        r = jobs["halt"]["result"]
-        source = r.get("qf_source", "")
-        if "halt_config" in jobs and d["halt"]["qf_deg"] is None and not d["halt"]["paper_qf"]:
-            source = "the optimal halt configuration above (halt_config job)"
-        decisions.append(("halt configuration source", source))
-        decisions.append(("halt time T [s]", r["T_s"]))
-        verdict = "feasible" if r["feasible"] else "INFEASIBLE: no k keeps every limit"
-        decisions.append(("verdict", verdict))
-        decisions.append(("k* [deg/s^6]" if r["feasible"] else "least-violating k [deg/s^6]", r["k"]))
-        decisions.append(
-            (
-                "global base torque k = 0 -> " + ("k*" if r["feasible"] else "least-violating k") + " [N m]",
-                f"{r['global_torque_k0_Nm']:.5g} -> {r['global_torque_Nm']:.5g} ({_pct(r['reduction'])} lower)",
-            )
-        )
-        if r["minimum_T_s"] is not None:
-            decisions.append(("smallest feasible halt time [s]", r["minimum_T_s"]))
-    if "jump" in jobs:
-        r = jobs["jump"]["result"]
-        if "kappa_fit" in r:
-            f = r["kappa_fit"]
-            decisions.append(
-                (
-                    f"kappa(t) [{KAPPA_UNIT}]",
-                    f"polynomial of order {f['order']} in tau = t/T, segment points "
-                    f"{_points_text(f['segment_points_s'])}",
-                )
-            )
-            decisions.append(
-                (
-                    f"kappa(t) coefficients (tau^0 first) [{KAPPA_UNIT}]",
-                    [float(f"{c:.4g}") for c in f["coefficients_tau"]],
-                )
-            )
-        elif r["mode"] == "fail_at":
-            decisions.append((f"optimal kappa at the failure [{KAPPA_UNIT}]", r["kappa"]))
-        elif np.ndim(r["kappa"]) == 0:
-            decisions.append((f"constant kappa [{KAPPA_UNIT}]", r["kappa"]))
-        decisions.append(
-            (
-                "mean jump reduction / share improved",
-                f"{_pct(r['mean_reduction'])} / {_pct(r['share_improved'])}",
-            )
-        )
-    if "tolerance_angle" in jobs:
-        r = jobs["tolerance_angle"]["result"]
-        ch = r["chosen"]
-        decisions.append(("tolerance angle gamma [deg]", None if ch is None else ch["gamma_deg"]))
-        if ch is not None:
-            decisions.append(("q at gamma [deg]", [round(v, 4) for v in ch["q_deg"]]))
-    if "replan" in jobs:
-        r = jobs["replan"]["result"]
-        decisions.append(
-            (
-                "re-plan",
-                f"{r['absorbed_waypoints']}/{r['waypoints']} waypoints absorb the lock; gamma {r['gamma_deg_range'][0]:.3f}..{r['gamma_deg_range'][1]:.3f} deg; max tracking error {1e3 * r['max_tracking_position_error_m']:.3f} mm",
-            )
-        )
-    if "workspace" in jobs:
-        r = jobs["workspace"]["result"]
-        if r.get("volume_locked_m3") is None:
-            decisions.append(("workspace volume [m^3]", f"{r['volume_full_m3']:.3g}"))
-        else:
-            decisions.append(
-                (
-                    "workspace volume full / locked [m^3]",
-                    f"{r['volume_full_m3']:.3g} / {r['volume_locked_m3']:.3g} (kept {_pct0(r.get('share_kept'))}; "
-                    f"from half the samples {_pct0(r.get('share_kept_half_samples'))})",
-                )
-            )
-            for w in r.get("warnings", []):
-                decisions.append(("workspace: warning", w))
-    if "singular" in jobs:
-        r = jobs["singular"]["result"]
-        if isinstance(r.get("conditions"), dict) and "cond1" in r["conditions"]:
-            conds = {**r["conditions"], **r.get("refined_conditions", {})}
-            dtables.append(
-                (
-                    ["condition", "samples", "singular", "fraction", "median sigma_min", "verdict"],
-                    [
-                        [
-                            k,
-                            c["samples"],
-                            c["singular"],
-                            c["fraction_singular"],
-                            c["sigma_min_median"],
-                            _condition_verdict(k, c["sufficient"]),
-                        ]
-                        for k, c in conds.items()
-                    ],
-                    "004's conditions: is every sampled configuration singular? (cond1f = S4 = 0 and F = 0, ours)",
-                )
-            )
-        elif "families" in r:
-            decisions.append(("singular families found", len(r["families"])))
-        else:
-            decisions.append(("sigma_min / rank", f"{r['sigma_min']:.4g} / {r['rank']}"))
-    sections.append(Section("Decisions", facts=decisions, tables=dtables))
     return sections
 
 

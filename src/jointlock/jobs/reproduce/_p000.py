@@ -20,6 +20,7 @@ from ...robots import load_robot
 from ._report import NOT_REPRODUCED, REPRODUCED, ReproductionRow, _g, _pct
 
 
+# Over 100 lines: one block per printed figure of 000, in the paper's order; each is a few lines.
 def rows_000() -> list[ReproductionRow]:
     """000 §5: CP at its printed q_sub and q_best, the halt motion at its k and limits."""
     sc, printed = p000.SCENARIO, p000.HALT_RESULTS

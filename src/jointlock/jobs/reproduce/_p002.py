@@ -20,6 +20,7 @@ def _printed(x: np.ndarray, decimals: int) -> np.ndarray:
     return np.trunc(x * scale) / scale if decimals == 2 else np.round(x, decimals)
 
 
+# Over 100 lines: one block per printed figure of 002, in the paper's order; each is a few lines.
 def rows_002() -> list[ReproductionRow]:
     """002: the worked examples, eqs. (21)-(22), example A's ranges, gamma and q at gamma."""
     arm = load_robot("puma6")

@@ -1,0 +1,163 @@
+"""The inputs of :func:`~jointlock.jobs.halt.plan_halt`: the state at failure
+(:class:`FailureState`), the joint limits (:class:`JointLimits`) and ``jointlock halt``'s rule
+for them (:func:`halt_limits`), with 000's defaults."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ...errors import ScenarioError
+from ...model import ArmModel
+from ...papers import p000
+from .._common import joint_vector_deg
+
+#: 000's limits (§5.2), the fallback where neither the caller nor the model gives one
+#: [deg/s, deg/s^2].
+DEFAULT_VMAX_DEG = p000.VELOCITY_LIMIT_DEG_S
+DEFAULT_AMAX_DEG = p000.ACCELERATION_LIMIT_DEG_S2
+
+
+@dataclass(frozen=True)
+class FailureState:
+    """State of the healthy joints when the failure is detected.
+
+    Attributes
+    ----------
+    q, dq, ddq
+        (n,) angles [rad], rates [rad/s] and accelerations [rad/s^2] of the movable joints
+        (the locked model's joint order, :attr:`ArmModel.joint_numbers`).
+    """
+
+    q: np.ndarray
+    dq: np.ndarray
+    ddq: np.ndarray
+
+    @classmethod
+    def from_degrees(
+        cls,
+        model: ArmModel,
+        q_deg: ArrayLike,
+        dq_deg: ArrayLike | None = None,
+        ddq_deg: ArrayLike | None = None,
+        *,
+        names: tuple[str, str, str] = ("q0_deg", "dq0_deg", "ddq0_deg"),
+    ) -> FailureState:
+        """From degrees, one value per movable joint or per joint of the full arm (a locked
+        joint's angle must then equal its lock angle, its rate and acceleration 0); ``None``
+        rates or accelerations are zeros.  ``names`` name the inputs in error messages."""
+        return cls(
+            joint_vector_deg(model, list(np.ravel(q_deg)), names[0]),
+            joint_vector_deg(model, None if dq_deg is None else list(np.ravel(dq_deg)), names[1], rates=True),
+            joint_vector_deg(
+                model, None if ddq_deg is None else list(np.ravel(ddq_deg)), names[2], rates=True
+            ),
+        )
+
+
+@dataclass(frozen=True)
+class JointLimits:
+    """Symmetric speed and acceleration limits of the healthy joints, and where each came from.
+
+    Attributes
+    ----------
+    velocity, acceleration
+        (n,) ``v_max`` [rad/s] and ``a_max`` [rad/s^2].
+    velocity_source, acceleration_source
+        (n,) plain-language origin of each joint's limit.
+    """
+
+    velocity: np.ndarray
+    acceleration: np.ndarray
+    velocity_source: tuple[str, ...]
+    acceleration_source: tuple[str, ...]
+
+
+def _limit_values(values: Any, name: str, n: int) -> np.ndarray | None:
+    """None, or (n,) from one value or n values (finite, > 0)."""
+    if values is None:
+        return None
+    arr = np.asarray(values, dtype=float).ravel()
+    if arr.size == 1:
+        arr = np.full(n, arr[0])
+    if arr.shape != (n,) or not np.all(np.isfinite(arr) & (arr > 0)):
+        raise ScenarioError(f"{name} needs one value or {n} values, finite and > 0; got {np.ravel(values).tolist()}")
+    return arr
+
+
+def halt_limits(
+    model: ArmModel,
+    vmax_deg: ArrayLike | None = None,
+    amax_deg: ArrayLike | None = None,
+    *,
+    names: tuple[str, str] = ("--vmax-deg", "--amax-deg"),
+) -> JointLimits:
+    """Speed and acceleration limits of the healthy joints by ``jointlock halt``'s rule.
+
+    A joint's speed limit is ``vmax_deg`` capped by the model's own ``velocity_limit`` (the
+    smaller of the two); without ``vmax_deg``, the model's limit where finite, else 000's
+    :data:`DEFAULT_VMAX_DEG`.  The acceleration limit is ``amax_deg``, else
+    :data:`DEFAULT_AMAX_DEG` (a model has no acceleration limit).
+
+    Parameters
+    ----------
+    vmax_deg, amax_deg
+        One value or one per healthy joint [deg/s, deg/s^2] (limits are typed by people, in
+        degrees), or None.
+    names
+        How the two inputs are named in the sources and in error messages (the CLI's options).
+    """
+    n = model.dof
+    v_opt = _limit_values(vmax_deg, names[0], n)
+    a_opt = _limit_values(amax_deg, names[1], n)
+    v_model = np.degrees([j.velocity_limit for j in model.joints])
+    vmax, v_src = np.empty(n), []
+    for i in range(n):
+        finite = math.isfinite(v_model[i])
+        if v_opt is not None and (not finite or v_opt[i] <= v_model[i]):
+            vmax[i] = v_opt[i]
+            v_src.append(names[0])
+        elif v_opt is not None:
+            vmax[i] = v_model[i]
+            v_src.append(f"model's limit, below {names[0]} {v_opt[i]:g}")
+        elif finite:
+            vmax[i] = v_model[i]
+            v_src.append("model's limit")
+        else:
+            vmax[i] = DEFAULT_VMAX_DEG
+            v_src.append("000's default; the model gives none")
+    if a_opt is not None:
+        amax, a_src = a_opt, [names[1]] * n
+    else:
+        amax, a_src = np.full(n, DEFAULT_AMAX_DEG), ["000's default"] * n
+    return JointLimits(np.radians(vmax), np.radians(amax), tuple(v_src), tuple(a_src))
+
+
+def resolve_limits(
+    model: ArmModel, vmax_deg: Sequence[float] | None, amax_deg: Sequence[float] | None
+) -> tuple[np.ndarray, np.ndarray, list[str], list[str]]:
+    """:func:`halt_limits` as a tuple ``(vmax [rad/s], amax [rad/s^2], vmax_source,
+    amax_source)`` (the CLI's form)."""
+    lim = halt_limits(model, vmax_deg, amax_deg)
+    return lim.velocity, lim.acceleration, list(lim.velocity_source), list(lim.acceleration_source)
+
+
+def limits_text(numbers: Sequence[int], values_rad: ArrayLike, sources: Sequence[str], unit: str) -> str:
+    """``"40 deg/s (model's limit)"`` when every joint has the same limit from the same
+    source, else the joints grouped: ``"joints 1, 2: 10 deg/s (model's limit); joint 4: ..."``."""
+    groups: dict[tuple[str, str], list[int]] = {}
+    for num, v, src in zip(numbers, np.degrees(values_rad), sources):
+        groups.setdefault((f"{v:.6g}", src), []).append(num)
+    if len(groups) == 1:
+        (value, src), _ = next(iter(groups.items()))
+        return f"{value} {unit} ({src})"
+    parts = []
+    for (value, src), nums in groups.items():
+        label = "joint" if len(nums) == 1 else "joints"
+        parts.append(f"{label} {', '.join(map(str, nums))}: {value} {unit} ({src})")
+    return "; ".join(parts)

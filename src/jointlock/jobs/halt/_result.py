@@ -1,0 +1,278 @@
+"""The result of :func:`~jointlock.jobs.halt.plan_halt`, :class:`HaltPlan`: the JSON of
+``jointlock halt --json`` (``to_dict()``), its printed lines (``summary()``) and the files of
+``--out`` (``write()``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ...io.files import (
+    atomic_write_bytes,
+    atomic_write_json,
+    atomic_write_text,
+    csv_text,
+    figure_png,
+    npz_bytes,
+)
+from ...papers import p000
+from ...planning.halt_config import HaltConfiguration
+from ...planning.halt_motion import (
+    K_UNIT_SCALE,
+    HaltMotion,
+    HaltProblem,
+    base_torque_history,
+    infeasibility_message,
+)
+from ...plots._common import offscreen_figure
+from ...plots.halt import (
+    global_torque_curve,
+    k_text,
+    plot_base_torque_vs_time,
+    plot_global_torque_vs_k,
+    plot_joint_profiles,
+)
+from .._common import JobResult, locked_deg, locked_text
+from ._inputs import JointLimits, limits_text
+
+
+@dataclass(frozen=True)
+class HaltPlan(JobResult):
+    """The result of :func:`plan_halt`: where the arm halts and how it gets there.
+
+    Attributes
+    ----------
+    motion
+        The optimal halt motion (its ``problem`` holds the model, state, halt configuration,
+        T and limits).
+    limits
+        The limits applied and their sources.
+    qf_source
+        Where the halt configuration came from.
+    paper_scenario
+        Whether this is 000 §5's scenario (then ``to_dict()["paper"]`` holds 000's numbers).
+    configuration
+        The halt-configuration search (None when ``qf`` was given).
+    reachability
+        How the reachability constraint went (None when not searched or not constrained).
+    samples
+        Monte Carlo samples of the search.
+    reachability_requested
+        Whether the search was asked to keep to reachable configurations.
+    seed
+        The seed of the halt-configuration search and the GA (:mod:`jointlock._random`; None
+        when a numpy Generator was given).
+    """
+
+    job: ClassVar[str] = "halt"
+
+    motion: HaltMotion
+    limits: JointLimits
+    qf_source: str
+    paper_scenario: bool = False
+    configuration: HaltConfiguration | None = field(default=None, repr=False)
+    reachability: str | None = None
+    samples: int = p000.SAMPLES
+    reachability_requested: bool = True
+    seed: int | None = 0
+
+    @property
+    def problem(self) -> HaltProblem:
+        return self.motion.problem
+
+    @property
+    def feasible(self) -> bool:
+        return bool(self.motion.feasible)
+
+    @property
+    def k_deg(self) -> Any:
+        """The chosen k [deg/s^6] (an array with one k per joint for the vector solver)."""
+        return np.asarray(self.motion.k) / K_UNIT_SCALE["deg/s^6"]
+
+    def _notes(self) -> dict[str, Any]:
+        """Where the limits and the halt configuration came from (keys in the CLI's order)."""
+        notes: dict[str, Any] = {
+            "velocity_limit_source": list(self.limits.velocity_source),
+            "acceleration_limit_source": list(self.limits.acceleration_source),
+            "paper_scenario": self.paper_scenario,
+        }
+        hc = self.configuration
+        if hc is not None and self.reachability is not None:
+            notes["reachability"] = self.reachability
+            if hc.reachability is not None:
+                notes["reachable_samples"] = hc.reachable_samples
+        notes["qf_source"] = self.qf_source
+        if hc is not None:
+            notes["cp_best"] = float(getattr(hc, "cp_best", float("nan")))
+            notes["hcom_jacobian"] = hc.jacobian
+            notes["hcom_base"] = hc.base
+        return notes
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``jointlock halt --json`` prints: degrees, deg/s^6 for k, N m for torques."""
+        res, p = self.motion, self.problem
+        scale = K_UNIT_SCALE["deg/s^6"]
+        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        return {
+            "robot": p.model.name,
+            "base": p.base,
+            "joint_numbers": list(p.model.joint_numbers),
+            "locked": locked_deg(p.model),
+            "T_s": p.T,
+            "k": np.asarray(res.k) / scale,
+            "k_unit": "deg/s^6",
+            "k_rad": res.k,
+            "global_torque_Nm": res.global_torque,
+            "global_torque_k0_Nm": res.global_torque_k0,
+            "reduction": None if math.isnan(res.reduction) else res.reduction,
+            "feasible": res.feasible,
+            "violations": [_violation(v) for v in res.violations],
+            "violations_k0": [_violation(v) for v in res.violations_k0],
+            "k_interval_deg": res.k_interval / scale,
+            **({"joint_k_intervals_deg": res.joint_intervals / scale} if res.per_joint else {}),
+            "minimum_T_s": res.minimum_T,
+            "q_initial_deg": np.degrees(p.q0),
+            "q_final_deg": np.degrees(p.qf),
+            "peak_velocity_deg_s": np.degrees(np.abs(dq).max(axis=0)),
+            "peak_acceleration_deg_s2": np.degrees(np.abs(ddq).max(axis=0)),
+            "velocity_limit_deg_s": np.degrees(p.dq_max),
+            "acceleration_limit_deg_s2": np.degrees(p.ddq_max),
+            "solver": res.solver,
+            "seed": res.seed,
+            # 000's printed numbers, for 000 §5's scenario on halt7 only (None otherwise)
+            "paper": dict(p000.HALT_RESULTS) if self.paper_scenario else None,
+            **self._notes(),
+        }
+
+    def summary(self) -> list[str]:
+        """The lines ``jointlock halt`` prints."""
+        res, p = self.motion, self.problem
+        nums = list(p.model.joint_numbers)
+        lines = [
+            f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
+            f"base torque with {p.base} base",
+            f"halt configuration ({self.qf_source}): " + ", ".join(f"{v:.2f}" for v in np.degrees(p.qf)) + " deg",
+        ]
+        hc = self.configuration
+        if hc is not None:
+            lines.append(
+                f"  (CP with the {_jacobian_text(hc.base)}; --base sets the base of the disturbance torque only)"
+            )
+        if self.reachability is not None:
+            lines.append(f"reachability: {self.reachability}")
+        lim = self.limits
+        lines += [
+            f"halt time T = {p.T:g} s",
+            f"speed limits: {limits_text(nums, p.dq_max, lim.velocity_source, 'deg/s')}",
+            f"acceleration limits: {limits_text(nums, p.ddq_max, lim.acceleration_source, 'deg/s^2')}",
+        ]
+        scale = K_UNIT_SCALE["deg/s^6"]
+        if not res.feasible:
+            lines += ["", "INFEASIBLE: " + infeasibility_message(res)]
+        elif res.per_joint:  # one k per joint: each within its own joint's interval
+            lines += ["", f"feasible k per joint [deg/s^6]; solver {res.solver}"]
+            for num, (lo, hi), kj in zip(nums, res.joint_intervals / scale, np.asarray(res.k) / scale):
+                lines.append(f"  joint {num}: [{lo:.6g}, {hi:.6g}], k* = {kj:.6g}")
+        else:
+            lo, hi = res.k_interval / scale
+            lines += ["", f"feasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}", f"k* = {k_text(res)}"]
+        at = "k*" if res.feasible else "least-violating k (infeasible)"
+        lines.append(
+            f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
+            f"({_change_text(res)})"
+        )
+        if self.paper_scenario:  # 000's numbers belong to 000 §5's scenario on halt7 only
+            lines.append(f"{_printed_text()} -- not reproduced, see docs/halt-motion.md")
+        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        peak_v, peak_a = np.degrees(np.abs(dq).max(axis=0)), np.degrees(np.abs(ddq).max(axis=0))
+        v_lim, a_lim = np.degrees(p.dq_max), np.degrees(p.ddq_max)
+        lines += ["", "joint   peak |dq| [deg/s] (limit)   peak |ddq| [deg/s^2] (limit)"]
+        for j, num in enumerate(nums):
+            v_text = f"({v_lim[j]:.6g})"
+            lines.append(f"{num:>5}   {peak_v[j]:10.3f} {v_text:<14}  {peak_a[j]:10.3f} ({a_lim[j]:.6g})")
+        return "\n".join(lines).split("\n")  # one entry per printed line
+
+    def time_series(self) -> dict[str, np.ndarray]:
+        """The halt on the objective's time grid: ``t`` (m,) [s]; ``q``, ``dq``, ``ddq`` (m, n)
+        [rad, rad/s, rad/s^2]; base torque ``tau_b`` and ``tau_b_k0`` (at k = 0) (m, 3) [N m]."""
+        res, p = self.motion, self.problem
+        t = p.times()
+        q, dq, ddq = res.trajectory(t)
+        tb = base_torque_history(p, res.k, t, per_joint=res.per_joint)
+        tb0 = base_torque_history(p, 0.0, t)
+        return {"t": t, "q": q, "dq": dq, "ddq": ddq, "tau_b": tb, "tau_b_k0": tb0}
+
+    def write(self, out: str | Path) -> list[str]:
+        """Plots like 000 Figs. 8-9, base torque vs time, time series (CSV, NPZ) and
+        result.json in ``out``; returns the file names."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        res, p = self.motion, self.problem
+        grid, tau = global_torque_curve(res)
+        ts = self.time_series()
+        figures = (
+            ("global_torque_vs_k.png", (7, 4), lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot())),
+            ("joint_profiles.png", (3 * p.dof, 7), lambda fig: plot_joint_profiles(res, fig=fig)),
+            ("base_torque_vs_time.png", (7, 4), lambda fig: plot_base_torque_vs_time(res, ax=fig.add_subplot())),
+        )
+        written = []
+        for name, size, draw in figures:
+            fig = offscreen_figure(size)
+            draw(fig)
+            atomic_write_bytes(out / name, figure_png(fig))
+            written.append(name)
+        cols = {"t_s": ts["t"]}
+        for j, num in enumerate(p.model.joint_numbers):
+            cols[f"q{num}_deg"] = np.degrees(ts["q"][:, j])
+            cols[f"dq{num}_deg_s"] = np.degrees(ts["dq"][:, j])
+            cols[f"ddq{num}_deg_s2"] = np.degrees(ts["ddq"][:, j])
+        for i, ax_name in enumerate("xyz"):
+            cols[f"tau_b_{ax_name}_Nm"] = ts["tau_b"][:, i]
+        for i, ax_name in enumerate("xyz"):
+            cols[f"tau_b0_{ax_name}_Nm"] = ts["tau_b_k0"][:, i]
+        atomic_write_text(out / "halt_motion.csv", csv_text(cols))
+        atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**ts, k_grid=grid, global_torque_grid=tau))
+        atomic_write_json(out / "result.json", self.to_dict())
+        return written + ["halt_motion.csv", "halt_motion.npz", "result.json"]
+
+
+def _violation(v: Any) -> dict[str, Any]:
+    return {
+        "joint": v.joint,
+        "limit": v.kind,
+        "limit_value_deg": math.degrees(v.limit),
+        "value_deg": math.degrees(v.value),
+        "excess_deg": math.degrees(v.excess),
+        "time_s": v.time,
+    }
+
+
+def _printed_text() -> str:
+    """000 §5.2's printed results (:data:`jointlock.papers.p000.HALT_RESULTS`) as one line:
+    ``"000 printed: k = 0.0018, 22.25 -> 15.55 N m (30.1 %)"``."""
+    r = p000.HALT_RESULTS
+    return (
+        f"000 printed: k = {r['k']:g}, {r['global_torque_k0_Nm']:g} -> {r['global_torque_Nm']:g} N m "
+        f"({100 * r['reduction']:.1f} %)"
+    )
+
+
+def _jacobian_text(hcom_base: str) -> str:
+    if hcom_base == "fixed":  # a robot without a spacecraft: J_F is the fixed-base one
+        return "generalized Jacobian, which for this fixed-base model is the fixed-base Jacobian"
+    return "free-floating arm's generalized Jacobian J_F (000 §3.1.2)"
+
+
+def _change_text(res: HaltMotion) -> str:
+    """The torque change from k = 0 to the chosen k, in words."""
+    if math.isnan(res.reduction):
+        return "reduction n/a: no torque at k = 0"
+    if res.reduction >= 0:
+        return f"{100 * res.reduction:.1f} % lower"
+    if res.violations_k0:
+        return f"{-100 * res.reduction:.1f} % higher: k = 0 breaks a limit"
+    return f"{-100 * res.reduction:.1f} % higher"

@@ -1,0 +1,320 @@
+"""000's halt strategy (:func:`plan_halt`): the checks before any work, the halt-configuration
+search among the configurations the halt reaches (with its fallback), then the halt motion;
+the arm it runs on (:func:`halt_model`) and the ``[halt]`` job of a scenario
+(:func:`halt_from_scenario`)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..._random import resolve_seed
+from ...errors import InfeasibleError, ModelError, ScenarioError
+from ...locking import lock_joints
+from ...model import ArmModel
+from ...papers import p000
+from ...planning.ga import GASettings
+from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
+from ...planning.halt_motion import HaltProblem, optimal_halt_motion
+from ...progress import Progress
+from ...robots import load_robot
+from .._common import JobResult, joint_vector_deg
+from ._inputs import FailureState, JointLimits, halt_limits, limits_text
+from ._result import HaltPlan
+
+#: Smallest number of time samples of the objective (Simpson's rule, odd).
+MIN_N_SAMPLES = 11
+
+#: Jacobian of the halt-configuration search (CP): 000 §3.1.2's generalized Jacobian J_F of
+#: the free-floating arm, whatever the base of the disturbance torque.
+HCOM_JACOBIAN = "generalized"
+
+Solver = Literal["scan", "ga", "vector"]
+
+
+def halt_model(robot: str, locks: Mapping[int, float] | None, base: str = "fixed") -> ArmModel:
+    """The locked arm ``jointlock halt`` uses for ``robot`` (a built-in name or model file).
+
+    The base torque is taken about the spacecraft's centre of mass (000 eq. 30), so the model
+    is loaded with its spacecraft even when the base is held fixed (``base`` only picks the
+    torque's base mode); a robot without one is loaded fixed (then the moment point is the
+    root frame's origin).  ``locks``: ``{joint number: angle [rad]}``.
+    """
+    try:
+        model = load_robot(robot, base="floating")
+    except ModelError:
+        if base == "floating":
+            raise
+        model = load_robot(robot, base="fixed")
+    return lock_joints(model, dict(locks)) if locks else model
+
+
+def _is_paper_state(model: ArmModel, state: FailureState, T: float, limits: JointLimits) -> bool:
+    """True for 000 §5's scenario on halt7: joint 4 locked at 0, §5.2's state, T and limits."""
+    ps = p000.SCENARIO
+    if model.name != "halt7" or {lj.number: lj.angle for lj in model.locked} != ps["lock"]:
+        return False
+    same = all(
+        np.allclose(np.degrees(v), ps[key], atol=1e-9)
+        for v, key in ((state.q, "q0_deg"), (state.dq, "dq0_deg"), (state.ddq, "ddq0_deg"))
+    )
+    return (
+        same
+        and T == ps["T"]
+        and np.allclose(np.degrees(limits.velocity), ps["vmax_deg"])
+        and np.allclose(np.degrees(limits.acceleration), ps["amax_deg"])
+    )
+
+
+def _check_start(model: ArmModel, state: FailureState, T: float, limits: JointLimits) -> None:
+    """Refuse a state at failure that itself breaks a limit before any search: every halt
+    starts from it (the k-part vanishes at t = 0 with two derivatives), so no halt
+    configuration, halt time or k helps, and a Monte Carlo search would be pointless."""
+    reach = HaltReachability(state.q, state.dq, state.ddq, T, limits.velocity, limits.acceleration)
+    bad = reach.bind(model).start_violations(model.joint_numbers)
+    if bad:
+        nums = model.joint_numbers
+        raise InfeasibleError(
+            "the state at failure (--q0-deg, --dq0-deg, --ddq0-deg) already breaks a limit, and every "
+            "halt starts from it, so no halt configuration, halt time or k helps: "
+            + "; ".join(bad)
+            + f" (speed limits: {limits_text(nums, limits.velocity, limits.velocity_source, 'deg/s')}; "
+            f"acceleration limits: "
+            f"{limits_text(nums, limits.acceleration, limits.acceleration_source, 'deg/s^2')}); "
+            "no halt configuration searched"
+        )
+
+
+def _search_halt_configuration(
+    model: ArmModel,
+    state: FailureState,
+    T: float,
+    limits: JointLimits,
+    *,
+    samples: int,
+    seed: Any,
+    reachable: bool,
+    per_joint: bool,
+    progress: bool,
+) -> tuple[HaltConfiguration, str | None]:
+    """000's HCOM on J_F among the configurations the halt reaches (unless ``reachable`` is
+    False), falling back to the whole ranges when none is; returns it and the reachability
+    note (None when not constrained)."""
+    reach = None
+    if reachable:
+        reach = HaltReachability(
+            state.q, state.dq, state.ddq, float(T), limits.velocity, limits.acceleration, per_joint=per_joint
+        )
+    note = None
+    bar = Progress(samples, "halt configuration", enabled=progress)
+    try:
+        hc = optimal_halt_configuration(
+            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar, reachability=reach
+        )
+    except InfeasibleError as exc:
+        if reach is None:
+            raise
+        note = f"not met, searched the whole ranges instead (000's way): {exc}"
+        bar.close()
+        bar = Progress(samples, "halt configuration", enabled=progress)
+        hc = optimal_halt_configuration(model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar)
+    bar.close()
+    if reach is not None and hc.reachability is not None:
+        note = (
+            f"exact: {hc.reachable_samples} of {samples} samples reachable by the halt polynomial "
+            f"within T = {float(T):g} s under the limits"
+        )
+    return hc, note
+
+
+def check_halt_settings(T: float | None, n_samples: int, samples: int, solver: str, ga: GASettings) -> None:
+    """Refuse settings :func:`plan_halt` cannot use, before any work (named as the CLI's options)."""
+    if T is not None and not (math.isfinite(T) and T > 0):
+        raise ScenarioError(f"--T must be a finite halt time > 0 [s]; got {T:g}")
+    if n_samples < MIN_N_SAMPLES or n_samples % 2 == 0:
+        raise ScenarioError(
+            f"--n-samples must be an odd integer >= {MIN_N_SAMPLES} (time samples of the objective, "
+            f"Simpson's rule); got {n_samples}"
+        )
+    if samples < 2:
+        raise ScenarioError(f"--samples must be an integer >= 2 (Monte Carlo samples); got {samples}")
+    if solver == "ga":
+        bad = []
+        if ga.n_pop < 2:
+            bad.append(f"--population must be >= 2 (GA population); got {ga.n_pop}")
+        if ga.n_gen < 0:
+            bad.append(f"--generations must be >= 0 (GA generations); got {ga.n_gen}")
+        if bad:
+            raise ScenarioError("; ".join(bad))
+
+
+# Over 100 lines: 17 keyword inputs with their numpydoc take 67; the strategy itself is 57 lines.
+def plan_halt(
+    robot: ArmModel | str,
+    state: FailureState | None = None,
+    *,
+    locks: Mapping[int, float] | None = None,
+    T: float | None = None,
+    qf: ArrayLike | None = None,
+    paper_qf: bool = False,
+    vmax_deg: ArrayLike | None = None,
+    amax_deg: ArrayLike | None = None,
+    limits: JointLimits | None = None,
+    base: Literal["fixed", "floating"] = "fixed",
+    solver: Solver = "scan",
+    rng: int | np.random.Generator | None = 0,
+    samples: int = p000.SAMPLES,
+    reachable: bool = True,
+    n_samples: int = 501,
+    ga: GASettings | None = None,
+    progress: bool = False,
+) -> HaltPlan:
+    """000's halt strategy: optimal halt configuration, then optimal halt motion (000 §3-§4).
+
+    Parameters
+    ----------
+    robot
+        A built-in name or model file (loaded by :func:`halt_model`, with ``locks``), or a
+        locked :class:`ArmModel` (used as given: the base torque is taken about its
+        spacecraft's centre of mass when it has one, else about its root frame's origin).
+    state
+        State at failure; None on halt7 = 000 §5.2's (:data:`jointlock.papers.p000.SCENARIO`).
+    locks
+        ``{joint number: angle [rad]}`` when ``robot`` is a name; None on halt7 = 000's
+        (joint 4 at 0).
+    T
+        Halt time [s]; None on halt7 = 000's 10 s.
+    qf
+        (n,) halt configuration [rad]; None = search it (HCOM), unless ``paper_qf`` (000's
+        printed q_best, halt7 only).
+    vmax_deg, amax_deg, limits
+        The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s] and ``amax_deg``
+        [deg/s^2], or ``limits`` as they are.
+    base
+        Base of the disturbance torque: ``"fixed"`` (000) or ``"floating"``; the halt
+        configuration is searched on J_F either way (000 §3.1.2).
+    solver
+        ``"scan"`` (exact), ``"ga"`` (000's adaptive GA, ``ga`` settings: default population
+        50, 100 generations) or ``"vector"`` (one k per joint).
+    rng
+        Seed of the Monte Carlo search and the GA (:mod:`jointlock._random`: ``None`` draws a
+        fresh seed; the seed used is :attr:`HaltPlan.seed`).
+    samples
+        Monte Carlo samples of the halt configuration (000's K, :data:`jointlock.papers.p000.SAMPLES`).
+    reachable
+        Search only configurations the halt polynomial reaches (exact; default) or the whole
+        ranges (000's way).
+    n_samples
+        Time samples of the objective (odd, Simpson's rule).
+    progress
+        Show progress bars on stderr.
+
+    Raises
+    ------
+    ScenarioError
+        Missing or malformed inputs.
+    InfeasibleError
+        The state at failure itself breaks a limit (no halt can help), or (with
+        ``reachable=False``) nothing sampled satisfies the search's constraints.
+    """
+    ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
+    named = isinstance(robot, str)
+    paper = robot == "halt7" if named else robot.name == "halt7"
+    defaults = p000.SCENARIO if paper else {}
+    check_halt_settings(T, n_samples, samples, solver, ga)
+    if state is None and not paper:
+        raise ScenarioError("plan_halt needs the state at failure (state=FailureState(...)) for this robot")
+    if T is None and "T" not in defaults:
+        raise ScenarioError("plan_halt needs the halt time T [s] for this robot")
+    T = float(T if T is not None else defaults["T"])
+    if named:
+        if locks is None:
+            locks = {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
+        model = halt_model(robot, locks, base)
+    else:
+        model = robot
+    if state is None:
+        state = FailureState.from_degrees(
+            model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
+            names=("--q0-deg", "--dq0-deg", "--ddq0-deg"),
+        )  # fmt: skip
+    if limits is None:
+        limits = halt_limits(model, vmax_deg, amax_deg)
+    paper_scenario = _is_paper_state(model, state, T, limits)
+    rng = resolve_seed(rng)  # one seed for the search and the GA, recorded
+    configuration, reach_note = None, None
+    if qf is not None:
+        qf_arr, qf_source = np.asarray(qf, dtype=float), "--qf-deg"
+    elif paper_qf:
+        if not paper:
+            raise ScenarioError("--paper-qf is 000's q_best for halt7 only; give --qf-deg")
+        qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "--paper-qf"), "000's printed q_best"
+    else:
+        _check_start(model, state, T, limits)
+        configuration, reach_note = _search_halt_configuration(
+            model, state, T, limits, samples=samples, seed=rng, reachable=reachable,
+            per_joint=solver == "vector", progress=progress,
+        )  # fmt: skip
+        qf_arr = np.asarray(configuration.q_best, dtype=float)
+        seed_text = "a numpy Generator" if isinstance(rng, np.random.Generator) else rng
+        qf_source = f"optimal halt configuration (Monte Carlo, {samples} samples, seed {seed_text})"
+    problem = HaltProblem(
+        model, state.q, state.dq, state.ddq, qf_arr, T, limits.velocity, limits.acceleration,
+        base=base, n_samples=n_samples,
+    )  # fmt: skip
+    bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
+    motion = optimal_halt_motion(problem, solver=solver, rng=rng, ga_settings=ga, progress=bar)
+    if bar is not None:
+        bar.close()
+    return HaltPlan(
+        motion=motion,
+        limits=limits,
+        qf_source=qf_source,
+        paper_scenario=paper_scenario,
+        configuration=configuration,
+        reachability=reach_note,
+        samples=samples,
+        reachability_requested=reachable,
+        seed=None if isinstance(rng, np.random.Generator) else rng,
+    )
+
+
+def halt_from_scenario(
+    data: Mapping[str, Any], previous: Mapping[str, JobResult], *, progress: bool = False
+) -> HaltPlan:
+    """The ``[halt]`` job of a resolved scenario (``Scenario.data``): the state, limits and
+    failure of the scenario; the halt configuration from ``[halt] qf_deg``, 000's q_best
+    (``paper_qf``), else the ``halt_config`` job that ran before it, else searched here."""
+    t, st, lim = data["halt"], data["state"], data["limits"]
+    fail = data["failure"]
+    locks = {int(fail["joint"]): math.radians(float(fail["angle_deg"]))} if fail.get("angle_deg") is not None else {}
+    base = t.get("base") or data["base"]
+    model = halt_model(data["robot"], locks, base)
+    state = FailureState.from_degrees(
+        model, st["q0_deg"], st["dq0_deg"], st["ddq0_deg"], names=("--q0-deg", "--dq0-deg", "--ddq0-deg")
+    )
+    qf = None
+    if t["qf_deg"] is not None:
+        qf = joint_vector_deg(model, list(t["qf_deg"]), "--qf-deg")
+    elif not t["paper_qf"] and "halt_config" in previous:
+        qf = joint_vector_deg(model, list(previous["halt_config"].to_dict()["best"]["q_deg"]), "--qf-deg")
+    return plan_halt(
+        model,
+        state,
+        T=float(t["T"]),
+        qf=qf,
+        paper_qf=bool(t["paper_qf"]) and qf is None,
+        vmax_deg=lim["vmax_deg"],
+        amax_deg=lim["amax_deg"],
+        base=base,
+        solver=t["solver"],
+        rng=data["seed"],
+        samples=int(t["samples"]),
+        n_samples=int(t["n_samples"]),
+        ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
+        progress=progress,
+    )

@@ -1,0 +1,127 @@
+"""Inverse kinematics as one call (``jointlock ik``): every branch of an arm, full or with a
+locked joint, or the nearest reachable pose when the target cannot be reached (002 §3)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..ik import IKResult, solve_ik, zyx_angles
+from ..io.files import atomic_write_json
+from ..model import ArmModel
+from ._common import JobResult, format_matrix, locked_deg, locked_text
+
+
+def _solution(sol: Any) -> dict[str, Any]:
+    return {
+        "branch": sol.branch,
+        "q_deg": np.degrees(sol.q_full),
+        "position_error_m": sol.position_error,
+        "rotation_error_deg": math.degrees(sol.rotation_error),
+        "exact": sol.exact,
+    }
+
+
+@dataclass(frozen=True)
+class InverseKinematicsReport(JobResult):
+    """Every IK solution of ``model`` for ``target``, or the nearest reachable pose.
+
+    Attributes
+    ----------
+    model
+        The arm (locked joints allowed).
+    target
+        (4, 4) desired end-effector pose ``T_base_ee`` [m].
+    result
+        The solver's result (:class:`jointlock.ik.IKResult`: solutions, candidates, nearest).
+    """
+
+    job: ClassVar[str] = "ik"
+
+    model: ArmModel
+    target: np.ndarray
+    result: IKResult
+
+    def to_dict(self) -> dict[str, Any]:
+        """What ``jointlock ik --json`` prints (angles of every joint, the locked ones included)."""
+        res, target = self.result, self.target
+        out: dict[str, Any] = {
+            "robot": self.model.name,
+            "locked": locked_deg(self.model),
+            "method": res.method,
+            "target": target,
+            "target_position_m": target[:3, 3],
+            "target_zyx_deg": np.degrees(zyx_angles(target[:3, :3])),
+            "reachable": res.reachable,
+            "solutions": [_solution(s) for s in res.solutions],
+            "candidates": [_solution(s) for s in res.candidates],
+            "nearest": None,
+        }
+        if res.nearest is not None:
+            near = res.nearest_pose
+            out["nearest"] = {
+                **_solution(res.nearest),
+                "pose": near,
+                "position_m": near[:3, 3],
+                "zyx_deg": np.degrees(zyx_angles(near[:3, :3])),
+                "distance_position_m": res.nearest.position_error,
+                "distance_rotation_deg": math.degrees(res.nearest.rotation_error),
+                "length_scale_m": res.length_scale,
+            }
+        return out
+
+    def summary(self) -> list[str]:
+        """The lines ``jointlock ik`` prints."""
+        res, model = self.result, self.model
+        lines = [
+            f"{model.name}: {res.method} IK, locked: {locked_text(locked_deg(model))}",
+            "target T_base_ee [m]:",
+            format_matrix(self.target, "{:>11.6f}"),
+        ]
+        if res.reachable:
+            lines.append(
+                f"\n{len(res.solutions)} solution(s), q [deg] (all joints), position error [m], rotation error [deg]:"
+            )
+            for s in res.solutions:
+                q = " ".join(f"{v:9.4f}" for v in np.degrees(s.q_full))
+                lines.append(
+                    f"  branch {s.branch}: {q}   {s.position_error:.2e}  {math.degrees(s.rotation_error):.2e}"
+                )
+        else:
+            n = self.to_dict()["nearest"]
+            lines.append("\nnot reachable by this arm" + (" with the locked joint" if model.locked else ""))
+            if n is not None:
+                lines += [
+                    "nearest reachable pose [m]:",
+                    format_matrix(n["pose"], "{:>11.6f}"),
+                    f"distance: {n['distance_position_m']:.6g} m, {n['distance_rotation_deg']:.6g} deg; "
+                    "q [deg]: " + " ".join(f"{v:.4f}" for v in n["q_deg"]),
+                ]
+        return "\n".join(lines).split("\n")
+
+    def write(self, out: str | Path) -> list[str]:
+        """``result.json`` (:meth:`to_dict`) in ``out``; returns its name."""
+        atomic_write_json(Path(out) / "result.json", self.to_dict())
+        return ["result.json"]
+
+
+def inverse_kinematics(
+    model: ArmModel,
+    target: ArrayLike,
+    *,
+    method: Literal["auto", "closed-form", "numeric"] = "auto",
+    rng: int | np.random.Generator | None = 0,
+    length_scale: float = 1.0,
+) -> InverseKinematicsReport:
+    """Every IK branch of ``model`` for the pose ``target`` (4, 4) [m]
+    (:func:`jointlock.ik.solve_ik`: 002's closed form for the puma6 family, Levenberg-Marquardt
+    from several seeded starts otherwise), or the nearest reachable pose, with ``length_scale``
+    [m] weighing rotation against position in the distance."""
+    target = np.asarray(target, dtype=float)
+    res = solve_ik(model, target, method=method, rng=rng, length_scale=length_scale)
+    return InverseKinematicsReport(model, target, res)

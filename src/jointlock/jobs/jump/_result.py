@@ -1,0 +1,313 @@
+"""The result of :func:`~jointlock.jobs.jump.run_jump_study`, :class:`JumpJobResult`: the JSON
+of ``jointlock jump --json`` (``to_dict()``, built by the ``*_json`` functions here), its text
+(``summary()``, :mod:`._text`) and the files of ``--out`` (``write()``)."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+import numpy as np
+
+from ...io.files import atomic_write_bytes, atomic_write_json, atomic_write_text, figure_png
+from ...model import ArmModel
+from ...planning.jump import (
+    JumpAtTime,
+    JumpScenario,
+    JumpStudy,
+    LimitReport,
+    Trajectory,
+    Verification,
+    simulate,
+)
+from ...plots._common import offscreen_figure
+from ...plots.jump import (
+    KAPPA_UNIT,
+    plot_joint_rates,
+    plot_jump_vs_failure_time,
+    plot_kappa_fit,
+    plot_objective_vs_kappa,
+    plot_position_deviation,
+)
+from .._common import JobResult
+from ._text import summary_lines
+
+Mode = Literal["fail_at", "sweep", "constant"]
+
+#: Names of the figures ``write`` draws (PNG files in the output folder).
+FIG_OBJECTIVE = "fig5_objective_vs_kappa.png"
+FIG_JOINT_RATES = "fig6_joint_velocities.png"
+FIG_DEVIATION = "fig7_position_deviation.png"
+FIG_KAPPA_FIT = "fig8_kappa_fit.png"
+FIG_JUMP = "fig9_jump_vs_failure_time.png"
+
+
+@dataclass(frozen=True, eq=False)
+class JumpJobResult(JobResult):
+    """Result of :func:`run_jump_study` (one of its three modes).
+
+    Attributes
+    ----------
+    mode
+        ``"fail_at"`` (one failure time), ``"sweep"`` (sampled failure times, fitted kappa(t),
+        verification) or ``"constant"`` (a constant kappa verified at every step; its JSON says
+        ``"mode": "sweep"``, as the command's does).
+    model
+        The arm (free-floating when ``task.base == "floating"``).
+    task
+        The task, the joint that locks and the limits (SI units, radians).
+    at_time
+        ``fail_at``: the metrics at the failure time (:class:`JumpAtTime`; its ``search`` is
+        ``None`` when kappa was given).
+    study
+        ``sweep``: search, fit, verification and fixed verification (:class:`JumpStudy`).
+    verification
+        ``sweep`` and ``constant``: kappa(t) (or the constant) checked with the failure at every
+        control step (:class:`Verification`).
+    kappa
+        The given constant kappa [rad^2/(s m^3)] (``fail_at`` with a given kappa, ``constant``);
+        ``None`` when it was searched.
+    """
+
+    job: ClassVar[str] = "jump"
+
+    mode: Mode
+    model: ArmModel
+    task: JumpScenario
+    at_time: JumpAtTime | None = None
+    study: JumpStudy | None = None
+    verification: Verification | None = None
+    kappa: float | None = None
+
+    @property
+    def kappa_given(self) -> bool:
+        """kappa was given, not searched."""
+        return self.kappa is not None
+
+    def to_dict(self) -> dict[str, Any]:
+        """The JSON object of ``jointlock jump --json`` (jumps in rad/s, as the keys say)."""
+        robot, sc = self.model.name, self.task
+        if self.mode == "fail_at":
+            assert self.at_time is not None
+            return _single_json(robot, sc, self.at_time)
+        assert self.verification is not None
+        if self.mode == "constant":
+            assert self.kappa is not None
+            return _constant_json(robot, sc, self.kappa, self.verification)
+        assert self.study is not None
+        return _study_json(robot, sc, self.study)
+
+    def summary(self) -> list[str]:
+        """The lines ``jointlock jump`` prints (jumps in deg/s)."""
+        return summary_lines(self.to_dict(), kappa_given=self.kappa_given)
+
+    def runs(self) -> tuple[Trajectory, Trajectory, float]:
+        """The runs of the figures: the failure with kappa = 0 and with the compensation, and
+        the failure time [s] (``fail_at``: the failure time and kappa used; otherwise the
+        verified schedule with the failure at the control step nearest the task's middle)."""
+        sc = self.task
+        if self.mode == "fail_at":
+            assert self.at_time is not None
+            kappa: Any = self.at_time.kappa
+            t_fail = self.at_time.fail_time
+        else:
+            assert self.verification is not None
+            kappa = self.verification.kappa
+            t_fail = float(np.round(sc.duration / 2 / sc.dt) * sc.dt)
+        r0 = simulate(self.model, sc, 0.0, failures=[(sc.lock_joint, t_fail)])
+        r1 = simulate(self.model, sc, kappa, failures=[(sc.lock_joint, t_fail)])
+        return r0, r1, t_fail
+
+    def write(self, out: str | Path) -> list[str]:
+        """Write ``results.json`` (:meth:`to_dict`), ``verification.csv`` (sweep and constant
+        modes) and the figures (PNG) into the folder ``out``; returns the names written."""
+        out = Path(out)
+        atomic_write_json(out / "results.json", self.to_dict())
+        names = ["results.json"]
+        if self.mode == "fail_at":
+            res = self.at_time
+            assert res is not None
+            if res.search is not None:
+                ax = plot_objective_vs_kappa(res.search, 0, title=f"failure at {res.fail_time:g} s", ax=_axes())
+                names.append(_save(out, FIG_OBJECTIVE, ax.figure))
+            return names + self._write_runs(out)
+        ver = self.verification
+        assert ver is not None
+        atomic_write_text(out / "verification.csv", verification_csv(ver))
+        names.append("verification.csv")
+        st = self.study
+        if st is not None:
+            s = st.search
+            mid = int(np.argmin(np.abs(s.fail_times - self.task.duration / 2)))
+            ax = plot_objective_vs_kappa(s, mid, title=f"failure at {s.fail_times[mid]:g} s", ax=_axes())
+            names.append(_save(out, FIG_OBJECTIVE, ax.figure))
+            ax = plot_kappa_fit(s, st.fit, self.task.duration, ax=_axes())
+            names.append(_save(out, FIG_KAPPA_FIT, ax.figure))
+        names += self._write_runs(out)
+        fixed = st.verification_fixed if st is not None else None
+        ax = plot_jump_vs_failure_time(ver, fixed, ax=_axes((7, 3.6)))
+        names.append(_save(out, FIG_JUMP, ax.figure))
+        return names
+
+    def _write_runs(self, out: Path) -> list[str]:
+        """fig6 (joint rates) and fig7 (position deviation) of :meth:`runs`."""
+        r0, r1, t_fail = self.runs()
+        fig = plot_joint_rates(self.model, self.task.lock_joint, r0, r1, t_fail, fig=offscreen_figure((10, 3.6)))
+        names = [_save(out, FIG_JOINT_RATES, fig)]
+        ax = plot_position_deviation(r0, r1, t_fail, self.task.eps, ax=_axes())
+        return names + [_save(out, FIG_DEVIATION, ax.figure)]
+
+
+# -- JSON ----------------------------------------------------------------------------------------
+
+
+def limits_json(rep: LimitReport) -> dict[str, Any]:
+    """A :class:`LimitReport` in the JSON's units (deg/s, deg/s^2, mm)."""
+    return {
+        "ok": rep.ok,
+        "max_velocity_deg_s": math.degrees(rep.max_velocity),
+        "max_acceleration_deg_s2": math.degrees(rep.max_acceleration),
+        "max_deviation_mm": 1e3 * rep.max_deviation,
+        "broken": rep.broken(),
+    }
+
+
+def _ver_json(v: Verification) -> dict:
+    return {
+        "fix": v.fix,
+        "mean_jump_before": float(v.jump_before.mean()),
+        "mean_jump_after": float(v.jump_after.mean()),
+        "mean_reduction": v.mean_reduction,
+        "share_improved": v.share_improved,
+        "limits_ok": v.limits_ok,
+        "healthy_run_ok": v.healthy_ok,
+        "limits": limits_json(v.limits),
+        "broken_failure_times_s": v.broken_steps,
+        "sampled_kappas_kept_limits": v.sampled_limits_ok,
+        "task_jump_replan_max_m_s": v.task_jump_replan_max,
+    }
+
+
+def _ver_series_json(v: Verification) -> dict:
+    """The verification's jumps per failure time, its headline figures and :func:`_ver_json`."""
+    return {
+        "verification_t_s": v.t,
+        "jump_before": v.jump_before,
+        "jump_after": v.jump_after,
+        "mean_reduction": v.mean_reduction,
+        "share_improved": v.share_improved,
+        "limits_ok": v.limits_ok,
+        "verification": _ver_json(v),
+    }
+
+
+def _single_json(robot: str, sc: JumpScenario, r: JumpAtTime) -> dict:
+    return {
+        "robot": robot,
+        "mode": "fail_at",
+        "scenario": sc.to_fields(),
+        "lock_joint": sc.lock_joint,
+        "fail_time_s": r.fail_time,
+        "kappa": r.kappa,
+        "kappa_unit": KAPPA_UNIT,
+        "kappa_interval": r.interval,
+        "jump_before": r.jump_before,
+        "jump_after": r.jump_after,
+        "mean_reduction": r.reduction,
+        "share_improved": float(r.jump_after < r.jump_before),
+        "limits_ok": r.limits_after.ok,
+        "joint_jump_before_rad_s": r.joint_jump_before,
+        "joint_jump_after_rad_s": r.joint_jump_after,
+        "joint_jump_noreplan_before": r.joint_jump_noreplan_before,
+        "joint_jump_noreplan_after": r.joint_jump_noreplan_after,
+        "task_jump_noreplan_before_m_s": r.task_jump_noreplan_before,
+        "task_jump_noreplan_after_m_s": r.task_jump_noreplan_after,
+        "task_jump_replan_before_m_s": r.task_jump_replan_before,
+        "task_jump_replan_after_m_s": r.task_jump_replan_after,
+        "limits_before": limits_json(r.limits_before),
+        "limits_after": limits_json(r.limits_after),
+    }
+
+
+def _study_json(robot: str, sc: JumpScenario, st: JumpStudy) -> dict:
+    s, f, v = st.search, st.fit, st.verification
+    out = {
+        "robot": robot,
+        "mode": "sweep",
+        "scenario": sc.to_fields(),
+        "lock_joint": sc.lock_joint,
+        "fail_times_s": s.fail_times,
+        "kappa": s.kappa_opt,
+        "kappa_unit": KAPPA_UNIT,
+        "kappa_interval": s.interval,
+        "objective_opt": s.objective_opt,
+        "objective_zero": s.objective_zero,
+        "kappa_fit": {
+            "order": f.order,
+            "coefficients_tau": f.coefficients,
+            "tau": "t / duration_s",
+            "ssr": f.ssr,
+            "threshold": f.threshold,
+            "accepted": f.accepted,
+            "segment_points_s": f.segment_points,
+            "breaks_s": f.breaks,
+            "segments": [{"start_s": a, "end_s": b, "decision": d} for a, b, d in f.segments],
+            "pieces": [
+                {
+                    "start_s": pc.start,
+                    "end_s": pc.end,
+                    "order": pc.order,
+                    "coefficients_u": pc.coefficients,
+                    "u": f"(t - {pc.center:.6g}) / {pc.half_width:.6g}",
+                    "ssr": pc.ssr,
+                    "threshold": pc.threshold,
+                    "accepted": pc.accepted,
+                    "n_samples": pc.n_samples,
+                    "source": pc.source,
+                }
+                for pc in (f.pieces or ())
+            ],
+        },
+        **_ver_series_json(v),
+        "elapsed_s": st.elapsed,
+    }
+    if st.verification_fixed is not None:
+        out["verification_fixed"] = _ver_json(st.verification_fixed)
+    return out
+
+
+def _constant_json(robot: str, sc: JumpScenario, kappa: float, v: Verification) -> dict:
+    return {
+        "robot": robot,
+        "mode": "sweep",
+        "scenario": sc.to_fields(),
+        "lock_joint": sc.lock_joint,
+        "kappa": kappa,
+        "kappa_unit": KAPPA_UNIT,
+        **_ver_series_json(v),
+    }
+
+
+# -- files ---------------------------------------------------------------------------------------
+
+
+def verification_csv(ver: Verification) -> str:
+    """``verification.csv``: per failure time, kappa used, jumps before/after [rad/s], limits kept."""
+    rows = ["t_fail_s,kappa,jump_before_rad_s,jump_after_rad_s,limits_ok"]
+    rows += [
+        f"{t:.6g},{k:.9g},{b:.9g},{a:.9g},{int(ok)}"
+        for t, k, b, a, ok in zip(ver.t, ver.kappa, ver.jump_before, ver.jump_after, ver.limits_ok_per_step)
+    ]
+    return "\n".join(rows) + "\n"
+
+
+def _axes(figsize: tuple[float, float] = (6, 3.6)) -> Any:
+    """One axis on a new off-screen figure (no pyplot)."""
+    return offscreen_figure(figsize).add_subplot()
+
+
+def _save(out: Path, name: str, fig: Any) -> str:
+    atomic_write_bytes(out / name, figure_png(fig))
+    return name

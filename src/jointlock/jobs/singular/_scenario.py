@@ -1,0 +1,64 @@
+"""The ``[singular]`` job of a scenario: :func:`singular_from_scenario` runs one of the three
+modes."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from typing import Any
+
+from .._common import JobResult, joint_vector_deg
+from ._search import SingularitySearchResult, search_singularities
+from ._shared import SEARCH_SAMPLES, VERIFY_SAMPLES, singular_model
+from ._study import SingularityResult, study_singularity
+from ._verify import ConditionVerificationResult, verify_singularity_conditions
+
+#: What :func:`singular_from_scenario` returns, by mode.
+SingularJobResult = SingularityResult | ConditionVerificationResult | SingularitySearchResult
+
+
+def singular_from_scenario(
+    data: Mapping[str, Any], previous: Mapping[str, JobResult], *, progress: bool = False
+) -> SingularJobResult:
+    """The ``[singular]`` job of a resolved scenario (``Scenario.data``, file units).
+
+    ``singular.verify_conditions`` -> :func:`verify_singularity_conditions`, else
+    ``singular.search`` -> :func:`search_singularities`, else :func:`study_singularity` at
+    ``singular.q_deg`` (zeros when not given).  The robot, the failure (locked joint) and
+    ``seed`` come from the top level; ``singular.base`` (already inherited from the top-level
+    ``base`` when the file gives one) defaults to virtual with ``verify_conditions`` and fixed
+    otherwise; ``singular.samples`` to 2000 (verification) or 512 (search).  ``previous`` is
+    not used.
+    """
+    t = data["singular"]
+    fail = data.get("failure") or {}
+    locks = {}
+    if fail.get("joint") is not None and fail.get("angle_deg") is not None:
+        locks = {int(fail["joint"]): math.radians(float(fail["angle_deg"]))}
+    verify = bool(t["verify_conditions"])
+    base = t["base"] or ("virtual" if verify else "fixed")
+    model = singular_model(data["robot"], locks, base)
+    weighting, seed, samples = t["weighting"], int(data["seed"]), t["samples"]
+    length = None if t["length"] is None else float(t["length"])
+    if verify:
+        return verify_singularity_conditions(
+            model,
+            samples=int(samples or VERIFY_SAMPLES),
+            rng=seed,
+            base=base,
+            weighting=weighting,
+            tol=float(t["tol"]),
+            progress=progress,
+        )
+    if t["search"]:
+        return search_singularities(
+            model,
+            samples=int(samples or SEARCH_SAMPLES),
+            rng=seed,
+            base=base,
+            weighting=weighting,
+            length=length,
+            progress=progress,
+        )
+    q = joint_vector_deg(model, t["q_deg"], "singular.q_deg")
+    return study_singularity(model, q, base=base, weighting=weighting, tol=float(t["tol"]), length=length)

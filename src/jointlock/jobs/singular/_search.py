@@ -1,0 +1,226 @@
+"""The search for singular configurations (``jointlock singular --search``):
+:func:`search_singularities` and its :class:`SingularitySearchResult` (with the figures of
+``--out``)."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any, ClassVar
+
+import numpy as np
+
+from ..._random import resolve_seed
+from ...analysis import singularity as sg
+from ...io.files import atomic_write_bytes, atomic_write_json, figure_png
+from ...kinematics import VMWeighting
+from ...model import ArmModel
+from ...plots._common import offscreen_figure
+from ...plots.singular import (
+    SIGMA_MIN_FIGSIZE,
+    families_figsize,
+    joint_angles_figsize,
+    plot_family_joint_angles,
+    plot_search_sigma_min,
+    plot_singular_families,
+)
+from ...progress import Progress
+from .._common import JobResult, locked_deg, locked_text
+from ._shared import (
+    SEARCH_MAX_ITER,
+    SEARCH_SAMPLES,
+    WEIGHTINGS,
+    Rng,
+    _check_choice,
+    _check_samples,
+    _condition_lengths,
+)
+
+
+@dataclass(frozen=True)
+class SingularitySearchResult(JobResult):
+    """Result of :func:`search_singularities` (``jointlock singular ROBOT --search``).
+
+    Attributes
+    ----------
+    model
+        The arm searched.
+    search
+        Starts, where they ended, the singular configurations found and their families
+        (seed, tolerance and Jacobian settings inside).
+    family_conditions
+        For a full Canadarm2-structure arm (fixed or virtual Jacobian): per family,
+        ``{condition: members satisfying it}`` over Cond1-Cond5 and cond1f; else ``None``.
+    """
+
+    job: ClassVar[str] = "singular"
+
+    model: ArmModel
+    search: sg.SingularitySearch
+    family_conditions: tuple[dict[str, int], ...] | None
+
+    def _families(self) -> list[dict[str, Any]]:
+        families = []
+        for i, fam in enumerate(self.search.families):
+            entry: dict[str, Any] = {
+                "label": fam.label,
+                "size": len(fam.members),
+                "zero_sine_joints": list(fam.zero_sine_joints),
+                "dependent_joints": list(fam.dependent_joints),
+                "representative_q_deg": np.degrees(fam.representative),
+                "sigma_min": fam.sigma_min,
+                "lost_direction_base": fam.lost_direction,
+                "lost_direction_ee": fam.lost_direction_ee,
+            }
+            if self.family_conditions is not None:
+                entry["conditions"] = dict(self.family_conditions[i])
+            families.append(entry)
+        return families
+
+    def search_json(self) -> dict[str, Any]:
+        """The content of ``search.json``: :meth:`to_dict` without ``found``, with every
+        configuration found (``q_deg`` (m, n) [deg]) and its ``sigma_min`` (m,)."""
+        res, model = self.search, self.model
+        return {
+            "robot": model.name,
+            "base": res.base,
+            "joint_numbers": list(model.joint_numbers),
+            "locked": locked_deg(model),
+            "seed": res.seed,
+            "starts": len(res.q_start),
+            "converged": int(res.converged.sum()),
+            "iterations": res.iterations,
+            "tol": res.tol,
+            "families": self._families(),
+            "q_deg": np.degrees(res.q),
+            "sigma_min": res.sigma_min,
+        }
+
+    def to_dict(self, files: Sequence[str | Path] | None = None) -> dict[str, Any]:
+        """The JSON of ``jointlock singular --search --json``.  ``files``: the paths
+        :meth:`write` wrote, listed under ``"files"`` as the command does with ``--out``."""
+        out = {k: v for k, v in self.search_json().items() if k not in ("q_deg", "sigma_min")}
+        if files is not None:
+            out["files"] = [str(f) for f in files]
+        return out | {"found": len(self.search.q)}
+
+    def summary(self) -> list[str]:
+        res, model = self.search, self.model
+        families = self._families()
+        lines = [
+            f"{model.name}: {model.dof} movable joints {list(model.joint_numbers)}, locked: "
+            f"{locked_text(locked_deg(model))}, Jacobian {res.base}",
+            f"{len(res.q_start)} starts (seed {res.seed}): {int(res.converged.sum())} converged to "
+            f"sigma_min < {res.tol:g} in {res.iterations} iterations; {len(families)} families",
+        ]
+        for i, fam in enumerate(families, 1):
+            lines += [
+                "",
+                f"{i:2d}. {fam['label']}  ({fam['size']} configurations)",
+                "    representative q [deg]: "
+                + ", ".join(
+                    f"q{j}={v:.2f}" for j, v in zip(model.joint_numbers, fam["representative_q_deg"])
+                ),
+                "    lost direction (ee frame vx vy vz wx wy wz): "
+                + np.array2string(np.asarray(fam["lost_direction_ee"]), precision=3, suppress_small=True),
+            ]
+            if "conditions" in fam:
+                held = ", ".join(f"{k}: {v}" for k, v in fam["conditions"].items() if v) or "none"
+                lines.append("    004 conditions held: " + held)
+        return lines
+
+    def file_names(self) -> list[str]:
+        """The names :meth:`write` writes."""
+        return ["search.json", "sigma_min.png"] + (["families.png", "joint_angles.png"] if self.search.families else [])
+
+    def write(self, out: str | Path) -> list[str]:
+        """``search.json`` (:meth:`search_json`), ``sigma_min.png`` and, when the search found
+        families, ``families.png`` and ``joint_angles.png``; returns their names."""
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write_json(out / "search.json", self.search_json())
+        names = ["search.json"]
+        fig = offscreen_figure(SIGMA_MIN_FIGSIZE)
+        plot_search_sigma_min(self.model, self.search, ax=fig.add_subplot())
+        atomic_write_bytes(out / "sigma_min.png", figure_png(fig))
+        names.append("sigma_min.png")
+        if self.search.families:
+            fig = plot_singular_families(
+                self.model, self.search, fig=offscreen_figure(families_figsize(self.search))
+            )
+            atomic_write_bytes(out / "families.png", figure_png(fig))
+            fig = plot_family_joint_angles(
+                self.model, self.search, fig=offscreen_figure(joint_angles_figsize(self.model))
+            )
+            atomic_write_bytes(out / "joint_angles.png", figure_png(fig))
+            names += ["families.png", "joint_angles.png"]
+        return names
+
+
+def search_singularities(
+    model: ArmModel,
+    *,
+    samples: int = SEARCH_SAMPLES,
+    rng: Rng = 0,
+    base: sg.BaseKind = "fixed",
+    weighting: VMWeighting = "segment",
+    length: float | None = None,
+    tol: float = sg.SEARCH_TOL,
+    max_iter: int = SEARCH_MAX_ITER,
+    progress: bool = False,
+) -> SingularitySearchResult:
+    """Search ``model`` for singular configurations and cluster them into families
+    (``jointlock singular --search``).
+
+    Parameters
+    ----------
+    model
+        Any arm (locked joints allowed); ``base="floating"``/``"virtual"`` need a free-floating one.
+    samples
+        Number of seeded starts, uniform within the joint limits (capped to +-pi).
+    rng
+        Seed or Generator (``None``: a fresh seed, recorded in the result).
+    base, weighting, length
+        The Jacobian (see :func:`study_singularity`).
+    tol
+        A start has converged when its sigma_min falls below this (the command uses the
+        default, :data:`jointlock.analysis.singularity.SEARCH_TOL`, whatever ``--tol`` says).
+    max_iter
+        Gauss-Newton iterations.
+    progress
+        Show a progress bar on stderr.
+
+    Returns
+    -------
+    SingularitySearchResult
+        With the 004 conditions each family's members satisfy when ``model`` is a full
+        Canadarm2-structure arm and ``base`` is fixed or virtual.
+    """
+    _check_choice("base", base, sg.BASE_KINDS)
+    _check_choice("weighting", weighting, WEIGHTINGS)
+    _check_samples(samples)
+    seed = resolve_seed(rng)  # None: a fresh seed, recorded in the result
+    with Progress(max_iter, "searching", enabled=progress) as bar:
+        res = sg.find_singularities(
+            model,
+            samples=samples,
+            rng=seed,
+            base=base,
+            weighting=weighting,
+            tol=tol,
+            max_iter=max_iter,
+            length=length,
+            progress=bar,
+        )
+    lengths = _condition_lengths(model, base, weighting)
+    family_conditions = None
+    if lengths is not None:
+        family_conditions = tuple(
+            {
+                k: int(v.sum())
+                for k, v in sg.conditions_hold(res.q[fam.members], lengths, refined=True).items()
+            }
+            for fam in res.families
+        )
+    return SingularitySearchResult(model=model, search=res, family_conditions=family_conditions)
