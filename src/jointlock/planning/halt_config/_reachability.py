@@ -10,6 +10,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._search1d import bisect_boundary
 from ...errors import ConfigurationError, InfeasibleError
 from ...model import ArmModel, FloatArray
 from ..halt_motion import LIMIT_RTOL, AffineKBounds, KIntervalBatch
@@ -236,11 +237,7 @@ class HaltReachability:
         t = max(t_stop, step)
         while t <= t_max + 1e-9:
             if ok(t):
-                a, b = prev, t
-                while b - a > tol:
-                    mid = 0.5 * (a + b)
-                    a, b = (a, mid) if ok(mid) else (mid, b)
-                return b
+                return float(bisect_boundary(lambda x: ok(float(x)), prev, t, xtol=tol).true_end)
             prev, t = t, t + step
         return None
 
