@@ -19,9 +19,9 @@ out = Path(sys.argv[1] if len(sys.argv) > 1 else "out/singular_004_py")
 
 arm = jl.load_robot("canadarm7", base="floating")
 
-at_q = study_singularity(arm, np.radians([10, 40, -70, 100, -60, 30, 20]), base="virtual")
+at_q = study_singularity(arm, np.radians([10, 40, -70, 100, -60, 30, 20]), jacobian="virtual")
 conditions = verify_singularity_conditions(arm, samples=200, rng=0)
-search = search_singularities(arm, samples=64, rng=0, base="floating")
+search = search_singularities(arm, samples=64, rng=0, jacobian="generalized")
 
 for result in (at_q, conditions, search):
     for line in result.summary():

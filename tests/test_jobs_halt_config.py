@@ -79,6 +79,7 @@ def results() -> dict[str, HaltConfigurationStudy]:
         if reach is not None:
             state = FailureState(np.radians(Q0), np.radians(DQ0), np.radians(DDQ0))
             settings = ReachabilitySettings(state, 10.0, method=reach[0], per_joint_k=reach[1])
+        kw = {"characteristic_length" if k == "length" else k: v for k, v in kw.items()}  # current name
         out[name] = study_halt_configuration(model, samples=SAMPLES, rng=3, reachability=settings, **kw)
     return out
 
@@ -165,7 +166,7 @@ def test_library_checks_its_own_inputs():
     with pytest.raises(jl.ConfigurationError, match="samples must be an integer >= 2"):
         study_halt_configuration(model, samples=1)
     with pytest.raises(jl.ConfigurationError, match="length must be a finite length > 0"):
-        study_halt_configuration(model, samples=10, length=0.0)
+        study_halt_configuration(model, samples=10, characteristic_length=0.0)
     with pytest.raises(jl.ScenarioError, match="needs one value or 6 values"):
         study_halt_configuration(
             model, samples=10, reachability=ReachabilitySettings(state, 10.0), vmax_deg=[1, 2]

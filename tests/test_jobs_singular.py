@@ -93,7 +93,8 @@ def _single(name: str) -> SingularityResult:
     base = kw.get("base", "fixed")
     model = singular_model(robot, locks, base)
     q = np.radians(kw.pop("q_deg")) if "q_deg" in kw else np.zeros(model.dof)
-    return study_singularity(model, q, **kw)
+    renamed = {"base": "jacobian", "length": "characteristic_length"}  # the keywords' current names
+    return study_singularity(model, q, **{renamed.get(k, k): v for k, v in kw.items()})
 
 
 def _search(name: str) -> SingularitySearchResult:
@@ -175,8 +176,8 @@ def test_verification_summary_equals_the_command_text(verification):
 
 def test_verification_checks_its_own_inputs():
     model = singular_model("canadarm7", None, "virtual")
-    with pytest.raises(Exception, match="base must be 'virtual'"):
-        verify_singularity_conditions(model, base="floating")  # type: ignore[arg-type]
+    with pytest.raises(Exception, match="jacobian must be 'virtual'"):
+        verify_singularity_conditions(model, jacobian="floating")  # type: ignore[arg-type]
     with pytest.raises(Exception, match="samples must be an integer >= 1"):
         verify_singularity_conditions(model, samples=0)
 

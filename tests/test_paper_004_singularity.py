@@ -70,7 +70,7 @@ def test_table3_configurations_are_singular(arm, lengths, name):
     q = solve_table3(name, lengths)
     assert sg.condition_residuals(q, lengths)[name] < 1e-12
     assert abs(np.degrees(q) - TABLE3_DEG[name]).max() < 0.8  # only the rounding moved
-    res = sg.analyse_singularity(arm, q, base="virtual")
+    res = sg.analyse_singularity(arm, q, jacobian="virtual")
     assert abs(res.det_jjt) < DET_SINGULAR
     assert abs(TABLE3_DET[name]) < DET_SINGULAR
     assert res.rank == 5
@@ -85,12 +85,12 @@ def test_table3_solved_angles(lengths):
 
 @pytest.mark.parametrize("name", ["cond3", "cond4", "cond5"])
 def test_table3_printed_rounded_angles_are_only_near_singular(arm, name):
-    res = sg.analyse_singularity(arm, np.radians(TABLE3_DEG[name]), base="virtual")
+    res = sg.analyse_singularity(arm, np.radians(TABLE3_DEG[name]), jacobian="virtual")
     assert 1e-6 < res.sigma_min < 1e-2 and res.rank == 6
 
 
 def test_random_configurations_are_not_singular(arm, rng):
-    res = sg.analyse_singularity(arm, rng.uniform(-np.pi, np.pi, (2000, 7)), base="virtual")
+    res = sg.analyse_singularity(arm, rng.uniform(-np.pi, np.pi, (2000, 7)), jacobian="virtual")
     assert np.abs(res.det_jjt).min() > 1e3 * DET_SINGULAR
     assert not res.singular.any()
 
@@ -98,15 +98,15 @@ def test_random_configurations_are_not_singular(arm, rng):
 @pytest.mark.parametrize("base", ["fixed", "virtual"])
 def test_reference_jacobian_is_eq15_and_eq24_has_the_zero_block(rng, base):
     arm = jl.load_robot("canadarm7", base="floating" if base == "virtual" else "fixed")
-    lg = sg.arm_lengths(arm, base=base)
+    lg = sg.arm_lengths(arm, jacobian=base)
     q = rng.uniform(-np.pi, np.pi, (50, 7))
-    ref = sg.reference_jacobian(arm, q, base=base)
+    ref = sg.reference_jacobian(arm, q, jacobian=base)
     np.testing.assert_allclose(ref, sg.eq15_jacobian(q, lg), atol=1e-12)
     part = sg.reorder_eq24(ref)
     assert np.abs(part.zero).max() < 1e-12
     np.testing.assert_allclose(np.linalg.det(part.j12), lg.d * lg.e * np.sin(q[:, 3]), atol=1e-12)
     # same singularities as the inertial-frame Jacobian: same det(J J^T), same rank
-    inertial = sg.analyse_singularity(arm, q, base=base)
+    inertial = sg.analyse_singularity(arm, q, jacobian=base)
     reordered = sg.singularity_of_jacobian(part.matrix)
     np.testing.assert_allclose(reordered.det_jjt, inertial.det_jjt, rtol=1e-9)
     np.testing.assert_array_equal(reordered.rank, inertial.rank)
@@ -118,7 +118,7 @@ def test_reordering_preserves_rank_at_singular_configurations(arm, lengths):
     q = np.concatenate([sg.sample_condition(c, 20, lengths, rng=5) for c in sg.CONDITIONS[1:]])
     part = sg.reorder_eq24(sg.reference_jacobian(arm, q))
     np.testing.assert_array_equal(
-        sg.singularity_of_jacobian(part.matrix).rank, sg.analyse_singularity(arm, q, base="virtual").rank
+        sg.singularity_of_jacobian(part.matrix).rank, sg.analyse_singularity(arm, q, jacobian="virtual").rank
     )
 
 
@@ -157,6 +157,6 @@ def test_analytic_directions_are_in_eq24_order_not_ref(arm, lengths):
 
 def test_cond1_extra_factor_separates_singular_from_regular(arm, lengths):
     q = sg.sample_condition("cond1", 500, lengths, rng=8)
-    res = sg.analyse_singularity(arm, q, base="virtual")
+    res = sg.analyse_singularity(arm, q, jacobian="virtual")
     f = np.abs(sg.cond1_extra(q, lengths))
     assert not res.singular.any() and f.min() > 1e-8

@@ -24,10 +24,10 @@ def test_batched_analysis_equals_loop(rng):
     model = jl.load_robot("halt7", base="floating")
     q = random_q(model, rng, (4, 3))
     for base in sg.BASE_KINDS:
-        batch = sg.analyse_singularity(model, q, base=base)
+        batch = sg.analyse_singularity(model, q, jacobian=base)
         assert batch.singular_values.shape == (4, 3, 6)
         for idx in np.ndindex(4, 3):
-            one = sg.analyse_singularity(model, q[idx], base=base)
+            one = sg.analyse_singularity(model, q[idx], jacobian=base)
             np.testing.assert_allclose(batch.singular_values[idx], one.singular_values, atol=EXACT_ATOL)
             assert batch.det_jjt[idx] == pytest.approx(float(one.det_jjt), rel=1e-9)
             assert batch.rank[idx] == one.rank
@@ -36,13 +36,13 @@ def test_batched_analysis_equals_loop(rng):
 def test_task_jacobians_are_the_kinematics_ones(rng):
     model = jl.load_robot("canadarm7", base="floating")
     q = random_q(model, rng, (3,))
-    np.testing.assert_allclose(sg.task_jacobian(model, q, base="fixed"), jl.jacobian(model, q))
-    np.testing.assert_allclose(sg.task_jacobian(model, q, base="floating"), jl.generalized_jacobian(model, q))
+    np.testing.assert_allclose(sg.task_jacobian(model, q, jacobian="fixed"), jl.jacobian(model, q))
+    np.testing.assert_allclose(sg.task_jacobian(model, q, jacobian="floating"), jl.generalized_jacobian(model, q))
     np.testing.assert_allclose(
-        sg.task_jacobian(model, q, base="virtual", weighting="vafa-dubowsky"),
+        sg.task_jacobian(model, q, jacobian="virtual", weighting="vafa-dubowsky"),
         jl.virtual_manipulator(model, q).jacobian,
     )
-    scaled = sg.task_jacobian(model, q, length=2.0)
+    scaled = sg.task_jacobian(model, q, characteristic_length=2.0)
     np.testing.assert_allclose(scaled[:, :3], jl.jacobian(model, q)[:, :3] / 2.0)
 
 
@@ -110,9 +110,9 @@ def test_search_finds_puma_wrist_family_and_is_reproducible():
 @pytest.mark.parametrize("base", ["fixed", "floating"])
 def test_search_finds_halt7_singularities(base):
     model = jl.load_robot("halt7", base=base)
-    res = sg.find_singularities(model, samples=48, rng=1, base=base)
+    res = sg.find_singularities(model, samples=48, rng=1, jacobian=base)
     assert len(res.q) >= 10
-    ana = sg.analyse_singularity(model, res.q, base=base, tol=1e-8)
+    ana = sg.analyse_singularity(model, res.q, jacobian=base, tol=1e-8)
     assert ana.singular.all()
     jac = ana.jacobian
     u = ana.directions[..., :, 5]
@@ -121,15 +121,15 @@ def test_search_finds_halt7_singularities(base):
 
 def test_errors_are_precise():
     with pytest.raises(jl.ModelError, match="free-floating"):
-        sg.task_jacobian(jl.load_robot("puma6"), np.zeros(6), base="virtual")
-    with pytest.raises(jl.ScenarioError, match="base must be one of"):
-        sg.analyse_singularity(jl.load_robot("puma6"), np.zeros(6), base="moving")  # type: ignore[arg-type]
+        sg.task_jacobian(jl.load_robot("puma6"), np.zeros(6), jacobian="virtual")
+    with pytest.raises(jl.ScenarioError, match="jacobian must be one of"):
+        sg.analyse_singularity(jl.load_robot("puma6"), np.zeros(6), jacobian="moving")  # type: ignore[arg-type]
     with pytest.raises(jl.ModelError, match="7-joint"):
-        sg.arm_lengths(jl.load_robot("puma6"), base="fixed")
+        sg.arm_lengths(jl.load_robot("puma6"), jacobian="fixed")
     with pytest.raises(jl.ModelError, match="not a Canadarm2-structure"):
-        sg.arm_lengths(jl.load_robot("halt7"), base="fixed")
+        sg.arm_lengths(jl.load_robot("halt7"), jacobian="fixed")
     with pytest.raises(jl.ScenarioError, match="condition must be one of"):
-        sg.sample_condition("cond9", 3, sg.arm_lengths(jl.load_robot("canadarm7"), base="fixed"))
+        sg.sample_condition("cond9", 3, sg.arm_lengths(jl.load_robot("canadarm7"), jacobian="fixed"))
 
 
 def _cli_json(capsys, argv):

@@ -147,7 +147,7 @@ def run(args: argparse.Namespace) -> int:
         assignment=args.assignment,
         renormalize=args.renormalize,
         refine=not args.no_refine,
-        length=args.length,
+        characteristic_length=args.length,
         reachability=_reachability(args, model),
         vmax_deg=args.vmax_deg,
         amax_deg=args.amax_deg,

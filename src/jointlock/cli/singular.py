@@ -120,7 +120,7 @@ def run(args: argparse.Namespace) -> int:
             _model(args, base),
             samples=args.samples or VERIFY_SAMPLES,
             rng=args.seed,
-            base=base,
+            jacobian=base,
             weighting=args.weighting,
             tol=args.tol,
             progress=_progress(args),
@@ -131,9 +131,9 @@ def run(args: argparse.Namespace) -> int:
             _model(args, base),
             samples=args.samples or SEARCH_SAMPLES,
             rng=args.seed,
-            base=base,
+            jacobian=base,
             weighting=args.weighting,
-            length=args.length,
+            characteristic_length=args.length,
             progress=_progress(args),
         )
     else:
@@ -141,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
         model = _model(args, base)
         q = joint_vector_deg(model, args.q_deg, "--q-deg")
         result = study_singularity(
-            model, q, base=base, weighting=args.weighting, tol=args.tol, length=args.length
+            model, q, jacobian=base, weighting=args.weighting, tol=args.tol, characteristic_length=args.length
         )
     files: list[Path] = []
     if args.out is not None and isinstance(result, SingularitySearchResult):  # --out is for --search

@@ -20,6 +20,7 @@ from typing import Any, ClassVar, Literal
 
 import numpy as np
 
+from .._deprecate import renamed_keyword
 from ..analysis.ability import INDEX_NAMES, Assignment, JacobianKind
 from ..errors import ConfigurationError
 from ..io.files import atomic_write_bytes, atomic_write_json, figure_png
@@ -264,6 +265,7 @@ def _fmt_q(q: np.ndarray) -> str:
     return "[" + ", ".join(f"{v:8.3f}" for v in np.degrees(q)) + "]"
 
 
+@renamed_keyword(old="length", new="characteristic_length")
 def study_halt_configuration(
     model: ArmModel,
     *,
@@ -273,7 +275,7 @@ def study_halt_configuration(
     assignment: Assignment = "equation",
     renormalize: bool = False,
     refine: bool = True,
-    length: float | None = None,
+    characteristic_length: float | None = None,
     reachability: ReachabilitySettings | None = None,
     vmax_deg: float | list[float] | None = None,
     amax_deg: float | list[float] | None = None,
@@ -301,8 +303,9 @@ def study_halt_configuration(
         Divide the combined weights by their sum (000 eq. 18 does not).
     refine
         Polish the best samples locally (False: plain Monte Carlo, as 000).
-    length
-        Characteristic length ``L`` [m] dividing the Jacobian's linear rows; None: raw (000).
+    characteristic_length
+        ``L`` [m] dividing the Jacobian's linear rows; None: raw (000).  Formerly ``length=`` (a
+        deprecated alias).
     reachability
         Keep to configurations reachable from the state at failure within ``T``; None: the
         whole joint ranges (000).
@@ -331,8 +334,9 @@ def study_halt_configuration(
         raise ConfigurationError(
             "study_halt_configuration needs a locked model (jointlock.lock(model, J, angle))"
         )
+    length = characteristic_length
     if length is not None and not (math.isfinite(length) and length > 0):
-        raise ConfigurationError(f"length must be a finite length > 0 [m]; got {length}")
+        raise ConfigurationError(f"characteristic_length must be a finite length > 0 [m]; got {length}")
     if reachability is not None and not isinstance(reachability, ReachabilitySettings):
         raise ConfigurationError(f"reachability must be ReachabilitySettings or None; got {reachability!r}")
     limits = constraint = None
@@ -388,7 +392,7 @@ def halt_config_from_scenario(
         assignment=t["assignment"],
         renormalize=bool(t["renormalize"]),
         refine=not t["no_refine"],
-        length=None if t["length"] is None else float(t["length"]),
+        characteristic_length=None if t["length"] is None else float(t["length"]),
         reachability=reach,
         vmax_deg=lim["vmax_deg"],
         amax_deg=lim["amax_deg"],

@@ -43,7 +43,7 @@ def plot_search_sigma_min(model: ArmModel, search: SingularitySearch, *, ax: Any
     Returns the axis."""
     ax = new_axes(ax, SIGMA_MIN_FIGSIZE)
     start = np.linalg.svd(
-        task_jacobian(model, search.q_start, base=search.base, weighting=search.weighting),  # type: ignore[arg-type]
+        task_jacobian(model, search.q_start, jacobian=search.base, weighting=search.weighting),  # type: ignore[arg-type]
         compute_uv=False,
     )
     bins = np.linspace(-17, 1, 55)

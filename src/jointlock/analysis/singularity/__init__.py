@@ -4,10 +4,11 @@ conditions Cond1-Cond5 of Canadarm2-structure arms checked against the numerical
 
 **General part** (any model, any batch of configurations):
 
-* :func:`task_jacobian` picks the Jacobian whose singularities are studied: ``"fixed"``
-  (geometric Jacobian, :func:`jointlock.jacobian`), ``"floating"`` (generalized Jacobian with
-  zero momentum, :func:`jointlock.generalized_jacobian`) or ``"virtual"`` (the Jacobian
-  ``J^_m`` of the virtual manipulator, 004 eqs. 10-14, :func:`jointlock.virtual_manipulator`).
+* :func:`task_jacobian` picks the Jacobian whose singularities are studied (``jacobian=``):
+  ``"fixed"`` (geometric Jacobian, :func:`jointlock.jacobian`), ``"generalized"`` (or
+  ``"floating"``, the same: generalized Jacobian with zero momentum,
+  :func:`jointlock.generalized_jacobian`) or ``"virtual"`` (the Jacobian ``J^_m`` of the
+  virtual manipulator, 004 eqs. 10-14, :func:`jointlock.virtual_manipulator`).
 * :func:`analyse_singularity` gives sigma_min, the numerical rank (tolerance by argument),
   ``det(J J^T)`` (004's test, Whitney) and the lost task directions: the left singular vectors
   ``u`` whose singular values fell below the tolerance, so that ``J^T u ~ 0``.
@@ -37,8 +38,13 @@ that refined condition ``"cond1f"`` is sufficient.  Every singular configuration
 finds satisfies one of Cond1-Cond5 (the list is complete).
 
 **Units.**  A 6 x n Jacobian mixes m/s and rad/s rows.  As in 004 the raw matrix is used;
-``length=L`` [m] divides the linear rows by ``L`` (``docs/conventions.md``).  Tolerances on
-sigma_min are therefore in the raw matrix's mixed units.
+``characteristic_length=L`` [m] divides the linear rows by ``L`` (``docs/conventions.md``).
+Tolerances on sigma_min are therefore in the raw matrix's mixed units.
+
+**Names** (``docs/conventions.md``, "Names").  The keywords were ``base=`` (which Jacobian)
+and ``length=`` before; both still work as deprecated aliases of ``jacobian=`` and
+``characteristic_length=`` (a ``FutureWarning`` once per process and function).  Result
+fields keep their names (``base``, ``length``).
 
 **Which virtual lengths.**  ``weighting="segment"`` (default here) is 004's formula and
 reproduces its printed virtual lengths and Table 3; ``"vafa-dubowsky"`` is the exact virtual
@@ -79,12 +85,16 @@ from ._canadarm2 import (
 )
 from ._general import (
     BASE_KINDS,
+    JACOBIAN_KINDS,
+    JACOBIAN_SYNONYMS,
     RANK_TOL,
     BaseKind,
     SingularityAnalysis,
+    TaskJacobianKind,
     _check_base,  # noqa: F401
     _rng,  # noqa: F401
     analyse_singularity,
+    jacobian_kind,
     singularity_of_jacobian,
     task_jacobian,
 )
@@ -114,6 +124,8 @@ __all__ = [
     "EQ24_COLS",
     "EQ24_ROWS",
     "EQ24_ROW_NAMES",
+    "JACOBIAN_KINDS",
+    "JACOBIAN_SYNONYMS",
     "RANK_TOL",
     "REFINED_CONDITIONS",
     "SEARCH_TOL",
@@ -126,6 +138,7 @@ __all__ = [
     "SingularFamily",
     "SingularityAnalysis",
     "SingularitySearch",
+    "TaskJacobianKind",
     "analyse_singularity",
     "analytic_directions",
     "arm_lengths",
@@ -136,6 +149,7 @@ __all__ = [
     "conditions_hold",
     "eq15_jacobian",
     "find_singularities",
+    "jacobian_kind",
     "reference_jacobian",
     "reorder_eq24",
     "sample_condition",

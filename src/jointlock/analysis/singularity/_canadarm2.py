@@ -11,8 +11,10 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._deprecate import renamed_keyword
 from ...errors import ConfigurationError, ModelError, ScenarioError
-from ...kinematics import VMWeighting, chain_state, jacobian, virtual_link_vectors, virtual_manipulator
+from ...kinematics import VMWeighting, chain_state, virtual_link_vectors, virtual_manipulator
+from ...kinematics import jacobian as geometric_jacobian
 from ...model import ArmModel, FloatArray
 
 #: A condition holds when its residual (dimensionless, see :func:`condition_residuals`) is
@@ -51,25 +53,27 @@ class ArmLengths:
     k: float
 
 
+@renamed_keyword(old="base", new="jacobian")
 def arm_lengths(
-    model: ArmModel, *, base: Literal["fixed", "virtual"] = "virtual", weighting: VMWeighting = "segment"
+    model: ArmModel, *, jacobian: Literal["fixed", "virtual"] = "virtual", weighting: VMWeighting = "segment"
 ) -> ArmLengths:
-    """Lengths entering eq. (15): the norms of the virtual link vectors (``base="virtual"``,
+    """Lengths entering eq. (15): the norms of the virtual link vectors (``jacobian="virtual"``,
     004 Table 2 with ``weighting="segment"``: 0.38, 0.39, 2.15, 2.33, 0.48, 0.49, 0.5 m on
-    ``canadarm7``) or of the real segments (``"fixed"``)."""
+    ``canadarm7``) or of the real segments (``"fixed"``).  Formerly ``base=`` (a deprecated
+    alias)."""
     _check_canadarm(model)
-    if base == "virtual":
+    if jacobian == "virtual":
         if not model.floating:
             raise ModelError(f"virtual lengths need a free-floating model; {model.name!r} has a fixed base")
         vec = virtual_link_vectors(model, weighting=weighting)
-    elif base != "fixed":
-        raise ScenarioError(f"base must be 'fixed' or 'virtual' for 004's conditions; got {base!r}")
+    elif jacobian != "fixed":
+        raise ScenarioError(f"jacobian must be 'fixed' or 'virtual' for 004's conditions; got {jacobian!r}")
     real = ArmLengths(*(float(x) for x in np.linalg.norm(_real_segments(model), axis=1)))
     probe = np.radians(
         [[10.0, 20.0, 30.0, 40.0, 50.0, 60.0, 70.0], [-35.0, 75.0, -120.0, 150.0, 5.0, -95.0, 0.0]]
     )
     mismatch = float(
-        np.abs(reference_jacobian(model, probe, base="fixed") - eq15_jacobian(probe, real)).max()
+        np.abs(reference_jacobian(model, probe, jacobian="fixed") - eq15_jacobian(probe, real)).max()
     )
     if mismatch > _STRUCTURE_TOL:
         raise ModelError(
@@ -77,7 +81,7 @@ def arm_lengths(
             f"reference point differs from eq. (15) by {mismatch:.3g} (allowed {_STRUCTURE_TOL:g}); see "
             "jointlock.robots.canadarm7 for the frames"
         )
-    if base == "fixed":
+    if jacobian == "fixed":
         return real
     return ArmLengths(*(float(x) for x in np.linalg.norm(vec, axis=1)))
 
@@ -97,24 +101,26 @@ def _check_canadarm(model: ArmModel) -> None:
 
 def _lengths(lengths: ArmLengths | ArmModel) -> ArmLengths:
     if isinstance(lengths, ArmModel):
-        return arm_lengths(lengths, base="virtual" if lengths.floating else "fixed")
+        return arm_lengths(lengths, jacobian="virtual" if lengths.floating else "fixed")
     return lengths
 
 
+@renamed_keyword(old="base", new="jacobian")
 def reference_jacobian(
     model: ArmModel,
     q: ArrayLike,
     *,
-    base: Literal["fixed", "virtual"] = "virtual",
+    jacobian: Literal["fixed", "virtual"] = "virtual",
     weighting: VMWeighting = "segment",
 ) -> FloatArray:
     """Our Jacobian in 004's reference frame and point (the numeric eq. 15).
 
     The twist ``(v, omega)`` of the point where axes 5 and 6 meet (origin of link frame 6,
-    index 5; for ``base="virtual"`` the virtual joint 6) with components in Sigma_ref =
+    index 5; for ``jacobian="virtual"`` the virtual joint 6) with components in Sigma_ref =
     Sigma_4 (orientation of link frame 5, index 4): ``v_ref = v_e + omega x (p_ref - p_e)``,
     then both blocks rotated by ``R_ref^T`` (004 eqs. 16-20; the map has determinant 1, so the
-    singularities are those of ``J^_m``).
+    singularities are those of ``J^_m``).  ``jacobian``: formerly ``base=`` (a deprecated
+    alias).
 
     Returns
     -------
@@ -122,13 +128,14 @@ def reference_jacobian(
     """
     _check_canadarm(model)
     state = chain_state(model, q)
-    if base == "virtual":
+    if jacobian == "virtual":
         vm = virtual_manipulator(model, q, weighting=weighting)
         jac, p_e, p_ref = vm.jacobian, vm.ee_position, vm.joint_positions[..., 5, :]
-    elif base == "fixed":
-        jac, p_e, p_ref = jacobian(model, q, state=state), state.ee_position, state.positions[..., 5, :]
+    elif jacobian == "fixed":
+        jac = geometric_jacobian(model, q, state=state)
+        p_e, p_ref = state.ee_position, state.positions[..., 5, :]
     else:
-        raise ScenarioError(f"base must be 'fixed' or 'virtual' for eq. (15); got {base!r}")
+        raise ScenarioError(f"jacobian must be 'fixed' or 'virtual' for eq. (15); got {jacobian!r}")
     ang = jac[..., 3:, :]
     lin = jac[..., :3, :] + np.swapaxes(
         np.cross(np.swapaxes(ang, -1, -2), (p_ref - p_e)[..., None, :]), -1, -2

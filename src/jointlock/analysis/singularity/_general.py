@@ -10,11 +10,23 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._deprecate import renamed_keyword
 from ..._random import resolve_rng
 from ...errors import ConfigurationError, ModelError, ScenarioError
-from ...kinematics import VMWeighting, generalized_jacobian, jacobian, virtual_manipulator
+from ...kinematics import VMWeighting, generalized_jacobian, virtual_manipulator
+from ...kinematics import jacobian as geometric_jacobian
 from ...model import ArmModel, FloatArray
 
+#: The Jacobians whose singularities are analysed, the keyword ``jacobian=`` (the spelling of
+#: :mod:`jointlock.analysis.ability` and the halt configuration): ``"fixed"`` (geometric),
+#: ``"generalized"`` (zero momentum) and ``"virtual"`` (004's virtual manipulator).
+JACOBIAN_KINDS: tuple[str, ...] = ("fixed", "generalized", "virtual")
+#: Other spellings accepted for a kind: ``"floating"`` is ``"generalized"`` (what
+#: ``jointlock singular --base floating`` and the scenario field ``singular.base`` say).
+JACOBIAN_SYNONYMS: dict[str, str] = {"floating": "generalized"}
+#: What ``jacobian=`` accepts: a kind of :data:`JACOBIAN_KINDS` or ``"floating"``.
+TaskJacobianKind = Literal["fixed", "generalized", "virtual", "floating"]
+#: The spellings of ``jointlock singular --base`` (its choices).
 BaseKind = Literal["fixed", "floating", "virtual"]
 BASE_KINDS: tuple[str, ...] = ("fixed", "floating", "virtual")
 
@@ -35,54 +47,69 @@ def _check_base(base: str) -> None:
         raise ScenarioError(f"base must be one of {BASE_KINDS}; got {base!r}")
 
 
+def jacobian_kind(kind: str) -> str:
+    """The kind of :data:`JACOBIAN_KINDS` that ``kind`` names (``"floating"`` ->
+    ``"generalized"``); :class:`~jointlock.ScenarioError` naming ``jacobian`` otherwise."""
+    canonical = JACOBIAN_SYNONYMS.get(kind, kind) if isinstance(kind, str) else kind
+    if canonical not in JACOBIAN_KINDS:
+        raise ScenarioError(
+            f"jacobian must be one of {JACOBIAN_KINDS} ('floating': the same as 'generalized'); got {kind!r}"
+        )
+    return canonical
+
+
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def task_jacobian(
     model: ArmModel,
     q: ArrayLike,
     *,
-    base: BaseKind = "fixed",
+    jacobian: TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
-    length: float | None = None,
+    characteristic_length: float | None = None,
 ) -> FloatArray:
     """The Jacobian whose singularities are analysed.
 
     Parameters
     ----------
     model
-        The arm.  ``base="floating"`` and ``"virtual"`` need a free-floating model
+        The arm.  ``jacobian="generalized"`` and ``"virtual"`` need a free-floating model
         (``model.floating``).
     q
         (..., n) joint angles [rad] of the movable joints.
-    base
+    jacobian
         ``"fixed"``: geometric Jacobian of the end effector (fixed base, or a spacecraft held
-        still), root-frame components.  ``"floating"``: generalized Jacobian, zero momentum
-        (000 eq. 5).  ``"virtual"``: Jacobian ``J^_m`` of the virtual manipulator (004 eqs.
-        10-12: free-flying arm with attitude held, or eq. 14 with the measured base rate
-        subtracted).
+        still), root-frame components.  ``"generalized"`` (or ``"floating"``, the same):
+        generalized Jacobian, zero momentum (000 eq. 5).  ``"virtual"``: Jacobian ``J^_m`` of
+        the virtual manipulator (004 eqs. 10-12: free-flying arm with attitude held, or eq. 14
+        with the measured base rate subtracted).  Formerly ``base=`` (deprecated alias).
     weighting
-        Virtual link lengths for ``base="virtual"`` (see :func:`jointlock.virtual_link_vectors`);
-        ``"segment"`` is 004's formula.
-    length
-        Characteristic length ``L`` [m]: the linear rows are divided by it.  ``None``: raw.
+        Virtual link lengths for ``jacobian="virtual"`` (see
+        :func:`jointlock.virtual_link_vectors`); ``"segment"`` is 004's formula.
+    characteristic_length
+        ``L`` [m]: the linear rows are divided by it.  ``None``: raw.  Formerly ``length=``
+        (deprecated alias).
 
     Returns
     -------
     (..., 6, n): twist ``(v, omega)`` of the end-effector origin, root-frame components.
     """
-    _check_base(base)
-    if base != "fixed" and not model.floating:
+    kind = jacobian_kind(jacobian)
+    if kind != "fixed" and not model.floating:
         raise ModelError(
-            f"base={base!r} needs a free-floating model (a spacecraft base); {model.name!r} has a fixed "
-            "base — load it with base='floating' or use base='fixed'"
+            f"jacobian={jacobian!r} needs a free-floating model (a spacecraft base); {model.name!r} has a "
+            "fixed base — load it with base='floating' or use jacobian='fixed'"
         )
-    if base == "fixed":
-        jac = jacobian(model, q)
-    elif base == "floating":
+    if kind == "fixed":
+        jac = geometric_jacobian(model, q)
+    elif kind == "generalized":
         jac = generalized_jacobian(model, q)
     else:
         jac = virtual_manipulator(model, q, weighting=weighting).jacobian
+    length = characteristic_length
     if length is not None:
         if not (math.isfinite(length) and length > 0):
-            raise ScenarioError(f"length must be a positive number of metres; got {length!r}")
+            raise ScenarioError(f"characteristic_length must be a positive number of metres; got {length!r}")
         jac = jac.copy()
         jac[..., :3, :] /= length
     return jac
@@ -113,7 +140,9 @@ class SingularityAnalysis:
         (..., 6) boolean mask over the columns of ``directions``: the lost directions
         (``j < k`` and ``sigma_j <= tol``).  Each satisfies ``J^T u ~ 0``.
     tol, base, weighting, length
-        The settings that produced it.
+        The settings that produced it: the rank tolerance, the Jacobian kind as given
+        (``jacobian=``), the virtual lengths and the characteristic length [m]
+        (``characteristic_length=``).
     """
 
     jacobian: FloatArray
@@ -135,15 +164,19 @@ class SingularityAnalysis:
         return self.directions[index][:, self.lost[index]]
 
 
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def singularity_of_jacobian(
     jac: ArrayLike,
     *,
     tol: float = RANK_TOL,
-    base: str = "given",
+    jacobian: str = "given",
     weighting: str = "",
-    length: float | None = None,
+    characteristic_length: float | None = None,
 ) -> SingularityAnalysis:
-    """:class:`SingularityAnalysis` of given Jacobians (..., 6, n) (batched SVD)."""
+    """:class:`SingularityAnalysis` of given Jacobians (..., 6, n) (batched SVD).  ``jacobian``,
+    ``weighting`` and ``characteristic_length`` only label the result (``base``, ``weighting``,
+    ``length``); formerly ``base=`` and ``length=`` (deprecated aliases)."""
     jac = np.asarray(jac, dtype=float)
     if jac.ndim < 2 or jac.shape[-2] != 6:
         raise ConfigurationError(f"jac must have shape (..., 6, n); got {jac.shape}")
@@ -164,27 +197,34 @@ def singularity_of_jacobian(
         singular=rank < k,
         lost=lost,
         tol=float(tol),
-        base=base,
+        base=jacobian,
         weighting=weighting,
-        length=length,
+        length=characteristic_length,
     )
 
 
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def analyse_singularity(
     model: ArmModel,
     q: ArrayLike,
     *,
-    base: BaseKind = "fixed",
+    jacobian: TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
     tol: float = RANK_TOL,
-    length: float | None = None,
+    characteristic_length: float | None = None,
 ) -> SingularityAnalysis:
     """sigma_min, rank, det(J J^T) and lost directions of ``model`` at ``q`` (..., n) [rad].
 
-    The Jacobian is :func:`task_jacobian` (``base``, ``weighting``, ``length`` as there).
+    The Jacobian is :func:`task_jacobian` (``jacobian``, ``weighting``,
+    ``characteristic_length`` as there; formerly ``base=`` and ``length=``, deprecated aliases).
     ``tol`` is the rank tolerance on singular values (units of the analysed matrix).  The lost
     directions are left singular vectors: task-space twists ``(v, omega)`` (root frame) the
     end effector cannot produce to first order.
     """
-    jac = task_jacobian(model, q, base=base, weighting=weighting, length=length)
-    return singularity_of_jacobian(jac, tol=tol, base=base, weighting=weighting, length=length)
+    jac = task_jacobian(
+        model, q, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+    )
+    return singularity_of_jacobian(
+        jac, tol=tol, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+    )

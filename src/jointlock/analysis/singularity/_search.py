@@ -10,11 +10,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._deprecate import renamed_keyword
 from ..._random import resolve_rng
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting, chain_state
 from ...model import ArmModel, FloatArray, as_joint_array
-from ._general import BaseKind, task_jacobian
+from ._general import TaskJacobianKind, task_jacobian
 
 log = logging.getLogger(__package__)
 
@@ -115,8 +116,9 @@ class SingularitySearch:
     families
         The clustering of ``q`` (:func:`cluster_singularities`).
     iterations, tol, base, weighting, length, seed
-        Settings; ``seed`` is the seed the starts were drawn with (the int given as ``rng``,
-        the fresh one drawn for ``rng=None``; ``None`` for a Generator).
+        Settings (``base``: the Jacobian kind as given, ``jacobian=``; ``length``: the
+        ``characteristic_length`` [m]); ``seed`` is the seed the starts were drawn with (the int
+        given as ``rng``, the fresh one drawn for ``rng=None``; ``None`` for a Generator).
     """
 
     q_start: FloatArray
@@ -136,16 +138,18 @@ class SingularitySearch:
 
 
 # Over 100 lines: half of it is the docstring, the rest one batched Newton loop best read whole.
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def find_singularities(
     model: ArmModel,
     *,
     samples: int = 512,
     rng: int | np.random.Generator | None = 0,
-    base: BaseKind = "fixed",
+    jacobian: TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
     tol: float = SEARCH_TOL,
     max_iter: int = 80,
-    length: float | None = None,
+    characteristic_length: float | None = None,
     q_start: ArrayLike | None = None,
     progress: object | None = None,
 ) -> SingularitySearch:
@@ -160,8 +164,9 @@ def find_singularities(
     rng
         Seed (int >= 0, default 0), ``numpy.random.Generator``, or None (a fresh seed) for the
         starts, recorded in ``seed`` (:mod:`jointlock._random`).
-    base, weighting, length
-        Which Jacobian (:func:`task_jacobian`).
+    jacobian, weighting, characteristic_length
+        Which Jacobian (:func:`task_jacobian`; formerly ``base=`` and ``length=``, deprecated
+        aliases).
     tol
         A start has converged when sigma_min < ``tol``.
     max_iter
@@ -194,7 +199,9 @@ def find_singularities(
         q0 = as_joint_array(model, q_start, "q_start").reshape(-1, model.dof)
 
     def fun(qq: FloatArray) -> FloatArray:
-        return task_jacobian(model, qq, base=base, weighting=weighting, length=length)
+        return task_jacobian(
+            model, qq, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+        )
 
     q = q0.copy()
     sigma = _sigma_min(fun, q)
@@ -226,7 +233,9 @@ def find_singularities(
         "singularity search: %d of %d starts converged in %d iterations", converged.sum(), len(q), iterations
     )
     found = q[converged]
-    families = cluster_singularities(model, found, base=base, weighting=weighting, length=length)
+    families = cluster_singularities(
+        model, found, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+    )
     return SingularitySearch(
         q_start=q0,
         q_final=q,
@@ -237,21 +246,23 @@ def find_singularities(
         families=families,
         iterations=iterations,
         tol=float(tol),
-        base=base,
+        base=jacobian,
         weighting=weighting,
-        length=length,
+        length=characteristic_length,
         seed=seed,
         joint_numbers=tuple(model.joint_numbers),
     )
 
 
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def cluster_singularities(
     model: ArmModel,
     q: ArrayLike,
     *,
-    base: BaseKind = "fixed",
+    jacobian: TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
-    length: float | None = None,
+    characteristic_length: float | None = None,
     zero_tol: float = 1e-4,
     rank_tol: float = 1e-6,
 ) -> tuple[SingularFamily, ...]:
@@ -263,12 +274,15 @@ def cluster_singularities(
     joint ``j`` is dependent when ``sum_i v_ij^2 > 1e-4`` over the singular values below
     ``rank_tol`` — the diagonal of the projector onto that subspace, which does not depend
     on the SVD's choice of basis.  Both keys are discrete, so the grouping is deterministic.
-    Families are sorted by size.
+    Families are sorted by size.  ``jacobian``, ``weighting``, ``characteristic_length``: the
+    Jacobian, as in :func:`task_jacobian` (formerly ``base=`` and ``length=``, deprecated aliases).
     """
     q = np.asarray(q, dtype=float).reshape(-1, model.dof)
     if len(q) == 0:
         return ()
-    jac = task_jacobian(model, q, base=base, weighting=weighting, length=length)
+    jac = task_jacobian(
+        model, q, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+    )
     u, s, vh = np.linalg.svd(jac)
     k = s.shape[-1]
     small = s < rank_tol  # (m, k); the singular subspace (always contains sigma_min's)

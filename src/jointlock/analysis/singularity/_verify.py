@@ -9,6 +9,7 @@ from typing import Literal
 
 import numpy as np
 
+from ..._deprecate import renamed_keyword
 from ..._random import resolve_rng
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting
@@ -27,7 +28,7 @@ from ._canadarm2 import (
     reference_jacobian,
     reorder_eq24,
 )
-from ._general import RANK_TOL, BaseKind, singularity_of_jacobian, task_jacobian
+from ._general import RANK_TOL, singularity_of_jacobian, task_jacobian
 from ._search import find_singularities
 
 
@@ -195,20 +196,21 @@ class ConditionVerification:
     checks: dict[str, ConditionCheck]
     completeness: Completeness
     lengths: ArmLengths
-    base: str
+    base: str  # the Jacobian kind (``jacobian=``)
     weighting: str
     sigma_tol: float
     condition_tol: float
     seed: int | None
 
 
+@renamed_keyword(old="base", new="jacobian")
 def verify_conditions(
     model: ArmModel,
     *,
     samples: int = 2000,
     search_samples: int = 256,
     rng: int | np.random.Generator | None = 0,
-    base: Literal["fixed", "virtual"] = "virtual",
+    jacobian: Literal["fixed", "virtual"] = "virtual",
     weighting: VMWeighting = "segment",
     sigma_tol: float = RANK_TOL,
     condition_tol: float = CONDITION_TOL,
@@ -223,24 +225,25 @@ def verify_conditions(
     condition (residual < ``condition_tol``).  One child generator per task (spawned from
     ``rng``), so results do not depend on order.
 
-    ``base="virtual"`` uses the virtual manipulator (needs a floating model, 004's case);
-    ``"fixed"`` the real arm.  ``rng``: seed (int >= 0, default 0), Generator or None (a fresh
+    ``jacobian="virtual"`` uses the virtual manipulator (needs a floating model, 004's case);
+    ``"fixed"`` the real arm (formerly ``base=``, a deprecated alias).  ``rng``: seed (int >= 0, default 0), Generator or None (a fresh
     seed), recorded in ``seed`` (:mod:`jointlock._random`).
     """
     gen, seed = resolve_rng(rng)
-    lengths = arm_lengths(model, base=base, weighting=weighting)
+    lengths = arm_lengths(model, jacobian=jacobian, weighting=weighting)
     children = gen.spawn(len(CONDITIONS + REFINED_CONDITIONS) + 1)
-    tb: BaseKind = base
     checks: dict[str, ConditionCheck] = {}
     for child, name in zip(children, CONDITIONS + REFINED_CONDITIONS):
         q = sample_condition(name, samples, lengths, rng=child)
-        res = singularity_of_jacobian(task_jacobian(model, q, base=tb, weighting=weighting), tol=sigma_tol)
+        res = singularity_of_jacobian(
+            task_jacobian(model, q, jacobian=jacobian, weighting=weighting), tol=sigma_tol
+        )
         max_res = float(condition_residuals(q, lengths, refined=True)[name].max()) if samples else math.nan
         dir_res, align = math.nan, math.nan
         sing = res.singular
         analytic_name = "cond1" if name == "cond1f" else name
         if sing.any():
-            part = reorder_eq24(reference_jacobian(model, q[sing], base=base, weighting=weighting))
+            part = reorder_eq24(reference_jacobian(model, q[sing], jacobian=jacobian, weighting=weighting))
             ua = analytic_directions(q[sing], lengths)[analytic_name]
             jt_u = np.einsum("...ij,...i->...j", part.matrix, ua)
             dir_res = float(
@@ -261,7 +264,9 @@ def verify_conditions(
         )
         if progress is not None:
             progress.update(1)  # type: ignore[attr-defined]
-    search = find_singularities(model, samples=search_samples, rng=children[-1], base=tb, weighting=weighting)
+    search = find_singularities(
+        model, samples=search_samples, rng=children[-1], jacobian=jacobian, weighting=weighting
+    )
     held = conditions_hold(search.q, lengths, tol=condition_tol, refined=True)
     any_held = np.zeros(len(search.q), dtype=bool)
     for name in CONDITIONS:
@@ -283,7 +288,7 @@ def verify_conditions(
         checks=checks,
         completeness=completeness,
         lengths=lengths,
-        base=base,
+        base=jacobian,
         weighting=weighting,
         sigma_tol=sigma_tol,
         condition_tol=condition_tol,

@@ -74,7 +74,7 @@ def rows_004() -> list[ReproductionRow]:
     )
     for name in sg.CONDITIONS:
         qs = solve_table3(name, lengths)
-        det = float(sg.analyse_singularity(arm, qs, base="virtual").det_jjt)
+        det = float(sg.analyse_singularity(arm, qs, jacobian="virtual").det_jjt)
         ok = abs(det) < DET_SINGULAR
         rows.append(
             ReproductionRow(

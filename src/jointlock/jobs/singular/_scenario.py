@@ -25,9 +25,10 @@ def singular_from_scenario(
     ``singular.verify_conditions`` -> :func:`verify_singularity_conditions`, else
     ``singular.search`` -> :func:`search_singularities`, else :func:`study_singularity` at
     ``singular.q_deg`` (zeros when not given).  The robot, the failure (locked joint) and
-    ``seed`` come from the top level; ``singular.base`` (already inherited from the top-level
-    ``base`` when the file gives one) defaults to virtual with ``verify_conditions`` and fixed
-    otherwise; ``singular.samples`` to 2000 (verification) or 512 (search).  ``previous`` is
+    ``seed`` come from the top level; ``singular.base`` (the Jacobian, ``jacobian=``; already
+    inherited from the top-level ``base`` when the file gives one) defaults to virtual with
+    ``verify_conditions`` and fixed otherwise; ``singular.length`` is the
+    ``characteristic_length``; ``singular.samples`` to 2000 (verification) or 512 (search).  ``previous`` is
     not used.
     """
     t = data["singular"]
@@ -39,13 +40,13 @@ def singular_from_scenario(
     base = t["base"] or ("virtual" if verify else "fixed")
     model = singular_model(data["robot"], locks, base)
     weighting, seed, samples = t["weighting"], int(data["seed"]), t["samples"]
-    length = None if t["length"] is None else float(t["length"])
+    length = None if t["length"] is None else float(t["length"])  # the scenario's name for it
     if verify:
         return verify_singularity_conditions(
             model,
             samples=int(samples or VERIFY_SAMPLES),
             rng=seed,
-            base=base,
+            jacobian=base,
             weighting=weighting,
             tol=float(t["tol"]),
             progress=progress,
@@ -55,10 +56,12 @@ def singular_from_scenario(
             model,
             samples=int(samples or SEARCH_SAMPLES),
             rng=seed,
-            base=base,
+            jacobian=base,
             weighting=weighting,
-            length=length,
+            characteristic_length=length,
             progress=progress,
         )
     q = joint_vector_deg(model, t["q_deg"], "singular.q_deg")
-    return study_singularity(model, q, base=base, weighting=weighting, tol=float(t["tol"]), length=length)
+    return study_singularity(
+        model, q, jacobian=base, weighting=weighting, tol=float(t["tol"]), characteristic_length=length
+    )

@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ..._deprecate import renamed_keyword
 from ..._random import resolve_seed
 from ...analysis import singularity as sg
 from ...io.files import atomic_write_bytes, atomic_write_json, figure_png
@@ -28,6 +29,7 @@ from ...plots.singular import (
 from ...progress import Progress
 from .._common import JobResult, locked_deg, locked_text
 from ._shared import (
+    JACOBIANS,
     SEARCH_MAX_ITER,
     SEARCH_SAMPLES,
     WEIGHTINGS,
@@ -158,14 +160,16 @@ class SingularitySearchResult(JobResult):
         return names
 
 
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def search_singularities(
     model: ArmModel,
     *,
     samples: int = SEARCH_SAMPLES,
     rng: Rng = 0,
-    base: sg.BaseKind = "fixed",
+    jacobian: sg.TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
-    length: float | None = None,
+    characteristic_length: float | None = None,
     tol: float = sg.SEARCH_TOL,
     max_iter: int = SEARCH_MAX_ITER,
     progress: bool = False,
@@ -176,13 +180,15 @@ def search_singularities(
     Parameters
     ----------
     model
-        Any arm (locked joints allowed); ``base="floating"``/``"virtual"`` need a free-floating one.
+        Any arm (locked joints allowed); ``jacobian="generalized"``/``"virtual"`` need a
+        free-floating one.
     samples
         Number of seeded starts, uniform within the joint limits (capped to +-pi).
     rng
         Seed or Generator (``None``: a fresh seed, recorded in the result).
-    base, weighting, length
-        The Jacobian (see :func:`study_singularity`).
+    jacobian, weighting, characteristic_length
+        The Jacobian (see :func:`study_singularity`; formerly ``base=`` and ``length=``,
+        deprecated aliases).
     tol
         A start has converged when its sigma_min falls below this (the command uses the
         default, :data:`jointlock.analysis.singularity.SEARCH_TOL`, whatever ``--tol`` says).
@@ -195,9 +201,9 @@ def search_singularities(
     -------
     SingularitySearchResult
         With the 004 conditions each family's members satisfy when ``model`` is a full
-        Canadarm2-structure arm and ``base`` is fixed or virtual.
+        Canadarm2-structure arm and ``jacobian`` is fixed or virtual.
     """
-    _check_choice("base", base, sg.BASE_KINDS)
+    _check_choice("jacobian", jacobian, JACOBIANS)
     _check_choice("weighting", weighting, WEIGHTINGS)
     _check_samples(samples)
     seed = resolve_seed(rng)  # None: a fresh seed, recorded in the result
@@ -206,14 +212,14 @@ def search_singularities(
             model,
             samples=samples,
             rng=seed,
-            base=base,
+            jacobian=jacobian,
             weighting=weighting,
             tol=tol,
             max_iter=max_iter,
-            length=length,
+            characteristic_length=characteristic_length,
             progress=bar,
         )
-    lengths = _condition_lengths(model, base, weighting)
+    lengths = _condition_lengths(model, jacobian, weighting)
     family_conditions = None
     if lengths is not None:
         family_conditions = tuple(

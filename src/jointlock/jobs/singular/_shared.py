@@ -8,6 +8,7 @@ from collections.abc import Mapping, Sequence
 
 import numpy as np
 
+from ..._deprecate import renamed_keyword
 from ...analysis import singularity as sg
 from ...errors import ModelError, ScenarioError
 from ...locking import lock_joints
@@ -31,13 +32,20 @@ _EQ24_FRAME = "eq. (24) rows (wz, vx, vy, vz, wx, wy), Sigma_ref = link frame 5,
 Rng = int | np.random.Generator | None
 
 
-def singular_model(robot: str, locks: Mapping[int, float] | None = None, base: str = "fixed") -> ArmModel:
-    """The arm ``jointlock singular`` analyses: ``robot`` (a built-in name or model file)
-    loaded with a fixed base for ``base="fixed"`` and free-floating otherwise (the generalized
-    and the virtual-manipulator Jacobians need the spacecraft), with ``locks``
-    (``{joint number: angle [rad]}``) locked."""
-    model = load_robot(robot, base="fixed" if base == "fixed" else "floating")
+@renamed_keyword(old="base", new="jacobian")
+def singular_model(robot: str, locks: Mapping[int, float] | None = None, jacobian: str = "fixed") -> ArmModel:
+    """The arm ``jointlock singular`` analyses for the Jacobian ``jacobian``: ``robot`` (a
+    built-in name or model file) loaded with a fixed base for ``jacobian="fixed"`` and
+    free-floating otherwise (the generalized and the virtual-manipulator Jacobians need the
+    spacecraft), with ``locks`` (``{joint number: angle [rad]}``) locked.  ``jacobian``:
+    formerly ``base=`` (a deprecated alias)."""
+    model = load_robot(robot, base="fixed" if jacobian == "fixed" else "floating")
     return lock_joints(model, dict(locks)) if locks else model
+
+
+#: What the singular job's ``jacobian=`` accepts (:data:`jointlock.analysis.singularity.JACOBIAN_KINDS`
+#: and ``"floating"``, the same as ``"generalized"``).
+JACOBIANS: tuple[str, ...] = sg.JACOBIAN_KINDS + tuple(sg.JACOBIAN_SYNONYMS)
 
 
 def _check_choice(name: str, value: str, choices: Sequence[str]) -> None:
@@ -50,12 +58,12 @@ def _check_samples(samples: int, name: str = "samples") -> None:
         raise ScenarioError(f"{name} must be an integer >= 1; got {samples!r}")
 
 
-def _condition_lengths(model: ArmModel, base: str, weighting: str) -> sg.ArmLengths | None:
+def _condition_lengths(model: ArmModel, jacobian: str, weighting: str) -> sg.ArmLengths | None:
     """Lengths of 004's conditions when ``model`` is a full Canadarm2-structure arm and the
     Jacobian is fixed or virtual; ``None`` otherwise."""
-    if base == "floating" or model.dof != 7 or model.locked:
+    if sg.jacobian_kind(jacobian) == "generalized" or model.dof != 7 or model.locked:
         return None
     try:
-        return sg.arm_lengths(model, base=base, weighting=weighting)  # type: ignore[arg-type]
+        return sg.arm_lengths(model, jacobian=jacobian, weighting=weighting)  # type: ignore[arg-type]
     except ModelError:
         return None

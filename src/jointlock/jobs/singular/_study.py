@@ -11,12 +11,20 @@ from typing import Any, ClassVar
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._deprecate import renamed_keyword
 from ...analysis import singularity as sg
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting
 from ...model import ArmModel, FloatArray
 from .._common import JobResult, format_matrix, locked_deg, locked_text
-from ._shared import _DIRECTION_CONVENTION, _EQ24_FRAME, WEIGHTINGS, _check_choice, _condition_lengths
+from ._shared import (
+    _DIRECTION_CONVENTION,
+    _EQ24_FRAME,
+    JACOBIANS,
+    WEIGHTINGS,
+    _check_choice,
+    _condition_lengths,
+)
 
 
 @dataclass(frozen=True)
@@ -84,20 +92,21 @@ class ConditionsAtConfiguration:
         }
 
 
+@renamed_keyword(old="base", new="jacobian")
 def conditions_at(
     model: ArmModel,
     q: ArrayLike,
     lengths: sg.ArmLengths,
     *,
-    base: str = "virtual",
+    jacobian: str = "virtual",
     weighting: str = "segment",
 ) -> ConditionsAtConfiguration:
     """Residuals of 004's Cond1-Cond5 (and cond1f) at ``q`` (7,) [rad] and 004's analytic
     directions of those that hold, compared with the numerical one of the eq.-(24) Jacobian
-    (``base``: ``"fixed"`` or ``"virtual"``)."""
+    (``jacobian``: ``"fixed"`` or ``"virtual"``; formerly ``base=``, a deprecated alias)."""
     q = np.asarray(q, dtype=float)
     residuals = sg.condition_residuals(q, lengths, refined=True)
-    part = sg.reorder_eq24(sg.reference_jacobian(model, q, base=base, weighting=weighting))  # type: ignore[arg-type]
+    part = sg.reorder_eq24(sg.reference_jacobian(model, q, jacobian=jacobian, weighting=weighting))  # type: ignore[arg-type]
     u_num = np.linalg.svd(part.matrix)[0][:, 5]
     norm = float(np.linalg.norm(part.matrix))
     held = {k: bool(v < sg.CONDITION_TOL) for k, v in residuals.items()}
@@ -139,7 +148,8 @@ class SingularityResult(JobResult):
     q
         (n,) [rad] the configuration (movable joints).
     base, weighting
-        The Jacobian (``"fixed"``, ``"floating"`` or ``"virtual"``) and the virtual lengths.
+        The Jacobian as given (``jacobian=``: ``"fixed"``, ``"generalized"``/``"floating"`` or
+        ``"virtual"``) and the virtual lengths.
     analysis
         Singular values, rank, ``det(J J^T)`` and lost directions at ``q``.
     conditions
@@ -227,50 +237,57 @@ class SingularityResult(JobResult):
         return []
 
 
+@renamed_keyword(old="base", new="jacobian")
+@renamed_keyword(old="length", new="characteristic_length")
 def study_singularity(
     model: ArmModel,
     q: ArrayLike,
     *,
-    base: sg.BaseKind = "fixed",
+    jacobian: sg.TaskJacobianKind = "fixed",
     weighting: VMWeighting = "segment",
     tol: float = sg.RANK_TOL,
-    length: float | None = None,
+    characteristic_length: float | None = None,
 ) -> SingularityResult:
     """Singularity analysis of ``model`` at one configuration (``jointlock singular``).
 
     Parameters
     ----------
     model
-        Any arm (locked joints allowed); ``base="floating"``/``"virtual"`` need a free-floating
-        one (:func:`singular_model` loads it so).
+        Any arm (locked joints allowed); ``jacobian="generalized"``/``"virtual"`` need a
+        free-floating one (:func:`singular_model` loads it so).
     q
         (n,) joint angles [rad] of the movable joints.
-    base
-        Jacobian: ``"fixed"`` (geometric), ``"floating"`` (generalized, zero momentum) or
-        ``"virtual"`` (004's virtual manipulator).
+    jacobian
+        ``"fixed"`` (geometric), ``"generalized"`` (zero momentum; ``"floating"`` is the same)
+        or ``"virtual"`` (004's virtual manipulator).  Formerly ``base=`` (a deprecated alias).
     weighting
         Virtual link lengths: ``"segment"`` (004's formula) or ``"vafa-dubowsky"``.
     tol
         Rank tolerance on the singular values (units of the analysed matrix).
-    length
-        Characteristic length [m] dividing the linear rows (``None``: raw Jacobian).
+    characteristic_length
+        ``L`` [m] dividing the linear rows (``None``: raw Jacobian).  Formerly ``length=`` (a
+        deprecated alias).
 
     Returns
     -------
     SingularityResult
         With 004's conditions at ``q`` when ``model`` is a full Canadarm2-structure arm and
-        ``base`` is fixed or virtual (evaluated on the raw eq.-(15) Jacobian).
+        ``jacobian`` is fixed or virtual (evaluated on the raw eq.-(15) Jacobian).
     """
-    _check_choice("base", base, sg.BASE_KINDS)
+    _check_choice("jacobian", jacobian, JACOBIANS)
     _check_choice("weighting", weighting, WEIGHTINGS)
     q = np.asarray(q, dtype=float)
     if q.shape != (model.dof,):
         raise ScenarioError(
             f"q must hold {model.dof} angles [rad] (movable joints {list(model.joint_numbers)}); got shape {q.shape}"
         )
-    analysis = sg.analyse_singularity(model, q, base=base, weighting=weighting, tol=tol, length=length)
-    lengths = _condition_lengths(model, base, weighting)
-    conditions = None if lengths is None else conditions_at(model, q, lengths, base=base, weighting=weighting)
+    analysis = sg.analyse_singularity(
+        model, q, jacobian=jacobian, weighting=weighting, tol=tol, characteristic_length=characteristic_length
+    )
+    lengths = _condition_lengths(model, jacobian, weighting)
+    conditions = (
+        None if lengths is None else conditions_at(model, q, lengths, jacobian=jacobian, weighting=weighting)
+    )
     return SingularityResult(
-        model=model, q=q, base=base, weighting=weighting, analysis=analysis, conditions=conditions
+        model=model, q=q, base=jacobian, weighting=weighting, analysis=analysis, conditions=conditions
     )

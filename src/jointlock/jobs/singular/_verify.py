@@ -9,6 +9,7 @@ from typing import Any, ClassVar, Literal
 
 import numpy as np
 
+from ..._deprecate import renamed_keyword
 from ..._random import resolve_seed
 from ...analysis import singularity as sg
 from ...errors import ScenarioError
@@ -43,7 +44,7 @@ class ConditionVerificationResult(JobResult):
     model
         The arm (full Canadarm2-structure arm).
     base, weighting
-        The Jacobian (``"virtual"`` or ``"fixed"``) and the virtual lengths.
+        The Jacobian (``jacobian=``: ``"virtual"`` or ``"fixed"``) and the virtual lengths.
     verification
         Sufficiency per condition and completeness (seed, tolerances and lengths inside).
     """
@@ -117,12 +118,13 @@ class ConditionVerificationResult(JobResult):
         return []
 
 
+@renamed_keyword(old="base", new="jacobian")
 def verify_singularity_conditions(
     model: ArmModel,
     *,
     samples: int = VERIFY_SAMPLES,
     rng: Rng = 0,
-    base: Literal["fixed", "virtual"] = "virtual",
+    jacobian: Literal["fixed", "virtual"] = "virtual",
     weighting: VMWeighting = "segment",
     tol: float = sg.RANK_TOL,
     search_samples: int = VERIFY_SEARCH_SAMPLES,
@@ -134,13 +136,14 @@ def verify_singularity_conditions(
     Parameters
     ----------
     model
-        The full 7-joint Canadarm2-structure arm (free-floating for ``base="virtual"``).
+        The full 7-joint Canadarm2-structure arm (free-floating for ``jacobian="virtual"``).
     samples
         Exact samples per condition (sufficiency: are they all singular?).
     rng
         Seed or Generator (``None``: a fresh seed, recorded in the result).
-    base
-        ``"virtual"`` (004's virtual manipulator) or ``"fixed"`` (the real arm).
+    jacobian
+        ``"virtual"`` (004's virtual manipulator) or ``"fixed"`` (the real arm).  Formerly
+        ``base=`` (a deprecated alias).
     weighting
         Virtual link lengths: ``"segment"`` (004's formula) or ``"vafa-dubowsky"``.
     tol
@@ -154,9 +157,9 @@ def verify_singularity_conditions(
     -------
     ConditionVerificationResult
     """
-    if base not in ("fixed", "virtual"):
+    if jacobian not in ("fixed", "virtual"):
         raise ScenarioError(
-            f"base must be 'virtual' (004's case) or 'fixed' to verify the conditions; got {base!r}"
+            f"jacobian must be 'virtual' (004's case) or 'fixed' to verify the conditions; got {jacobian!r}"
         )
     _check_choice("weighting", weighting, WEIGHTINGS)
     _check_samples(samples)
@@ -167,10 +170,10 @@ def verify_singularity_conditions(
             model,
             samples=samples,
             rng=seed,
-            base=base,
+            jacobian=jacobian,
             weighting=weighting,
             sigma_tol=tol,
             search_samples=search_samples,
             progress=bar,
         )
-    return ConditionVerificationResult(model=model, base=base, weighting=weighting, verification=ver)
+    return ConditionVerificationResult(model=model, base=jacobian, weighting=weighting, verification=ver)
