@@ -19,6 +19,7 @@ import jointlock as jl
 from jointlock.cli import main
 from jointlock.ik import pose_from_zyx
 from jointlock.io.files import to_plain
+from jointlock.planning.ga import GASettings
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = ROOT / "examples"
@@ -94,7 +95,7 @@ def test_plan_halt_is_jointlock_halt():
     model = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
     state = jl.FailureState.from_degrees(model, [-180, -180, -100, -10, 20, 20], [20, 30, 15, 25, 40, 35],
                                          [8, 10, 12, 10, -8, 6])  # fmt: skip
-    same = jl.plan_halt(model, state, T=10.0, samples=6000)  # limits: the model's 40 deg/s, 000's 20 deg/s^2
+    same = jl.plan_halt(model, state, T=10.0, base="fixed", samples=6000)  # limits: halt7's 40 deg/s, 000's 20
     assert to_plain(same.to_dict()) == printed
 
 
@@ -105,8 +106,36 @@ def test_plan_halt_text_is_the_cli_text(capsys):
 
 
 def test_plan_halt_needs_a_state_for_other_robots():
-    with pytest.raises(jl.ScenarioError, match="state at failure"):
+    with pytest.raises(jl.ScenarioError, match="state at failure of 'puma6'"):
         jl.plan_halt("puma6", locks={2: 0.5}, T=5.0)
+
+
+def test_plan_halt_errors_name_its_own_inputs():
+    with pytest.raises(jl.ModelError, match="did you mean 'halt7'"):
+        jl.plan_halt("halt8")  # the name is checked before anything else
+    with pytest.raises(jl.ScenarioError, match="joint 4 locked at 0; this model has locked no joint"):
+        jl.plan_halt(jl.load_robot("halt7"))  # 000's state needs 000's lock
+    with pytest.raises(jl.ScenarioError, match="^T must be a finite halt time") as err:
+        jl.plan_halt("halt7", T=-1.0)
+    assert "--" not in str(err.value)  # a keyword, not a CLI option
+    with pytest.raises(jl.ScenarioError, match="ga.n_pop must be >= 2"):
+        jl.plan_halt("halt7", solver="ga", ga=GASettings(n_pop=1))
+
+
+def test_plan_halt_base_follows_the_model_given():
+    model = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
+    assert jl.plan_halt(model, paper_qf=True, n_samples=101).problem.base == "floating"
+    assert jl.plan_halt("halt7", paper_qf=True, n_samples=101).problem.base == "fixed"  # 000's, by name
+
+
+def test_run_scenario_takes_a_path_and_names_missing_jobs():
+    path = EXAMPLES / "singular_004.toml"
+    run = jl.run_scenario(path)
+    assert run.to_dict()["summary"] == jl.run_scenario(jl.load_scenario(path)).to_dict()["summary"]
+    with pytest.raises(KeyError, match="it ran: singular"):
+        run["halt"]
+    with pytest.raises(jl.ScenarioError, match="needs a Scenario"):
+        jl.run_scenario(42)
 
 
 def test_the_library_never_chooses_a_backend(tmp_path, monkeypatch):

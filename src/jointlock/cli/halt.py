@@ -16,6 +16,7 @@ from typing import Any
 
 from ..errors import ScenarioError
 from ..jobs.halt import (
+    CLI_NAMES,
     DEFAULT_AMAX_DEG,
     DEFAULT_VMAX_DEG,
     MIN_N_SAMPLES,
@@ -122,7 +123,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     """The options as :func:`plan_halt`'s inputs (errors name the options), and its result."""
     ga = GASettings(n_pop=args.population, n_gen=args.generations)
-    check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga)
+    check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga, CLI_NAMES)
     defaults = PAPER_SCENARIO if args.robot == "halt7" else {}
     missing = [
         option
@@ -170,6 +171,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         n_samples=args.n_samples,
         ga=ga,
         progress=progress,
+        _names=CLI_NAMES,
     )
 
 

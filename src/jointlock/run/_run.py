@@ -23,10 +23,10 @@ from typing import Any
 
 import numpy as np
 
-from ..errors import JointlockError
+from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
-from ..scenario import JOB_PAPER, Scenario
+from ..scenario import JOB_PAPER, Scenario, load_scenario
 from ._commands import job_argv, job_command, jump_task_toml
 from ._summary import summarize, summary_lines
 
@@ -88,14 +88,15 @@ def run_title(scenario: Scenario) -> str:
     return f"{title} [failure overridden: {what}]"
 
 
-def run_scenario(scenario: Scenario, *, progress: bool = False) -> RunResult:
+def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> RunResult:
     """Run every job of ``scenario`` in-process, each on the typed results of those before it.
 
     Parameters
     ----------
     scenario
         A validated scenario (:func:`jointlock.scenario.load_scenario` or
-        :func:`~jointlock.scenario.scenario_from_dict`).
+        :func:`~jointlock.scenario.scenario_from_dict`), or the path of a scenario file (read
+        with :func:`~jointlock.scenario.load_scenario`, no overrides).
     progress
         Show progress bars on stderr.
 
@@ -104,6 +105,13 @@ def run_scenario(scenario: Scenario, *, progress: bool = False) -> RunResult:
     JointlockError
         From a job, with the scenario's source and the job's name in front of the message.
     """
+    if isinstance(scenario, (str, Path)):
+        scenario = load_scenario(scenario)
+    elif not isinstance(scenario, Scenario):
+        raise ScenarioError(
+            f"run_scenario needs a Scenario (jointlock.load_scenario(path)) or a scenario file's path; "
+            f"got {type(scenario).__name__}"
+        )
     results: dict[str, JobResult] = {}
     for job in scenario.jobs:
         try:
@@ -155,6 +163,8 @@ class RunResult:
         return self.scenario.data["seed"]
 
     def __getitem__(self, job: str) -> JobResult:
+        if job not in self.jobs:
+            raise KeyError(f"job {job!r} did not run in this scenario; it ran: {', '.join(self.jobs) or 'none'}")
         return self.jobs[job]
 
     def _job_dicts(self, out: Path) -> dict[str, dict[str, Any]]:

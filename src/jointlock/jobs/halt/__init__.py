@@ -39,7 +39,9 @@ from ._inputs import (
 )
 from ._result import HaltPlan
 from ._strategy import (
+    CLI_NAMES,
     HCOM_JACOBIAN,
+    LIBRARY_NAMES,
     MIN_N_SAMPLES,
     Solver,
     check_halt_settings,
@@ -49,6 +51,8 @@ from ._strategy import (
 )
 
 __all__ = [
+    "CLI_NAMES",
+    "LIBRARY_NAMES",
     "DEFAULT_AMAX_DEG",
     "DEFAULT_VMAX_DEG",
     "HCOM_JACOBIAN",

@@ -131,23 +131,38 @@ def _search_halt_configuration(
     return hc, note
 
 
-def check_halt_settings(T: float | None, n_samples: int, samples: int, solver: str, ga: GASettings) -> None:
-    """Refuse settings :func:`plan_halt` cannot use, before any work (named as the CLI's options)."""
+#: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
+LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
+                 "generations": "ga.n_gen"}  # fmt: skip
+CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
+             "generations": "--generations"}  # fmt: skip
+
+
+def check_halt_settings(
+    T: float | None,
+    n_samples: int,
+    samples: int,
+    solver: str,
+    ga: GASettings,
+    names: Mapping[str, str] = LIBRARY_NAMES,
+) -> None:
+    """Refuse settings :func:`plan_halt` cannot use, before any work; ``names`` name them in
+    the messages (:data:`LIBRARY_NAMES`, or :data:`CLI_NAMES` for the command line)."""
     if T is not None and not (math.isfinite(T) and T > 0):
-        raise ScenarioError(f"--T must be a finite halt time > 0 [s]; got {T:g}")
+        raise ScenarioError(f"{names['T']} must be a finite halt time > 0 [s]; got {T:g}")
     if n_samples < MIN_N_SAMPLES or n_samples % 2 == 0:
         raise ScenarioError(
-            f"--n-samples must be an odd integer >= {MIN_N_SAMPLES} (time samples of the objective, "
+            f"{names['n_samples']} must be an odd integer >= {MIN_N_SAMPLES} (time samples of the objective, "
             f"Simpson's rule); got {n_samples}"
         )
     if samples < 2:
-        raise ScenarioError(f"--samples must be an integer >= 2 (Monte Carlo samples); got {samples}")
+        raise ScenarioError(f"{names['samples']} must be an integer >= 2 (Monte Carlo samples); got {samples}")
     if solver == "ga":
         bad = []
         if ga.n_pop < 2:
-            bad.append(f"--population must be >= 2 (GA population); got {ga.n_pop}")
+            bad.append(f"{names['population']} must be >= 2 (GA population); got {ga.n_pop}")
         if ga.n_gen < 0:
-            bad.append(f"--generations must be >= 0 (GA generations); got {ga.n_gen}")
+            bad.append(f"{names['generations']} must be >= 0 (GA generations); got {ga.n_gen}")
         if bad:
             raise ScenarioError("; ".join(bad))
 
@@ -164,7 +179,7 @@ def plan_halt(
     vmax_deg: ArrayLike | None = None,
     amax_deg: ArrayLike | None = None,
     limits: JointLimits | None = None,
-    base: Literal["fixed", "floating"] = "fixed",
+    base: Literal["fixed", "floating"] | None = None,
     solver: Solver = "scan",
     rng: int | np.random.Generator | None = 0,
     samples: int = p000.SAMPLES,
@@ -172,6 +187,8 @@ def plan_halt(
     n_samples: int = 501,
     ga: GASettings | None = None,
     progress: bool = False,
+    _names: Mapping[str, str] = LIBRARY_NAMES,
+    _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
     """000's halt strategy: optimal halt configuration, then optimal halt motion (000 §3-§4).
 
@@ -195,7 +212,8 @@ def plan_halt(
         The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s] and ``amax_deg``
         [deg/s^2], or ``limits`` as they are.
     base
-        Base of the disturbance torque: ``"fixed"`` (000) or ``"floating"``; the halt
+        Base of the disturbance torque: ``"fixed"`` (000) or ``"floating"``; None: ``"fixed"``
+        for a robot given by name (000's), the model's own base for a model.  The halt
         configuration is searched on J_F either way (000 §3.1.2).
     solver
         ``"scan"`` (exact), ``"ga"`` (000's adaptive GA, ``ga`` settings: default population
@@ -223,24 +241,37 @@ def plan_halt(
     """
     ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
     named = isinstance(robot, str)
-    paper = robot == "halt7" if named else robot.name == "halt7"
-    defaults = p000.SCENARIO if paper else {}
-    check_halt_settings(T, n_samples, samples, solver, ga)
-    if state is None and not paper:
-        raise ScenarioError("plan_halt needs the state at failure (state=FailureState(...)) for this robot")
-    if T is None and "T" not in defaults:
-        raise ScenarioError("plan_halt needs the halt time T [s] for this robot")
-    T = float(T if T is not None else defaults["T"])
+    check_halt_settings(T, n_samples, samples, solver, ga, _names)
     if named:
+        paper = robot == "halt7"
+        defaults = p000.SCENARIO if paper else {}
         if locks is None:
             locks = {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
-        model = halt_model(robot, locks, base)
+        base = base or "fixed"  # 000 computes the torque with the spacecraft held
+        model = halt_model(robot, locks, base)  # a name that is no robot is refused here
     else:
         model = robot
+        base = base or ("floating" if model.floating else "fixed")  # the model's own base
+        paper = model.name == "halt7"
+        defaults = p000.SCENARIO if paper else {}
+    if state is None and not paper:
+        raise ScenarioError(
+            f"plan_halt needs the state at failure of {model.name!r} (state=FailureState(...)); "
+            "000's scenario is the default for halt7 only"
+        )
+    if T is None and "T" not in defaults:
+        raise ScenarioError(f"plan_halt needs the halt time T [s] for {model.name!r}")
+    T = float(T if T is not None else defaults["T"])
     if state is None:
+        lock_now = {lj.number: lj.angle for lj in model.locked}
+        if lock_now != dict(defaults["lock"]):
+            raise ScenarioError(
+                f"plan_halt: 000's state at failure is for halt7 with joint 4 locked at 0; this model has "
+                f"locked {sorted(lock_now) or 'no joint'}: give state=FailureState(...)"
+            )
         state = FailureState.from_degrees(
             model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
-            names=("--q0-deg", "--dq0-deg", "--ddq0-deg"),
+            names=_state_names,
         )  # fmt: skip
     if limits is None:
         limits = halt_limits(model, vmax_deg, amax_deg)
@@ -251,8 +282,8 @@ def plan_halt(
         qf_arr, qf_source = np.asarray(qf, dtype=float), "--qf-deg"
     elif paper_qf:
         if not paper:
-            raise ScenarioError("--paper-qf is 000's q_best for halt7 only; give --qf-deg")
-        qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "--paper-qf"), "000's printed q_best"
+            raise ScenarioError("paper_qf is 000's q_best for halt7 only; give qf")
+        qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"), "000's printed q_best"
     else:
         _check_start(model, state, T, limits)
         configuration, reach_note = _search_halt_configuration(
