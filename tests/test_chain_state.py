@@ -225,3 +225,17 @@ def test_rnea_follows_the_model_not_a_stale_cache(rng):
             rtol=1e-12,
         )
         del model
+
+
+def test_a_state_of_another_arm_is_refused():
+    """A state is tied to the arm it was computed for, not only to its joint count."""
+    halt7 = jl.load_robot("halt7")
+    third, fourth = jl.lock(halt7, 3, 0.0), jl.lock(halt7, 4, 0.0)  # same joint count, other arms
+    q = np.zeros(6)
+    with pytest.raises(jl.ConfigurationError, match="computed for another arm"):
+        jl.jacobian(third, q, state=jl.chain_state(fourth, q))
+    # an equal copy of the same arm (e.g. unpickled in a worker) is the same arm
+    import pickle
+
+    copy = pickle.loads(pickle.dumps(fourth))
+    np.testing.assert_array_equal(jl.jacobian(copy, q, state=jl.chain_state(fourth, q)), jl.jacobian(fourth, q))

@@ -12,7 +12,7 @@ import pytest
 import jointlock as jl
 from jointlock.cli import main as cli_main
 from jointlock.derivatives import jacobian_derivatives
-from jointlock.jobs.reproduce import notes_001_task
+from jointlock.jobs.reproduction import notes_001_task
 from jointlock.planning.jump import (
     JumpScenario,
     cartesian_trapezoid,

@@ -35,7 +35,7 @@ import pytest
 
 import jointlock as jl
 from jointlock.analysis import singularity as sg
-from jointlock.jobs.reproduce import solve_table3  # Table 3's angles re-solved, unrounded
+from jointlock.jobs.reproduction import solve_table3  # Table 3's angles re-solved, unrounded
 from jointlock.papers import p004
 
 pytestmark = pytest.mark.paper

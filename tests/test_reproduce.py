@@ -1,5 +1,5 @@
 """``jointlock reproduce --json`` has a row for every headline figure of the four seeds; the
-library call behind it (:func:`jointlock.jobs.reproduce.reproduce`) gives the same table, and
+library call behind it (:func:`jointlock.jobs.reproduction.reproduce`) gives the same table, and
 the papers' values in it are :mod:`jointlock.papers`'s."""
 
 from __future__ import annotations
@@ -13,7 +13,7 @@ import pytest
 
 from jointlock.cli import main
 from jointlock.errors import ScenarioError
-from jointlock.jobs.reproduce import ReproductionReport, ReproductionRow, reproduce
+from jointlock.jobs.reproduction import ReproductionReport, ReproductionRow, reproduce
 from jointlock.papers import p000, p002, p004
 
 #: Headline figures (row keys) per seed: 000 §5 (CP, gain, torques, k*, feasibility); 001 (no
@@ -122,7 +122,7 @@ def test_report_is_picklable_and_writes_its_json(report_002, tmp_path):
 
 
 def test_papers_run_in_table_order_and_unknown_ones_are_refused(monkeypatch):
-    import jointlock.jobs.reproduce as rep
+    import jointlock.jobs.reproduction as rep
 
     for paper in rep.PAPERS:  # stand-ins: one row per paper, no experiment
         row = ReproductionRow(paper, "k", "q", "1", "1", "reproduced")

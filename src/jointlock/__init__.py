@@ -98,7 +98,7 @@ _LAZY = {
         "ReproductionReport",
         "describe_configuration", "KinematicsReport", "inverse_kinematics", "InverseKinematicsReport",
     )},  # fmt: skip
-    "reproduce": "jointlock.jobs.reproduce",  # the function (jointlock.jobs.reproduce is its module)
+    "reproduce": "jointlock.jobs.reproduction",
     # scenarios in-process
     "load_scenario": "jointlock.scenario",
     "scenario_from_dict": "jointlock.scenario",

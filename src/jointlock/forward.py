@@ -12,7 +12,7 @@ Every name here is also importable from :mod:`jointlock.kinematics`.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
@@ -63,6 +63,7 @@ class ChainState:
     soa_ee_rotation: FloatArray  # (3, 3, N)
     soa_ee_position: FloatArray  # (3, N)
     q: FloatArray  # (..., n), read-only
+    model: ArmModel | None = field(default=None, repr=False, compare=False)  # the arm it belongs to
 
     def _batch_first(self, soa: FloatArray) -> FloatArray:
         return np.ascontiguousarray(np.moveaxis(soa, -1, 0)).reshape(self.batch_shape + soa.shape[:-1])
@@ -104,7 +105,13 @@ class ChainState:
                 )
             ),
             q,
+            a.model,
         )
+
+
+def _kinematic_key(model: ArmModel) -> bytes:
+    """What a chain state depends on: every joint's placement and axis, and the tool."""
+    return b"".join(j.placement.tobytes() + j.axis.tobytes() for j in model.joints) + model.tool.tobytes()
 
 
 def _rotate_soa(matrix: FloatArray, soa: FloatArray) -> FloatArray:
@@ -166,7 +173,7 @@ def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
     ee_pos = pos + np.einsum("rjN,j->rN", rot, tool[:3, 3])
     q_at = q.copy()
     q_at.setflags(write=False)
-    return ChainState(batch, rotations, positions, axes, ee_rot, ee_pos, q_at)
+    return ChainState(batch, rotations, positions, axes, ee_rot, ee_pos, q_at, model)
 
 
 def state_at(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> ChainState:
@@ -203,6 +210,12 @@ def state_at(model: ArmModel, q: ArrayLike | None, state: ChainState | None = No
         raise ConfigurationError(
             f"state has {state.soa_axes.shape[0]} joints but model {model.name!r} has {model.dof}"
         )
+    if state.model is not None and state.model is not model and _kinematic_key(state.model) != _kinematic_key(model):
+        raise ConfigurationError(
+            f"state was computed for another arm ({state.model.name!r}, locked "
+            f"{[lj.number for lj in state.model.locked]}) than {model.name!r} (locked "
+            f"{[lj.number for lj in model.locked]}): pass chain_state(model, q) of this model"
+        )
     if q is None or q is state.q:
         return state
     try:
@@ -217,7 +230,7 @@ def state_at(model: ArmModel, q: ArrayLike | None, state: ChainState | None = No
         )
         raise ConfigurationError(
             f"state was computed at other joint angles than q ({detail}): pass the state of q "
-            "(chain_state(model, q)), or q=None to use the state's own angles (state.q)"
+            "(chain_state(model, q)), or q=None where the function allows it (state.q is used)"
         )
     return state
 

@@ -1,7 +1,7 @@
 """``jointlock reproduce``: each seed paper's published experiment, re-run with the documented
 readings, as one table -- quantity, the paper's value, ours, and whether it is reproduced.
 
-A thin shell over :func:`jointlock.jobs.reproduce.reproduce` (the comparisons) and
+A thin shell over :func:`jointlock.jobs.reproduction.reproduce` (the comparisons) and
 :mod:`jointlock.papers` (the printed numbers): parse, call, print.
 """
 
@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..jobs.reproduce import PAPERS, reproduce
+from ..jobs.reproduction import PAPERS, reproduce
 from ._common import print_json
 
 

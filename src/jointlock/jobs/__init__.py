@@ -47,7 +47,7 @@ _NAMES: dict[str, tuple[str, ...]] = {
         "ConditionVerificationResult",
         "SingularitySearchResult",
     ),
-    "reproduce": ("reproduce", "ReproductionReport"),
+    "reproduction": ("reproduce", "ReproductionReport"),
     "kinematics": ("describe_configuration", "KinematicsReport"),
     "ik": ("inverse_kinematics", "InverseKinematicsReport"),
 }

@@ -100,7 +100,7 @@ class ReachabilitySettings:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class HaltConfigurationStudy(JobResult):
     """The result of :func:`study_halt_configuration`.
 

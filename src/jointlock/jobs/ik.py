@@ -27,7 +27,7 @@ def _solution(sol: Any) -> dict[str, Any]:
     }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class InverseKinematicsReport(JobResult):
     """Every IK solution of ``model`` for ``target``, or the nearest reachable pose.
 

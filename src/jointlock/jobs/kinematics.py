@@ -21,7 +21,7 @@ from ._common import JobResult, format_matrix, locked_deg, locked_text
 JACOBIAN_CONVENTION = "twist (v, omega) of the end-effector origin, base-frame components"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class KinematicsReport(JobResult):
     """Pose, Jacobian and singular values of ``model`` at ``q``.
 

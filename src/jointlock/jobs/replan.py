@@ -46,7 +46,7 @@ def step_flag_dict(flag: StepFlag, unit: str) -> dict[str, Any]:
     }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class ReplanJobResult(JobResult):
     """A straight-line plan of the locked arm, with the settings that produced it.
 

@@ -42,7 +42,7 @@ def gamma_sample_count(gamma_limit_deg: float, step_deg: float) -> int:
     return int(round(2 * limit / step)) + 1
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class ToleranceAngleResult(JobResult):
     """The gamma sweep of one desired configuration and the gammas absorbing a lock.
 

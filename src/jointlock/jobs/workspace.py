@@ -79,7 +79,7 @@ class VoxelTooSmallError(ScenarioError):
         return (type(self), (self.voxel, self.samples, self.density, self.auto_voxel))
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class WorkspaceStudy(JobResult):
     """The Monte Carlo workspace of an arm, and of the arm with one joint locked.
 

@@ -2,7 +2,7 @@
 
 Everything here is data copied from the papers (with the section, table or equation it comes
 from), used by the library's defaults, ``jointlock reproduce``
-(:func:`jointlock.jobs.reproduce.reproduce`), the tests and the docs, so a printed figure
+(:func:`jointlock.jobs.reproduction.reproduce`), the tests and the docs, so a printed figure
 exists in exactly one place.  Pure data: these modules import nothing from jointlock (the
 lowest layer); the arms' own tables are the robot factories of :mod:`jointlock.robots`.
 

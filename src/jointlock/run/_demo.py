@@ -170,7 +170,7 @@ def arm_overview(name: str) -> tuple[dict[str, Any], Section]:
     return figures, section
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class DemoResult:
     """The demo's results: the main job's :class:`RunResult`, the arm overviews and their
     report sections and drawings (picklable)."""

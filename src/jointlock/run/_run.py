@@ -27,7 +27,7 @@ from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
 from ..scenario import JOB_PAPER, Scenario, load_scenario
-from ._commands import job_argv, job_command, jump_task_toml
+from ._commands import job_command, jump_task_toml
 from ._summary import summarize, summary_lines
 
 #: The library call of each job: (module, function) taking ``(data, previous, *, progress)``.
@@ -88,6 +88,16 @@ def run_title(scenario: Scenario) -> str:
     return f"{title} [failure overridden: {what}]"
 
 
+def _with_context(exc: JointlockError, where: str) -> JointlockError:
+    """``exc`` with ``where`` in front of its message: the same class when it can be made from
+    a message alone, else a :class:`ScenarioError` (an error class with other arguments)."""
+    message = f"{where}: {exc}"
+    try:
+        return type(exc)(message)
+    except TypeError:
+        return ScenarioError(message)
+
+
 def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> RunResult:
     """Run every job of ``scenario`` in-process, each on the typed results of those before it.
 
@@ -117,7 +127,7 @@ def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> 
         try:
             results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
         except JointlockError as exc:
-            raise type(exc)(f"{scenario.source}: job [{job}]: {exc}") from exc
+            raise _with_context(exc, f"{scenario.source}: job [{job}]") from exc
     return RunResult(scenario, results, versions())
 
 
@@ -136,7 +146,7 @@ def _with_files(data: dict[str, Any], files: list[str]) -> dict[str, Any]:
     return out
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class RunResult:
     """The results of one scenario run (picklable).
 
@@ -171,9 +181,8 @@ class RunResult:
         jobs: dict[str, dict[str, Any]] = {}
         for job, result in self.jobs.items():
             previous = {k: v["result"] for k, v in jobs.items()}
-            argv = job_argv(job, self.scenario, out, previous, quiet=True)
             data = result.to_dict()
-            if hasattr(result, "file_names") and "--out" in argv:  # its command's JSON lists its files
+            if hasattr(result, "file_names"):  # the command's JSON lists the files it writes
                 data = _with_files(data, [str(out / job / name) for name in result.file_names()])
             jobs[job] = {
                 "paper": JOB_PAPER[job],
@@ -221,12 +230,9 @@ class RunResult:
         out.mkdir(parents=True, exist_ok=True)
         results = self.to_dict(out)
         for job, result in self.jobs.items():
-            previous = {k: results["jobs"][k]["result"] for k in list(self.jobs)[: list(self.jobs).index(job)]}
-            if job == "jump":
+            if job == "jump":  # the task file its equivalent command reads
                 atomic_write_text(out / "jump" / "task.toml", jump_task_toml(self.scenario))
-            if "--out" in job_argv(job, self.scenario, out, previous, quiet=True):
-                result.write(out / job)
-            else:  # a job whose command writes no files of its own: its result dictionary
+            if not result.write(out / job):  # a job with no files of its own: its result dictionary
                 atomic_write_json(out / job / "result.json", results["jobs"][job]["result"])
         results.update(to_plain(dict(extra or {})))
         sections = report_sections(self.scenario, results, dict(self.jobs), out) + list(extra_sections)

@@ -38,6 +38,20 @@ class FailureState:
     dq: np.ndarray
     ddq: np.ndarray
 
+    def __post_init__(self) -> None:
+        arrays = {}
+        for name in ("q", "dq", "ddq"):
+            arr = np.array(getattr(self, name), dtype=float)
+            if arr.ndim != 1 or not np.all(np.isfinite(arr)):
+                raise ScenarioError(f"FailureState.{name} must be one finite value per movable joint; got {arr.tolist()}")
+            arr.setflags(write=False)
+            arrays[name] = arr
+        sizes = {name: arr.size for name, arr in arrays.items()}
+        if len(set(sizes.values())) != 1:
+            raise ScenarioError(f"FailureState: q, dq and ddq need one value per movable joint each; got sizes {sizes}")
+        for name, arr in arrays.items():
+            object.__setattr__(self, name, arr)
+
     @classmethod
     def from_degrees(
         cls,

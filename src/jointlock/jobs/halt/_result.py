@@ -40,7 +40,7 @@ from .._common import JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class HaltPlan(JobResult):
     """The result of :func:`plan_halt`: where the arm halts and how it gets there.
 

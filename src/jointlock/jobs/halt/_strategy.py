@@ -273,6 +273,11 @@ def plan_halt(
             model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
             names=_state_names,
         )  # fmt: skip
+    if state.q.size != model.dof:
+        raise ScenarioError(
+            f"plan_halt: the state has {state.q.size} joints but {model.name!r} has {model.dof} movable joints "
+            f"{list(model.joint_numbers)} (FailureState.from_degrees accepts the full arm too)"
+        )
     if limits is None:
         limits = halt_limits(model, vmax_deg, amax_deg)
     paper_scenario = _is_paper_state(model, state, T, limits)

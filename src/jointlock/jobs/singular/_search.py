@@ -40,7 +40,7 @@ from ._shared import (
 )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class SingularitySearchResult(JobResult):
     """Result of :func:`search_singularities` (``jointlock singular ROBOT --search``).
 

@@ -137,7 +137,7 @@ def _gram(singular_values: np.ndarray, dof: int) -> dict[str, Any]:
     return {"gram_det_kind": kind, "gram_det": float(np.prod(np.square(singular_values)))}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class SingularityResult(JobResult):
     """Result of :func:`study_singularity` (``jointlock singular ROBOT [--q-deg ...]``).
 

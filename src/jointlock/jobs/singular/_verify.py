@@ -34,7 +34,7 @@ def _check_dict(c: sg.ConditionCheck) -> dict[str, Any]:
     }
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class ConditionVerificationResult(JobResult):
     """Result of :func:`verify_singularity_conditions` (``jointlock singular ROBOT
     --verify-conditions``).

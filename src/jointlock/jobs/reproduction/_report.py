@@ -1,4 +1,4 @@
-"""The table of :func:`jointlock.jobs.reproduce.reproduce`: its rows and the report."""
+"""The table of :func:`jointlock.jobs.reproduction.reproduce`: its rows and the report."""
 
 from __future__ import annotations
 
@@ -57,7 +57,7 @@ class ReproductionRow:
         return asdict(self) | {"agreement": self.agreement}
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class ReproductionReport(JobResult):
     """What :func:`reproduce` returns: the rows of the papers it ran, how long each paper
     took and the readings behind them.
