@@ -40,4 +40,5 @@ fig.savefig(Path(out) / "my_fig8.png", dpi=110)
 # checked quantities: the halt keeps every limit and lowers the base torque
 assert plan.feasible, "000's scenario with the reachable halt configuration must be feasible"
 assert plan.motion.global_torque < plan.motion.global_torque_k0
-assert np.all(plan.to_dict()["peak_velocity_deg_s"] <= plan.to_dict()["velocity_limit_deg_s"] + 1e-9)
+result = plan.to_dict()  # plain JSON data, as `jointlock halt --json` prints it
+assert np.all(np.asarray(result["peak_velocity_deg_s"]) <= np.asarray(result["velocity_limit_deg_s"]) + 1e-9)

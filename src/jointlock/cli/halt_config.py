@@ -8,7 +8,7 @@ import math
 from pathlib import Path
 
 from ..errors import ScenarioError
-from ..jobs.halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
+from ..jobs.halt import CLI_LIMIT_NAMES, DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
 from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, ReachabilitySettings, study_halt_configuration
 from ..papers import p000
 from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
@@ -151,6 +151,7 @@ def run(args: argparse.Namespace) -> int:
         reachability=_reachability(args, model),
         vmax_deg=args.vmax_deg,
         amax_deg=args.amax_deg,
+        limit_names=CLI_LIMIT_NAMES,
         progress=not args.quiet and args.samples >= PROGRESS_MIN_SAMPLES,
     )
     data = result.to_dict()

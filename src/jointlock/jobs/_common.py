@@ -15,6 +15,7 @@ and plots through :mod:`jointlock.plots`.
 
 from __future__ import annotations
 
+import functools
 import math
 from pathlib import Path
 from typing import Any, ClassVar
@@ -27,10 +28,29 @@ from ..model import ArmModel
 
 
 class JobResult:
-    """Base of every job's result (mix into a frozen dataclass)."""
+    """Base of every job's result (mix into a frozen dataclass; ``eq=False``: results hold
+    arrays, compare their ``to_dict()``).
+
+    A subclass's ``to_dict`` is wrapped so that it returns plain JSON data
+    (:func:`~jointlock.io.files.to_plain`: lists, Python numbers, None for NaN), so
+    ``json.dumps(result.to_dict())`` always works; the arrays stay on the result's fields.
+    """
 
     #: Name of the job (``"halt"``, ``"jump"``, ...), as in scenario files.
     job: ClassVar[str] = ""
+
+    def __init_subclass__(cls, **kwargs: Any) -> None:
+        super().__init_subclass__(**kwargs)
+        raw = cls.__dict__.get("to_dict")
+        if raw is None or getattr(raw, "_returns_plain", False):
+            return
+
+        @functools.wraps(raw)
+        def to_dict(self: Any, *args: Any, **kw: Any) -> dict[str, Any]:
+            return to_plain(raw(self, *args, **kw))
+
+        to_dict._returns_plain = True  # type: ignore[attr-defined]
+        cls.to_dict = to_dict  # type: ignore[method-assign]
 
     def to_dict(self) -> dict[str, Any]:  # pragma: no cover - every result overrides it
         raise NotImplementedError
@@ -46,8 +66,8 @@ class JobResult:
         return json_text(self.to_dict())
 
     def plain(self) -> dict[str, Any]:
-        """:meth:`to_dict` with arrays as lists and NaN as None (what JSON holds)."""
-        return to_plain(self.to_dict())
+        """:meth:`to_dict` (already plain JSON data; kept for compatibility)."""
+        return self.to_dict()
 
 
 def locked_deg(model: ArmModel) -> dict[str, float]:

@@ -37,7 +37,7 @@ from ..plots.halt_config import section_figures
 from ..progress import Progress
 from ..robots import load_robot
 from ._common import JobResult
-from .halt import FailureState, JointLimits, halt_limits, limits_text
+from .halt import SCENARIO_LIMIT_NAMES, FailureState, JointLimits, halt_limits, limits_text
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
 PROGRESS_MIN_SAMPLES = 20000
@@ -279,6 +279,7 @@ def study_halt_configuration(
     reachability: ReachabilitySettings | None = None,
     vmax_deg: float | list[float] | None = None,
     amax_deg: float | list[float] | None = None,
+    limit_names: tuple[str, str] = ("vmax_deg", "amax_deg"),
     progress: bool = False,
 ) -> HaltConfigurationStudy:
     """The optimal halt configuration of a locked arm (000 HCOM: Monte Carlo over the healthy
@@ -314,6 +315,8 @@ def study_halt_configuration(
         value or one per healthy joint, by ``jointlock halt``'s rule
         (:func:`jointlock.jobs.halt.halt_limits`: the speed limit capped by the model's own,
         defaults the model's, else 000's); used only with ``reachability``.
+    limit_names
+        How the two limits are named in the limit sources (the CLI passes its options).
     progress
         Show a progress bar on stderr (when it is a terminal).
 
@@ -341,7 +344,7 @@ def study_halt_configuration(
         raise ConfigurationError(f"reachability must be ReachabilitySettings or None; got {reachability!r}")
     limits = constraint = None
     if reachability is not None:
-        limits = halt_limits(model, vmax_deg, amax_deg)
+        limits = halt_limits(model, vmax_deg, amax_deg, names=limit_names)
         constraint = reachability.constraint(limits)
     with Progress(samples, "sampling", enabled=None if progress else False) as bar:
         result = optimal_halt_configuration(
@@ -395,6 +398,7 @@ def halt_config_from_scenario(
         characteristic_length=None if t["length"] is None else float(t["length"]),
         reachability=reach,
         vmax_deg=lim["vmax_deg"],
+        limit_names=SCENARIO_LIMIT_NAMES,
         amax_deg=lim["amax_deg"],
         progress=progress and samples >= PROGRESS_MIN_SAMPLES,
     )

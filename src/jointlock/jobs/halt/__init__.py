@@ -29,8 +29,10 @@ from them.
 from __future__ import annotations
 
 from ._inputs import (
+    CLI_LIMIT_NAMES,
     DEFAULT_AMAX_DEG,
     DEFAULT_VMAX_DEG,
+    SCENARIO_LIMIT_NAMES,
     FailureState,
     JointLimits,
     halt_limits,
@@ -51,6 +53,8 @@ from ._strategy import (
 )
 
 __all__ = [
+    "CLI_LIMIT_NAMES",
+    "SCENARIO_LIMIT_NAMES",
     "CLI_NAMES",
     "LIBRARY_NAMES",
     "DEFAULT_AMAX_DEG",

@@ -109,7 +109,7 @@ def halt_limits(
     vmax_deg: ArrayLike | None = None,
     amax_deg: ArrayLike | None = None,
     *,
-    names: tuple[str, str] = ("--vmax-deg", "--amax-deg"),
+    names: tuple[str, str] = ("vmax_deg", "amax_deg"),
 ) -> JointLimits:
     """Speed and acceleration limits of the healthy joints by ``jointlock halt``'s rule.
 
@@ -152,12 +152,17 @@ def halt_limits(
     return JointLimits(np.radians(vmax), np.radians(amax), tuple(v_src), tuple(a_src))
 
 
+#: How the two limits are named in the limit sources and errors, by caller.
+CLI_LIMIT_NAMES = ("--vmax-deg", "--amax-deg")
+SCENARIO_LIMIT_NAMES = ("limits.vmax_deg_s", "limits.amax_deg_s2")
+
+
 def resolve_limits(
     model: ArmModel, vmax_deg: Sequence[float] | None, amax_deg: Sequence[float] | None
 ) -> tuple[np.ndarray, np.ndarray, list[str], list[str]]:
     """:func:`halt_limits` as a tuple ``(vmax [rad/s], amax [rad/s^2], vmax_source,
     amax_source)`` (the CLI's form)."""
-    lim = halt_limits(model, vmax_deg, amax_deg)
+    lim = halt_limits(model, vmax_deg, amax_deg, names=CLI_LIMIT_NAMES)
     return lim.velocity, lim.acceleration, list(lim.velocity_source), list(lim.acceleration_source)
 
 

@@ -23,7 +23,14 @@ from ...planning.halt_motion import HaltProblem, optimal_halt_motion
 from ...progress import Progress
 from ...robots import load_robot
 from .._common import JobResult, joint_vector_deg
-from ._inputs import FailureState, JointLimits, halt_limits, limits_text
+from ._inputs import (
+    CLI_LIMIT_NAMES,
+    SCENARIO_LIMIT_NAMES,
+    FailureState,
+    JointLimits,
+    halt_limits,
+    limits_text,
+)
 from ._result import HaltPlan
 
 #: Smallest number of time samples of the objective (Simpson's rule, odd).
@@ -70,7 +77,9 @@ def _is_paper_state(model: ArmModel, state: FailureState, T: float, limits: Join
     )
 
 
-def _check_start(model: ArmModel, state: FailureState, T: float, limits: JointLimits) -> None:
+def _check_start(
+    model: ArmModel, state: FailureState, T: float, limits: JointLimits, state_name: str = "state"
+) -> None:
     """Refuse a state at failure that itself breaks a limit before any search: every halt
     starts from it (the k-part vanishes at t = 0 with two derivatives), so no halt
     configuration, halt time or k helps, and a Monte Carlo search would be pointless."""
@@ -79,7 +88,7 @@ def _check_start(model: ArmModel, state: FailureState, T: float, limits: JointLi
     if bad:
         nums = model.joint_numbers
         raise InfeasibleError(
-            "the state at failure (--q0-deg, --dq0-deg, --ddq0-deg) already breaks a limit, and every "
+            f"the state at failure ({state_name}) already breaks a limit, and every "
             "halt starts from it, so no halt configuration, halt time or k helps: "
             + "; ".join(bad)
             + f" (speed limits: {limits_text(nums, limits.velocity, limits.velocity_source, 'deg/s')}; "
@@ -133,9 +142,13 @@ def _search_halt_configuration(
 
 #: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
 LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
-                 "generations": "ga.n_gen"}  # fmt: skip
+                 "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg")}  # fmt: skip
 CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
-             "generations": "--generations"}  # fmt: skip
+             "generations": "--generations", "qf": "--qf-deg", "state": "--q0-deg, --dq0-deg, --ddq0-deg",
+             "limits": CLI_LIMIT_NAMES}  # fmt: skip
+SCENARIO_NAMES = {"T": "halt.T", "n_samples": "halt.n_samples", "samples": "halt.samples",
+                  "population": "halt.population", "generations": "halt.generations", "qf": "halt.qf_deg",
+                  "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES}  # fmt: skip
 
 
 def check_halt_settings(
@@ -279,18 +292,18 @@ def plan_halt(
             f"{list(model.joint_numbers)} (FailureState.from_degrees accepts the full arm too)"
         )
     if limits is None:
-        limits = halt_limits(model, vmax_deg, amax_deg)
+        limits = halt_limits(model, vmax_deg, amax_deg, names=_names["limits"])
     paper_scenario = _is_paper_state(model, state, T, limits)
     rng = resolve_seed(rng)  # one seed for the search and the GA, recorded
     configuration, reach_note = None, None
     if qf is not None:
-        qf_arr, qf_source = np.asarray(qf, dtype=float), "--qf-deg"
+        qf_arr, qf_source = np.asarray(qf, dtype=float), _names["qf"]
     elif paper_qf:
         if not paper:
             raise ScenarioError("paper_qf is 000's q_best for halt7 only; give qf")
         qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"), "000's printed q_best"
     else:
-        _check_start(model, state, T, limits)
+        _check_start(model, state, T, limits, _names["state"])
         configuration, reach_note = _search_halt_configuration(
             model, state, T, limits, samples=samples, seed=rng, reachable=reachable,
             per_joint=solver == "vector", progress=progress,
@@ -331,13 +344,15 @@ def halt_from_scenario(
     base = t.get("base") or data["base"]
     model = halt_model(data["robot"], locks, base)
     state = FailureState.from_degrees(
-        model, st["q0_deg"], st["dq0_deg"], st["ddq0_deg"], names=("--q0-deg", "--dq0-deg", "--ddq0-deg")
+        model, st["q0_deg"], st["dq0_deg"], st["ddq0_deg"], names=("state.q0_deg", "state.dq0_deg", "state.ddq0_deg")
     )
+    names = dict(SCENARIO_NAMES)
     qf = None
     if t["qf_deg"] is not None:
-        qf = joint_vector_deg(model, list(t["qf_deg"]), "--qf-deg")
+        qf = joint_vector_deg(model, list(t["qf_deg"]), "halt.qf_deg")
     elif not t["paper_qf"] and "halt_config" in previous:
-        qf = joint_vector_deg(model, list(previous["halt_config"].to_dict()["best"]["q_deg"]), "--qf-deg")
+        qf = np.asarray(previous["halt_config"].q_best, dtype=float)  # the typed result, in radians
+        names["qf"] = "the halt_config job's optimal halt configuration"
     return plan_halt(
         model,
         state,
@@ -353,4 +368,5 @@ def halt_from_scenario(
         n_samples=int(t["n_samples"]),
         ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
         progress=progress,
+        _names=names,
     )
