@@ -36,7 +36,7 @@ _FUNCTIONS: dict[str, tuple[str, ...]] = {
         "plot_workspace_clouds",
     ),
     "singular": ("plot_search_sigma_min", "plot_singular_families", "plot_family_joint_angles"),
-    "summary": ("plot_halt_base_torque", "plot_replan_error"),
+    "summary": ("plot_jump_before_after", "plot_halt_base_torque", "plot_replan_error"),
 }
 _WHERE = {name: module for module, names in _FUNCTIONS.items() for name in names}
 _MODULES = (*_FUNCTIONS, "arm")

@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 from ._common import new_axes
 
 
-def plot_jump_vs_failure_time(
+def plot_jump_before_after(
     failure_times: ArrayLike, jump_before: ArrayLike, jump_after: ArrayLike, *, ax: Any | None = None
 ) -> Any:
     """2-norm of the joint-rate jump [rad/s] (plotted in deg/s) vs failure time [s], without

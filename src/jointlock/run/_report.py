@@ -16,7 +16,7 @@ from ..io.files import save_figure
 from ..locking import lock
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
-from ..plots.summary import plot_halt_base_torque, plot_jump_vs_failure_time, plot_replan_error
+from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_replan_error
 from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
 from ..robots import load_robot
 from ..scenario import JOB_PAPER, Scenario
@@ -300,7 +300,7 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
     ):
         r = jobs["jump"]["result"]
         fig = offscreen_figure((7, 3.6))
-        plot_jump_vs_failure_time(
+        plot_jump_before_after(
             r["verification_t_s"], _floats(r["jump_before"]), _floats(r["jump_after"]), ax=fig.add_subplot()
         )
         images.append(("velocity jump vs failure time", save_figure(fig, figdir, "jump_vs_failure_time")))
