@@ -180,7 +180,57 @@ def check_halt_settings(
             raise ScenarioError("; ".join(bad))
 
 
-# Over 100 lines: 17 keyword inputs with their numpydoc take 67; the strategy itself is 57 lines.
+def _arm_state_and_time(
+    robot: ArmModel | str,
+    state: FailureState | None,
+    locks: Mapping[int, float] | None,
+    T: float | None,
+    base: str | None,
+    state_names: tuple[str, str, str],
+) -> tuple[ArmModel, FailureState, float, str, bool]:
+    """:func:`plan_halt`'s arm (loaded and locked when given by name), state at failure, halt
+    time and base, with 000 §5's as defaults on halt7; and whether the arm is halt7."""
+    named = isinstance(robot, str)
+    if named:
+        paper = robot == "halt7"
+        defaults = p000.SCENARIO if paper else {}
+        if locks is None:
+            locks = {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
+        base = base or "fixed"  # 000 computes the torque with the spacecraft held
+        model = halt_model(robot, locks, base)  # a name that is no robot is refused here
+    else:
+        model = robot
+        base = base or ("floating" if model.floating else "fixed")  # the model's own base
+        paper = model.name == "halt7"
+        defaults = p000.SCENARIO if paper else {}
+    if state is None and not paper:
+        raise ScenarioError(
+            f"plan_halt needs the state at failure of {model.name!r} (state=FailureState(...)); "
+            "000's scenario is the default for halt7 only"
+        )
+    if T is None and "T" not in defaults:
+        raise ScenarioError(f"plan_halt needs the halt time T [s] for {model.name!r}")
+    T = float(T if T is not None else defaults["T"])
+    if state is None:
+        lock_now = {lj.number: lj.angle for lj in model.locked}
+        if lock_now != dict(defaults["lock"]):
+            raise ScenarioError(
+                f"plan_halt: 000's state at failure is for halt7 with joint 4 locked at 0; this model has "
+                f"locked {sorted(lock_now) or 'no joint'}: give state=FailureState(...)"
+            )
+        state = FailureState.from_degrees(
+            model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
+            names=state_names,
+        )  # fmt: skip
+    if state.q.size != model.dof:
+        raise ScenarioError(
+            f"plan_halt: the state has {state.q.size} joints but {model.name!r} has {model.dof} movable joints "
+            f"{list(model.joint_numbers)} (FailureState.from_degrees accepts the full arm too)"
+        )
+    return model, state, T, base, paper
+
+
+# Over 100 lines: 19 keyword inputs and their numpydoc take about 80; the strategy itself is ~45 lines.
 def plan_halt(
     robot: ArmModel | str,
     state: FailureState | None = None,
@@ -253,44 +303,8 @@ def plan_halt(
         ``reachable=False``) nothing sampled satisfies the search's constraints.
     """
     ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
-    named = isinstance(robot, str)
     check_halt_settings(T, n_samples, samples, solver, ga, _names)
-    if named:
-        paper = robot == "halt7"
-        defaults = p000.SCENARIO if paper else {}
-        if locks is None:
-            locks = {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
-        base = base or "fixed"  # 000 computes the torque with the spacecraft held
-        model = halt_model(robot, locks, base)  # a name that is no robot is refused here
-    else:
-        model = robot
-        base = base or ("floating" if model.floating else "fixed")  # the model's own base
-        paper = model.name == "halt7"
-        defaults = p000.SCENARIO if paper else {}
-    if state is None and not paper:
-        raise ScenarioError(
-            f"plan_halt needs the state at failure of {model.name!r} (state=FailureState(...)); "
-            "000's scenario is the default for halt7 only"
-        )
-    if T is None and "T" not in defaults:
-        raise ScenarioError(f"plan_halt needs the halt time T [s] for {model.name!r}")
-    T = float(T if T is not None else defaults["T"])
-    if state is None:
-        lock_now = {lj.number: lj.angle for lj in model.locked}
-        if lock_now != dict(defaults["lock"]):
-            raise ScenarioError(
-                f"plan_halt: 000's state at failure is for halt7 with joint 4 locked at 0; this model has "
-                f"locked {sorted(lock_now) or 'no joint'}: give state=FailureState(...)"
-            )
-        state = FailureState.from_degrees(
-            model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
-            names=_state_names,
-        )  # fmt: skip
-    if state.q.size != model.dof:
-        raise ScenarioError(
-            f"plan_halt: the state has {state.q.size} joints but {model.name!r} has {model.dof} movable joints "
-            f"{list(model.joint_numbers)} (FailureState.from_degrees accepts the full arm too)"
-        )
+    model, state, T, base, paper = _arm_state_and_time(robot, state, locks, T, base, _state_names)
     if limits is None:
         limits = halt_limits(model, vmax_deg, amax_deg, names=_names["limits"])
     paper_scenario = _is_paper_state(model, state, T, limits)
