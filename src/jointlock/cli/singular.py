@@ -109,6 +109,8 @@ def run(args: argparse.Namespace) -> int:
     if args.samples is not None and args.samples < 1:
         raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
     require_finite(args, "tol", "length")
+    if args.length is not None and not args.length > 0:
+        raise ScenarioError(f"--length must be a positive number of metres; got {args.length}")
     check_out_dir(args.out)
     if args.verify_conditions:
         base = args.base or "virtual"
