@@ -119,7 +119,7 @@ def test_tolerance_angle_checks_its_parameters(puma):
 def test_tolerance_angle_writes_the_commands_files(tmp_path, puma):
     result = find_tolerance_angle(puma, 2, math.radians(59.4), Q_TARGET, step_deg=2.0)
     files = result.write(tmp_path)
-    assert files == [str(tmp_path / name) for name in TOLERANCE_FILES]
+    assert files == list(TOLERANCE_FILES)
     sweep = json.loads((tmp_path / "sweep.json").read_text())
     assert {k: v for k, v in sweep.items() if k not in ("gamma_deg", "q_deg")} == to_plain(result.to_dict())
     assert np.array(sweep["q_deg"]).shape == (len(result.sweep.gammas), 6)
@@ -186,7 +186,7 @@ def test_replan_checks_its_parameters(puma):
 
 def test_replan_writes_the_commands_files(tmp_path, puma):
     result = _replan(puma, 60.0, {"steps": 3})
-    assert result.write(tmp_path) == [str(tmp_path / name) for name in REPLAN_FILES]
+    assert result.write(tmp_path) == list(REPLAN_FILES)
     assert json.loads((tmp_path / "plan.json").read_text()) == to_plain(result.to_dict())
     csv = (tmp_path / "trajectory.csv").read_text().splitlines()
     assert csv[0].startswith("time_s,q1_deg,") and len(csv) == 1 + result.plan.times.size
@@ -247,7 +247,7 @@ def test_workspace_writes_the_commands_files(capsys, tmp_path):
     case = WORKSPACE_CASES[0]
     result = _workspace(*case)
     files = result.write(tmp_path / "lib")
-    assert files == [str(tmp_path / "lib" / name) for name in WORKSPACE_FILES]
+    assert files == list(WORKSPACE_FILES)
     out = _cli_json(capsys, [*_workspace_argv(*case), "--out", str(tmp_path / "cli")])
     assert out.pop("files") == [str(tmp_path / "cli" / name) for name in WORKSPACE_FILES]
     assert json.loads((tmp_path / "lib" / "workspace.json").read_text()) == to_plain(result.to_dict()) == out
@@ -255,8 +255,8 @@ def test_workspace_writes_the_commands_files(capsys, tmp_path):
         assert np.array_equal(z["full"], result.full_points) and np.array_equal(
             z["locked"], result.locked_points
         )
-    for f in files:
-        assert Path(f).read_bytes() == (tmp_path / "cli" / Path(f).name).read_bytes()
+    for name in files:
+        assert (tmp_path / "lib" / name).read_bytes() == (tmp_path / "cli" / name).read_bytes()
 
 
 # -- every result: pickle, scenario ----------------------------------------------------------------

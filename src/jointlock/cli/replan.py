@@ -114,7 +114,7 @@ def run(args: argparse.Namespace) -> int:
     )
     out = result.headline()
     if args.out is not None:
-        out["files"] = result.write(args.out)
+        out["files"] = [str(Path(args.out) / name) for name in result.write(args.out)]
     if args.json:
         print_json({**out, "trajectory": result.trajectory()})
         return 0

@@ -84,7 +84,7 @@ def run(args: argparse.Namespace) -> int:
     )
     out = result.to_dict()
     if args.out is not None:
-        out["files"] = result.write(args.out)
+        out["files"] = [str(Path(args.out) / name) for name in result.write(args.out)]
     if args.json:
         print_json(out)
         return 0

@@ -179,7 +179,7 @@ class ReplanJobResult(JobResult):
     def write(self, out: str | Path) -> list[str]:
         """Write ``joints.png`` (002 Figs. 11/17), ``pose.png`` (Figs. 12/18), ``error.png``
         (Figs. 13/19), ``velocity.png`` (Figs. 14/20), ``trajectory.csv`` and ``plan.json``
-        (:meth:`to_dict`) to the folder ``out``; returns their paths (``str(out / name)``)."""
+        (:meth:`to_dict`) to the folder ``out``; returns their names."""
         from ..plots._common import offscreen_figure
         from ..plots.replan import (
             plot_replan_errors,
@@ -195,18 +195,18 @@ class ReplanJobResult(JobResult):
         plot_replan_joints(self.plan, ax=fig.add_subplot())
         fig.tight_layout()
         write_png(fig, folder / "joints.png", dpi=110)
-        files.append(str(folder / "joints.png"))
+        files.append("joints.png")
         for name, plot in (
             ("pose.png", plot_replan_pose),
             ("error.png", plot_replan_errors),
             ("velocity.png", plot_replan_velocity),
         ):
             write_png(plot(self.plan, fig=offscreen_figure(PANELS_FIGSIZE)), folder / name, dpi=110)
-            files.append(str(folder / name))
+            files.append(name)
         atomic_write_text(folder / "trajectory.csv", self.trajectory_csv())
-        files.append(str(folder / "trajectory.csv"))
+        files.append("trajectory.csv")
         atomic_write_json(folder / "plan.json", self.to_dict())
-        files.append(str(folder / "plan.json"))
+        files.append("plan.json")
         return files
 
 

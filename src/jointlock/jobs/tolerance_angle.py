@@ -142,7 +142,7 @@ class ToleranceAngleResult(JobResult):
         """Write ``joints_vs_gamma.png`` (002 Fig. 7), ``joints_vs_gamma_zoom.png`` (Fig. 8),
         ``locked_joint_vs_gamma.png`` (Figs. 5-6) and ``sweep.json`` (:meth:`to_dict` plus the
         sweep: ``gamma_deg`` (G,), ``q_deg`` (G, 6)) to the folder ``out``; returns their
-        paths (``str(out / name)``)."""
+        names."""
         from ..plots._common import offscreen_figure
         from ..plots.tolerance_angle import plot_joints_vs_gamma, plot_locked_joint_vs_gamma
 
@@ -160,15 +160,15 @@ class ToleranceAngleResult(JobResult):
                 fig=offscreen_figure(PANELS_FIGSIZE),
             )
             write_png(fig, folder / name, dpi=110)
-            files.append(str(folder / name))
+            files.append(name)
         fig = offscreen_figure(LOCKED_FIGSIZE)
         plot_locked_joint_vs_gamma(self.sweep, self.joint, self.angle, ax=fig.add_subplot())
         fig.tight_layout()
         write_png(fig, folder / "locked_joint_vs_gamma.png", dpi=110)
-        files.append(str(folder / "locked_joint_vs_gamma.png"))
+        files.append("locked_joint_vs_gamma.png")
         sweep = {"gamma_deg": np.degrees(self.sweep.gammas), "q_deg": np.degrees(self.sweep.q)}
         atomic_write_json(folder / "sweep.json", {**self.to_dict(), **sweep})
-        files.append(str(folder / "sweep.json"))
+        files.append("sweep.json")
         return files
 
 

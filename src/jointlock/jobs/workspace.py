@@ -198,8 +198,8 @@ class WorkspaceStudy(JobResult):
     def write(self, out: str | Path) -> list[str]:
         """Write ``projections.png`` (xy, xz, yz), ``clouds.png`` (002 Figs. 2-3),
         ``points.npz`` (``full`` (N, 3) and, with a lock, ``locked`` [m]; compressed) and
-        ``workspace.json`` (:meth:`to_dict`) to the folder ``out``; returns their paths
-        (``str(out / name)``)."""
+        ``workspace.json`` (:meth:`to_dict`) to the folder ``out``; returns their
+        names."""
         from ..plots._common import offscreen_figure
         from ..plots.workspace import plot_workspace_clouds, plot_workspace_projections
 
@@ -209,17 +209,17 @@ class WorkspaceStudy(JobResult):
         files = []
         fig = plot_workspace_projections(full, locked, fig=offscreen_figure(PROJECTIONS_FIGSIZE))
         write_png(fig, folder / "projections.png", dpi=110)
-        files.append(str(folder / "projections.png"))
+        files.append("projections.png")
         fig = plot_workspace_clouds(full, locked, fig=offscreen_figure(CLOUDS_FIGSIZE))
         write_png(fig, folder / "clouds.png", dpi=110)
-        files.append(str(folder / "clouds.png"))
+        files.append("clouds.png")
         arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
         buf = io.BytesIO()
         np.savez_compressed(buf, **arrays)
         _files.atomic_write_bytes(folder / "points.npz", buf.getvalue())  # looked up here: spies see it
-        files.append(str(folder / "points.npz"))
+        files.append("points.npz")
         atomic_write_json(folder / "workspace.json", self.to_dict())
-        files.append(str(folder / "workspace.json"))
+        files.append("workspace.json")
         return files
 
 
