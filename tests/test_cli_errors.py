@@ -66,7 +66,8 @@ def test_joint_vector_deg_rates_need_a_zero_locked_entry():
 
 
 def test_run_passes_the_healthy_rates_of_a_full_arm_state(tmp_path):
-    from jointlock.cli.run import job_argv
+    from equivalent_commands import job_argv
+
     from jointlock.scenario import load_scenario
 
     f = tmp_path / "s.toml"
@@ -340,7 +341,8 @@ def test_jump_warns_about_ignored_options(tmp_path, capsys, extra, ignored):
 
 
 def test_jump_no_warning_for_the_default_mode_options(tmp_path, capsys):
-    from jointlock.cli.run import job_argv
+    from equivalent_commands import job_argv
+
     from jointlock.scenario import load_scenario
 
     f = tmp_path / "s.toml"

@@ -286,7 +286,8 @@ def test_results_pickle(puma):
     ],
 )
 def test_from_scenario_equals_the_runs_command(tmp_path, job, runner):
-    from jointlock.cli.run import JOB_MODULE, call_subcommand, job_argv
+    from equivalent_commands import JOB_MODULE, call_subcommand, job_argv
+
     from jointlock.scenario import load_scenario
 
     overrides = {"workspace.samples": 4000, "replan.steps": 10, "tolerance_angle.step_deg": 0.5}

@@ -12,10 +12,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from equivalent_commands import call_subcommand, job_argv
 
 import jointlock as jl
 from jointlock.cli import main as cli_main
-from jointlock.cli.run import call_subcommand, job_argv
 from jointlock.io.files import to_plain
 from jointlock.jobs.halt import CLI_LIMIT_NAMES, FailureState
 from jointlock.jobs.halt_config import (

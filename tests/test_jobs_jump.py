@@ -9,10 +9,10 @@ import pickle
 from pathlib import Path
 
 import pytest
+from equivalent_commands import call_subcommand, job_argv
 
 import jointlock as jl
 from jointlock.cli import main as cli_main
-from jointlock.cli.run import call_subcommand, job_argv
 from jointlock.io.files import to_plain
 from jointlock.jobs.jump import (
     JumpJobResult,

@@ -15,9 +15,9 @@ from pathlib import Path
 import matplotlib
 import numpy as np
 import pytest
+from equivalent_commands import call_subcommand, job_argv
 
 from jointlock.cli import main as cli_main
-from jointlock.cli.run import call_subcommand, job_argv
 from jointlock.io.files import to_plain
 from jointlock.jobs.singular import (
     ConditionVerificationResult,

@@ -179,7 +179,7 @@ def test_singular_job_inherits_the_top_level_base(tmp_path, top, singular, expec
 
 
 def test_singular_job_command_line_uses_the_inherited_base(tmp_path):
-    from jointlock.cli.run import job_argv
+    from equivalent_commands import job_argv
 
     sc = load_scenario(write(tmp_path, 'robot = "canadarm7"\nbase = "floating"\n[singular]\nsearch = true\n'))
     argv = job_argv("singular", sc, tmp_path / "out", {}, quiet=True)
@@ -249,9 +249,9 @@ NEW_LIMITS = "[limits]\nvmax_deg_s = 30.0\namax_deg_s2 = 15.0\neps_m = 0.002\n"
 @pytest.fixture
 def fresh_warnings(monkeypatch):
     """Forget which former names warned already (they warn once per process)."""
-    import jointlock.scenario._read as read
+    import jointlock._deprecate as deprecate  # the one warn-once memory of the package
 
-    monkeypatch.setattr(read, "_WARNED", set())
+    monkeypatch.setattr(deprecate, "_WARNED", set())
 
 
 def former_name_warnings(record: list[warnings.WarningMessage]) -> list[str]:
@@ -345,11 +345,11 @@ def test_examples_use_the_current_names(fresh_warnings):
 
 
 def test_load_jump_task_and_its_former_name(tmp_path, monkeypatch):
-    import jointlock.planning.jump._task as task
+    import jointlock._deprecate as deprecate
     from jointlock.planning.jump import load_jump_task
     from jointlock.planning.jump import load_scenario as former
 
-    monkeypatch.setattr(task, "_warned_load_scenario", False)
+    monkeypatch.setattr(deprecate, "_WARNED", set())
     f = write(tmp_path, "q0_deg = [0, 30, -60, 90, -60, 30, 0]\ndx_m = [0.5, 0, 0]\nduration_s = 6.0\n")
     with warnings.catch_warnings(record=True) as record:
         warnings.simplefilter("always")

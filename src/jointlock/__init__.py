@@ -20,6 +20,7 @@ Quick start::
 from __future__ import annotations
 
 from . import io
+from ._lazy import lazy_attributes
 from ._version import __version__
 from .dh import from_dh
 from .dynamics import (
@@ -112,18 +113,7 @@ _LAZY = {
 _LAZY_MODULES = ("plots", "jobs", "papers", "run", "report", "scenario", "analysis", "planning")
 
 
-def __getattr__(name: str):
-    import importlib
-
-    if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
-    if name in _LAZY_MODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    raise AttributeError(f"module 'jointlock' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY) | set(_LAZY_MODULES))
+__getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals())
 
 
 __all__ = [

@@ -21,22 +21,28 @@ from .errors import JointlockError
 
 F = TypeVar("F", bound=Callable[..., Any])
 
-#: ``(function, former keyword)`` pairs already warned about in this process.
-_WARNED: set[tuple[str, str]] = set()
+#: What has already been warned about in this process (one warning per key).
+_WARNED: set[str] = set()
+
+
+def warn_once(key: str, message: str) -> None:
+    """Warn ``message`` (``FutureWarning``) the first time ``key`` is seen in this process,
+    attributed to the first caller outside jointlock: the one deprecation mechanism of the
+    package (renamed keywords, former scenario fields, renamed functions)."""
+    if key in _WARNED:
+        return
+    _WARNED.add(key)
+    frame, level = sys._getframe(), 1
+    while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith("jointlock."):
+        frame, level = frame.f_back, level + 1
+    warnings.warn(message, FutureWarning, stacklevel=level)
 
 
 def _warn_once(where: str, name: str, old: str, new: str) -> None:
-    if (where, old) in _WARNED:
-        return
-    _WARNED.add((where, old))
-    frame, level = sys._getframe(), 1  # attribute the warning to the first caller outside this module
-    while frame.f_back is not None and frame.f_globals.get("__name__") == __name__:
-        frame, level = frame.f_back, level + 1
-    warnings.warn(
+    warn_once(
+        f"keyword {where}:{old}",
         f"{name}(): the keyword {old}= is deprecated: use {new}= instead (the same argument); "
         f"{old}= still works for now",
-        FutureWarning,
-        stacklevel=level,
     )
 
 

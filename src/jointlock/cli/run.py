@@ -9,29 +9,14 @@ options become overrides of the file, the jobs run in-process, and
 from __future__ import annotations
 
 import argparse
-import contextlib
-import importlib
-import io
-import json
 import math
-import shlex
 import sys
-from collections.abc import Mapping
-from pathlib import Path
 from typing import Any
 
-from ..errors import ScenarioError
-from ..io.files import atomic_write_text
 from ..run import default_out_dir, run_scenario
-from ..run._commands import JOB_COMMAND, jump_task_toml  # noqa: F401  (re-exported)
-from ..run._commands import job_argv as _job_argv
-from ..run._report import _condition_verdict, assumptions, halt_k_label, is_000_case  # noqa: F401
-from ..run._summary import summarize, summary_lines  # noqa: F401
-from ..scenario import JOB_ORDER, Scenario, load_scenario, parse_set
+from ..run._summary import summary_lines
+from ..scenario import JOB_ORDER, load_scenario, parse_set
 from ._common import check_out_dir, parse_lock, print_json, seed_arg
-
-#: Subcommand module of each job (``jointlock.cli.<module>``).
-JOB_MODULE = {job: job for job in JOB_ORDER}
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -102,38 +87,3 @@ def run(args: argparse.Namespace) -> int:
             print(line)
         print(f"\nwrote {out / 'results.json'}, {out / 'report.html'} and {len(results['files'])} files")
     return 0
-
-
-# -- running one job's equivalent command (tests check it agrees with the library call) ----------
-
-
-def job_argv(
-    job: str, scenario: Scenario, out: Path, previous: Mapping[str, dict], *, quiet: bool
-) -> list[str]:
-    """The equivalent command line of ``job`` (:func:`jointlock.run._commands.job_argv`); for
-    the jump job it also writes the task file the command reads (``out/jump/task.toml``)."""
-    if job == "jump":
-        atomic_write_text(Path(out) / "jump" / "task.toml", jump_task_toml(scenario))
-    return _job_argv(job, scenario, Path(out), previous, quiet=quiet)
-
-
-def call_subcommand(module: str, argv: list[str]) -> tuple[dict, int]:
-    """Run ``jointlock <argv>`` in-process through the subcommand ``module`` and return the
-    JSON object it prints (``--json`` must be in ``argv``) and its exit code."""
-    mod = importlib.import_module(f"jointlock.cli.{module}")
-    parser = argparse.ArgumentParser(prog="jointlock")
-    mod.register(parser.add_subparsers(dest="command"))
-    err = io.StringIO()
-    try:
-        with contextlib.redirect_stderr(err):
-            args = parser.parse_args(argv)
-    except SystemExit:
-        msg = err.getvalue().strip().splitlines()
-        raise ScenarioError(
-            f"cannot form the command line `jointlock {shlex.join(argv)}`: {msg[-1] if msg else '?'}"
-        ) from None
-    buf = io.StringIO()
-    with contextlib.redirect_stdout(buf):
-        code = int(args.func(args) or 0)
-    text = buf.getvalue()
-    return (json.loads(text) if text.strip() else {}), code

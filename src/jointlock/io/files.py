@@ -86,10 +86,11 @@ def csv_text(columns: dict[str, np.ndarray], fmt: str = "{:.9g}") -> str:
     return header + "\n" + body + "\n"
 
 
-def npz_bytes(**arrays: Any) -> bytes:
-    """``np.savez`` of ``arrays`` into bytes (to write atomically)."""
+def npz_bytes(*, compressed: bool = False, **arrays: Any) -> bytes:
+    """``np.savez`` (``np.savez_compressed`` with ``compressed=True``) of ``arrays`` into
+    bytes (to write atomically)."""
     buf = io.BytesIO()
-    np.savez(buf, **arrays)
+    (np.savez_compressed if compressed else np.savez)(buf, **arrays)
     return buf.getvalue()
 
 

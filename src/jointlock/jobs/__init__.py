@@ -26,9 +26,7 @@ The job modules are imported on first use.
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from .._lazy import lazy_attributes
 from ._common import JobResult
 
 #: Public names of each job module (imported on first use).
@@ -52,18 +50,12 @@ _NAMES: dict[str, tuple[str, ...]] = {
     "ik": ("inverse_kinematics", "InverseKinematicsReport"),
 }
 _WHERE = {name: module for module, names in _NAMES.items() for name in names}
+_MODULES = tuple(_NAMES)
 
 
-def __getattr__(name: str) -> Any:
-    if name in _NAMES:
-        return importlib.import_module(f"{__name__}.{name}")
-    if name in _WHERE:
-        return getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_NAMES) | set(_WHERE))
+__getattr__, __dir__ = lazy_attributes(
+    __name__, {name: f"{__name__}.{module}" for name, module in _WHERE.items()}, _MODULES, globals()
+)
 
 
 __all__ = ["JobResult", *_WHERE]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import functools
 import math
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -68,6 +69,18 @@ class JobResult:
     def plain(self) -> dict[str, Any]:
         """:meth:`to_dict` (already plain JSON data; kept for compatibility)."""
         return self.to_dict()
+
+
+def scenario_lock(data: Mapping[str, Any], job: str | None = None) -> tuple[int, float] | None:
+    """``(joint number, angle [rad])`` of a resolved scenario's ``[failure]`` when it gives both
+    (the jobs that lock a joint at a known angle), else None -- or, when ``job`` is given (a
+    job that needs the lock), a :class:`ScenarioError` naming it."""
+    failure = data.get("failure") or {}
+    if failure.get("joint") is None or failure.get("angle_deg") is None:
+        if job is not None:
+            raise ScenarioError(f"job [{job}] needs [failure] joint and angle_deg")
+        return None
+    return int(failure["joint"]), math.radians(float(failure["angle_deg"]))
 
 
 def locked_deg(model: ArmModel) -> dict[str, float]:

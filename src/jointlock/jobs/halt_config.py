@@ -36,7 +36,7 @@ from ..planning.halt_config import (
 from ..plots.halt_config import section_figures
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult
+from ._common import JobResult, scenario_lock
 from .halt import SCENARIO_LIMIT_NAMES, FailureState, JointLimits, halt_limits, limits_text
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
@@ -243,8 +243,8 @@ class HaltConfigurationStudy(JobResult):
         atomic_write_json(out / "result.json", self.to_dict())
         atomic_write_bytes(out / "samples.npz", self.samples_npz())
         atomic_write_bytes(out / "samples.csv", self.samples_csv())
-        names = ["result.json", "samples.npz", "samples.csv"]
-        return names + [p.name for p in write_section_plots(self.configuration, out)]
+        write_section_plots(self.configuration, out)
+        return self.file_names()
 
 
 def write_section_plots(result: Any, folder: str | Path, *, dpi: int = SECTION_DPI) -> list[Path]:
@@ -372,9 +372,9 @@ def halt_config_from_scenario(
     shown from :data:`PROGRESS_MIN_SAMPLES` samples on, as the command does."""
     t, st, lim = data["halt_config"], data["state"], data["limits"]
     model = load_robot(data["robot"], base=t.get("base") or data["base"])
-    fail = data.get("failure") or {}
-    if fail.get("joint") is not None and fail.get("angle_deg") is not None:
-        model = lock_joints(model, {int(fail["joint"]): math.radians(float(fail["angle_deg"]))})
+    lk = scenario_lock(data)
+    if lk is not None:
+        model = lock_joints(model, dict([lk]))
     reach = None
     if t["reachable"]:
         state = FailureState.from_degrees(

@@ -26,7 +26,7 @@ from ..model import ArmModel
 from ..planning.replan import DEFAULT_STEP_WEIGHT, ReplanResult, StepFlag, replan_line
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult
+from ._common import JobResult, scenario_lock
 
 #: Size of each figure [inch]: the joints, then the two-panel pose, error and velocity figures.
 JOINTS_FIGSIZE = (7.0, 4.0)
@@ -190,24 +190,19 @@ class ReplanJobResult(JobResult):
 
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
-        files = []
         fig = offscreen_figure(JOINTS_FIGSIZE)
         plot_replan_joints(self.plan, ax=fig.add_subplot())
         fig.tight_layout()
         write_png(fig, folder / "joints.png", dpi=110)
-        files.append("joints.png")
         for name, plot in (
             ("pose.png", plot_replan_pose),
             ("error.png", plot_replan_errors),
             ("velocity.png", plot_replan_velocity),
         ):
             write_png(plot(self.plan, fig=offscreen_figure(PANELS_FIGSIZE)), folder / name, dpi=110)
-            files.append(name)
         atomic_write_text(folder / "trajectory.csv", self.trajectory_csv())
-        files.append("trajectory.csv")
         atomic_write_json(folder / "plan.json", self.to_dict())
-        files.append("plan.json")
-        return files
+        return self.file_names()
 
 
 def plan_replan(
@@ -313,15 +308,13 @@ def replan_from_scenario(
     and ``[failure]``, and the ``[replan]`` table, in degrees; ``method``, ``step_weight`` and
     the jump threshold take their defaults); ``previous`` is not used.  Same result as
     ``jointlock replan`` with the scenario's options."""
-    failure = data.get("failure", {})
-    if failure.get("joint") is None or failure.get("angle_deg") is None:
-        raise ScenarioError("job [replan] needs [failure] joint and angle_deg")
+    joint, angle = scenario_lock(data, "replan")
     t = data["replan"]
     model = load_robot(data["robot"], base=data["base"])
     return plan_replan(
         model,
-        int(failure["joint"]),
-        math.radians(float(failure["angle_deg"])),
+        joint,
+        angle,
         np.radians([float(v) for v in t["from_deg"]]),
         np.radians([float(v) for v in t["to_deg"]]),
         steps=int(t["steps"]),

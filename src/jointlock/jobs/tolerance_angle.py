@@ -24,7 +24,7 @@ from ..model import ArmModel
 from ..planning.replan import GammaRoot, GammaSweep, LockRange, absorbable_range, gamma_sweep, gammas_for_lock
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult
+from ._common import JobResult, scenario_lock
 
 #: Most gamma samples of one sweep (steps of about 0.0018 deg over +-180 deg; some 1.5 GB and
 #: 15 s): each is an IK solution, and a tiny step would otherwise try to allocate many GiB.
@@ -148,7 +148,6 @@ class ToleranceAngleResult(JobResult):
 
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
-        files = []
         zoom = math.degrees(math.radians(self.zoom_deg))  # as the command always computed it
         for name, window in (("joints_vs_gamma.png", None), ("joints_vs_gamma_zoom.png", zoom)):
             fig = plot_joints_vs_gamma(
@@ -160,16 +159,13 @@ class ToleranceAngleResult(JobResult):
                 fig=offscreen_figure(PANELS_FIGSIZE),
             )
             write_png(fig, folder / name, dpi=110)
-            files.append(name)
         fig = offscreen_figure(LOCKED_FIGSIZE)
         plot_locked_joint_vs_gamma(self.sweep, self.joint, self.angle, ax=fig.add_subplot())
         fig.tight_layout()
         write_png(fig, folder / "locked_joint_vs_gamma.png", dpi=110)
-        files.append("locked_joint_vs_gamma.png")
         sweep = {"gamma_deg": np.degrees(self.sweep.gammas), "q_deg": np.degrees(self.sweep.q)}
         atomic_write_json(folder / "sweep.json", {**self.to_dict(), **sweep})
-        files.append("sweep.json")
-        return files
+        return self.file_names()
 
 
 def find_tolerance_angle(
@@ -265,15 +261,13 @@ def tolerance_angle_from_scenario(
     """Run the job for a resolved scenario (``Scenario.data``: the top-level ``robot``, ``base``
     and ``[failure]``, and the ``[tolerance_angle]`` table, in degrees); ``previous`` is not
     used.  Same result as ``jointlock tolerance-angle`` with the scenario's options."""
-    failure = data.get("failure", {})
-    if failure.get("joint") is None or failure.get("angle_deg") is None:
-        raise ScenarioError("job [tolerance_angle] needs [failure] joint and angle_deg")
+    joint, angle = scenario_lock(data, "tolerance_angle")
     t = data["tolerance_angle"]
     model = load_robot(data["robot"], base=data["base"])
     return find_tolerance_angle(
         model,
-        int(failure["joint"]),
-        math.radians(float(failure["angle_deg"])),
+        joint,
+        angle,
         [float(v) for v in t["q_target_deg"]],
         gamma_limit_deg=float(t["gamma_limit_deg"]),
         zoom_deg=float(t["zoom_deg"]),

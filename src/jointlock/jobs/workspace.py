@@ -10,7 +10,6 @@ printing.
 
 from __future__ import annotations
 
-import io
 import math
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -32,11 +31,11 @@ from ..analysis.workspace import (
 )
 from ..errors import ScenarioError
 from ..io import files as _files
-from ..io.files import atomic_write_json, write_png
+from ..io.files import atomic_write_json, npz_bytes, write_png
 from ..model import ArmModel
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult
+from ._common import JobResult, scenario_lock
 
 #: Points of each cloud drawn in the projections, and in the 3-D clouds.
 PROJECTION_POINTS = 20000
@@ -206,21 +205,14 @@ class WorkspaceStudy(JobResult):
         folder = Path(out)
         folder.mkdir(parents=True, exist_ok=True)
         full, locked = self.full_points, self.locked_points
-        files = []
         fig = plot_workspace_projections(full, locked, fig=offscreen_figure(PROJECTIONS_FIGSIZE))
         write_png(fig, folder / "projections.png", dpi=110)
-        files.append("projections.png")
         fig = plot_workspace_clouds(full, locked, fig=offscreen_figure(CLOUDS_FIGSIZE))
         write_png(fig, folder / "clouds.png", dpi=110)
-        files.append("clouds.png")
         arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
-        buf = io.BytesIO()
-        np.savez_compressed(buf, **arrays)
-        _files.atomic_write_bytes(folder / "points.npz", buf.getvalue())  # looked up here: spies see it
-        files.append("points.npz")
+        _files.atomic_write_bytes(folder / "points.npz", npz_bytes(compressed=True, **arrays))  # spies see it
         atomic_write_json(folder / "workspace.json", self.to_dict())
-        files.append("workspace.json")
-        return files
+        return self.file_names()
 
 
 def study_workspace(
@@ -303,15 +295,11 @@ def workspace_from_scenario(
     """Run the job for a resolved scenario (``Scenario.data``: the top-level ``robot``, ``base``,
     ``seed`` and ``[failure]`` (optional), and the ``[workspace]`` table); ``previous`` is not
     used.  Same result as ``jointlock workspace`` with the scenario's options."""
-    failure = data.get("failure", {})
-    lk = None
-    if failure.get("joint") is not None and failure.get("angle_deg") is not None:
-        lk = (int(failure["joint"]), math.radians(float(failure["angle_deg"])))
     t = data["workspace"]
     model = load_robot(data["robot"], base=data["base"])
     return study_workspace(
         model,
-        lk,
+        scenario_lock(data),
         samples=int(t["samples"]),
         voxel=None if t["voxel"] is None else float(t["voxel"]),
         rng=int(data["seed"]),

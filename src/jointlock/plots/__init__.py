@@ -10,9 +10,7 @@ from here (``jl.plots.plot_global_torque_vs_k``).  Modules are imported on first
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from .._lazy import lazy_attributes
 from ._common import new_axes, new_figure, offscreen_figure
 from .arm import arm_figure, draw_arm, plot_arm, set_equal_3d
 
@@ -42,16 +40,9 @@ _WHERE = {name: module for module, names in _FUNCTIONS.items() for name in names
 _MODULES = (*_FUNCTIONS, "arm")
 
 
-def __getattr__(name: str) -> Any:
-    if name in _MODULES:
-        return importlib.import_module(f"{__name__}.{name}")
-    if name in _WHERE:
-        return getattr(importlib.import_module(f"{__name__}.{_WHERE[name]}"), name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_MODULES) | set(_WHERE))
+__getattr__, __dir__ = lazy_attributes(
+    __name__, {name: f"{__name__}.{module}" for name, module in _WHERE.items()}, _MODULES, globals()
+)
 
 
 __all__ = ["arm_figure", "draw_arm", "new_axes", "new_figure", "offscreen_figure", "plot_arm", "set_equal_3d", *_WHERE]

@@ -7,20 +7,11 @@ from typing import Any
 
 import numpy as np
 
+from ..jobs.jump import KAPPA_UNIT, _points_text
 from ..report import Section
 from ..scenario import Scenario
 from ._summary import _pct, _pct0
 
-#: Unit of kappa: qdot [rad/s] = kappa * grad w, w = sqrt(det(J J^T)) [m^3] (docs/jump.md).
-KAPPA_UNIT = "rad^2/(s m^3)"
-
-
-def _points_text(points: list) -> str:
-    """001's segment points [s]; NaN (kappa falls back to 0 over the whole task) -> none."""
-    vals = [np.nan if p is None else float(p) for p in points]
-    if not any(np.isfinite(vals)):
-        return "none (kappa = 0 everywhere)"
-    return ", ".join(f"{v:.3g} s" if np.isfinite(v) else "none" for v in vals)
 
 def _condition_verdict(name: str, sufficient: bool) -> str:
     """Verdict of one singularity condition: 004's Cond1-Cond5 are reproduced or not;

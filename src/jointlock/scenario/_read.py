@@ -5,13 +5,12 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
-import sys
 import tomllib
-import warnings
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from .._deprecate import warn_once
 from ..errors import ScenarioError
 from ..robots import BUILTIN_ROBOTS
 from ._checks import _check_semantics, _inherit_singular_base, _resolve_robot
@@ -206,23 +205,12 @@ def _table(raw: Any, name: str, fields: dict[str, Field], source: str) -> dict[s
     return out
 
 
-#: Former field names (``"table.field"``) already warned about in this process.
-_WARNED: set[str] = set()
-
-
 def _warn_former_name(table: str, old: str, new: str, spec: Field, source: str) -> None:
     """A ``FutureWarning``, once per process and former name, naming the field's new name."""
-    if f"{table}.{old}" in _WARNED:
-        return
-    _WARNED.add(f"{table}.{old}")
-    frame, level = sys._getframe(), 1  # point at the first caller outside this package
-    while frame.f_back is not None and frame.f_globals.get("__name__", "").startswith(f"{__package__}."):
-        frame, level = frame.f_back, level + 1
-    warnings.warn(
+    warn_once(
+        f"field {table}.{old}",
         f"{source}: {table}.{old} is deprecated: write {table}.{new} instead (the same quantity, in "
         f"{spec.unit}); the old name still works for now",
-        FutureWarning,
-        stacklevel=level,
     )
 
 

@@ -22,7 +22,7 @@ from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal
 from ...planning.halt_motion import HaltProblem, optimal_halt_motion
 from ...progress import Progress
 from ...robots import load_robot
-from .._common import JobResult, joint_vector_deg
+from .._common import JobResult, joint_vector_deg, scenario_lock
 from ._inputs import (
     CLI_LIMIT_NAMES,
     SCENARIO_LIMIT_NAMES,
@@ -353,8 +353,8 @@ def halt_from_scenario(
     failure of the scenario; the halt configuration from ``[halt] qf_deg``, 000's q_best
     (``paper_qf``), else the ``halt_config`` job that ran before it, else searched here."""
     t, st, lim = data["halt"], data["state"], data["limits"]
-    fail = data["failure"]
-    locks = {int(fail["joint"]): math.radians(float(fail["angle_deg"]))} if fail.get("angle_deg") is not None else {}
+    lk = scenario_lock(data)
+    locks = {} if lk is None else dict([lk])
     base = t.get("base") or data["base"]
     model = halt_model(data["robot"], locks, base)
     state = FailureState.from_degrees(

@@ -3,11 +3,10 @@ modes."""
 
 from __future__ import annotations
 
-import math
 from collections.abc import Mapping
 from typing import Any
 
-from .._common import JobResult, joint_vector_deg
+from .._common import JobResult, joint_vector_deg, scenario_lock
 from ._search import SingularitySearchResult, search_singularities
 from ._shared import SEARCH_SAMPLES, VERIFY_SAMPLES, singular_model
 from ._study import SingularityResult, study_singularity
@@ -32,10 +31,8 @@ def singular_from_scenario(
     not used.
     """
     t = data["singular"]
-    fail = data.get("failure") or {}
-    locks = {}
-    if fail.get("joint") is not None and fail.get("angle_deg") is not None:
-        locks = {int(fail["joint"]): math.radians(float(fail["angle_deg"]))}
+    lk = scenario_lock(data)
+    locks = {} if lk is None else dict([lk])
     verify = bool(t["verify_conditions"])
     base = t["base"] or ("virtual" if verify else "fixed")
     model = singular_model(data["robot"], locks, base)

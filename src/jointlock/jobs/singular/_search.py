@@ -142,11 +142,9 @@ class SingularitySearchResult(JobResult):
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         atomic_write_json(out / "search.json", self.search_json())
-        names = ["search.json"]
         fig = offscreen_figure(SIGMA_MIN_FIGSIZE)
         plot_search_sigma_min(self.model, self.search, ax=fig.add_subplot())
         atomic_write_bytes(out / "sigma_min.png", figure_png(fig))
-        names.append("sigma_min.png")
         if self.search.families:
             fig = plot_singular_families(
                 self.model, self.search, fig=offscreen_figure(families_figsize(self.search))
@@ -156,8 +154,7 @@ class SingularitySearchResult(JobResult):
                 self.model, self.search, fig=offscreen_figure(joint_angles_figsize(self.model))
             )
             atomic_write_bytes(out / "joint_angles.png", figure_png(fig))
-            names += ["families.png", "joint_angles.png"]
-        return names
+        return self.file_names()
 
 
 @renamed_keyword(old="base", new="jacobian")

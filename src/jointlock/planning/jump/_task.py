@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import difflib
 import math
-import warnings
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -15,6 +14,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._deprecate import warn_once
 from ...errors import ScenarioError
 from ...model import FloatArray
 
@@ -232,22 +232,14 @@ def load_jump_task(path: str | Path) -> JumpScenario:
     return scenario_from_mapping(data, source=str(path))
 
 
-#: Whether the deprecated :func:`load_scenario` has warned in this process (it warns once).
-_warned_load_scenario = False
-
-
 def load_scenario(path: str | Path) -> JumpScenario:
     """Deprecated alias of :func:`load_jump_task` (warns once per process, ``FutureWarning``)."""
-    global _warned_load_scenario
-    if not _warned_load_scenario:
-        _warned_load_scenario = True
-        warnings.warn(
-            "jointlock.planning.jump.load_scenario is deprecated: use jointlock.planning.jump."
-            "load_jump_task (the same jump task-file reader; jointlock.load_scenario reads "
-            "`jointlock run` scenario files)",
-            FutureWarning,
-            stacklevel=2,
-        )
+    warn_once(
+        "function jointlock.planning.jump.load_scenario",
+        "jointlock.planning.jump.load_scenario is deprecated: use jointlock.planning.jump."
+        "load_jump_task (the same jump task-file reader; jointlock.load_scenario reads "
+        "`jointlock run` scenario files)",
+    )
     return load_jump_task(path)
 
 
