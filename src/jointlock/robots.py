@@ -7,6 +7,7 @@ Use :func:`load_robot` to get one by name (or to read a ``.urdf`` / ``.toml`` mo
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -242,6 +243,31 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
 
 # -- registry -------------------------------------------------------------------------------
 
+# Models are immutable (frozen, read-only arrays), so one process builds each model once and
+# shares it: a failure campaign loads the same arm for thousands of cases, in every worker.
+
+
+@functools.lru_cache(maxsize=16)
+def _builtin(name: str, base: BaseMode) -> ArmModel:
+    return _builtin_factories()[name](base=base)
+
+
+@functools.lru_cache(maxsize=32)
+def _read_model_file(path: str, base: BaseMode, stamp: tuple[str, int, int] | None) -> ArmModel:
+    """A model file read once per (absolute path, base, modification time, size): an edited
+    file is read again."""
+    del stamp  # part of the cache key only
+    if Path(path).suffix.lower() == ".urdf":
+        from .io.urdf import read_urdf
+
+        return read_urdf(path, base=base)
+    from .io.modelfile import read_model_toml
+
+    model = read_model_toml(path)
+    if base == "floating" and not model.floating:
+        raise ModelError(f"{path}: base='floating' needs a [base] table with the spacecraft")
+    return model if base == "floating" else model.fixed()
+
 
 def _builtin_factories() -> dict[str, Callable[..., ArmModel]]:
     return {"halt7": halt7, "canadarm7": canadarm7, "puma6": puma6}
@@ -262,24 +288,22 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         ``"fixed"`` or ``"floating"``.  For built-ins, ``"floating"`` attaches the robot's
         documented spacecraft; for a URDF, the root link's inertial; for a TOML file, its
         ``[base]`` table (``"fixed"`` drops it).
+
+    Each model is built once per process (a model file once per modification) and shared:
+    models are immutable.
     """
     _check_base(base)
     text = str(name_or_path)
     factories = _builtin_factories()
     if text in factories:
-        return factories[text](base=base)
+        return _builtin(text, base)
     suffix = Path(text).suffix.lower()
-    if suffix == ".urdf":
-        from .io.urdf import read_urdf
-
-        return read_urdf(text, base=base)
-    if suffix == ".toml":
-        from .io.modelfile import read_model_toml
-
-        model = read_model_toml(text)
-        if base == "floating" and not model.floating:
-            raise ModelError(f"{text}: base='floating' needs a [base] table with the spacecraft")
-        return model if base == "floating" else model.fixed()
+    if suffix in (".urdf", ".toml"):
+        try:
+            stat = Path(text).stat()
+        except OSError:  # the reader names the file and the reason
+            return _read_model_file(text, base, None)
+        return _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size))
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ModelError(
