@@ -112,6 +112,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=501,
         help=f"time samples of the objective (odd, >= {MIN_N_SAMPLES}; default 501)",
     )
+    p.add_argument(
+        "--minimum-T",
+        action="store_true",
+        help="also find the smallest feasible halt time when the halt is feasible (an infeasible "
+        "halt always reports it)",
+    )
     p.add_argument("--generations", type=int, default=100, help="GA generations, >= 0 (default 100)")
     p.add_argument("--population", type=int, default=50, help="GA population, >= 2 (default 50)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -170,6 +176,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         reachable=not args.no_reachability,
         n_samples=args.n_samples,
         ga=ga,
+        minimum_T=args.minimum_T,
         progress=progress,
         _names=CLI_NAMES,
     )

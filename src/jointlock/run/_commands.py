@@ -8,12 +8,12 @@ that running the printed command gives the same result.
 
 from __future__ import annotations
 
-import json
 import shlex
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from ..io.files import toml_document
 from ..robots import load_robot
 from ..scenario import JOB_ORDER, Scenario, job_lock_args, jump_fields
 
@@ -87,8 +87,8 @@ def job_argv(
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
-        argv += ["--population", str(t["population"]), "--json", "--out", job_out]
-        argv += ["--quiet"] if quiet else []
+        argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])
+        argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "jump":
         fields = jump_fields(d)
         task = out / "jump" / "task.toml"
@@ -136,21 +136,7 @@ def job_argv(
 
 def toml_table(fields: dict[str, Any]) -> str:
     """A flat TOML table (numbers, strings, booleans, lists of numbers)."""
-
-    def value(v: Any) -> str:
-        if isinstance(v, bool):
-            return "true" if v else "false"
-        if isinstance(v, str):
-            return json.dumps(v)
-        if isinstance(v, (list, tuple)):
-            return "[" + ", ".join(value(x) for x in v) + "]"
-        if isinstance(v, int):
-            return str(v)
-        return repr(float(v))
-
-    return "".join(f"{k} = {value(v)}\n" for k, v in fields.items())
-
-
+    return toml_document(fields)
 
 
 def jump_task_toml(scenario: Scenario) -> str:

@@ -172,6 +172,12 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
         "generations": Field("int", 100, lo=1, hi=100_000, help="GA generations"),
         "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
+        "minimum_T": Field(
+            "bool",
+            False,
+            help="also find the smallest feasible halt time when the halt is feasible (an "
+            "infeasible halt always reports it)",
+        ),
         "base": Field(
             "choice",
             None,

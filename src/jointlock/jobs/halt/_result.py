@@ -180,6 +180,8 @@ class HaltPlan(JobResult):
         else:
             lo, hi = res.k_interval / scale
             lines += ["", f"feasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}", f"k* = {k_text(res)}"]
+        if res.feasible and res.minimum_T is not None:
+            lines.append(f"smallest halt time with a feasible k: T = {res.minimum_T:.3f} s")
         at = "k*" if res.feasible else "least-violating k (infeasible)"
         lines.append(
             f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "

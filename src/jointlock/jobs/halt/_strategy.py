@@ -249,6 +249,7 @@ def plan_halt(
     reachable: bool = True,
     n_samples: int = 501,
     ga: GASettings | None = None,
+    minimum_T: bool = False,
     progress: bool = False,
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
@@ -291,6 +292,10 @@ def plan_halt(
         ranges (000's way).
     n_samples
         Time samples of the objective (odd, Simpson's rule).
+    minimum_T
+        Also find the smallest halt time with a feasible ``k`` when the halt is feasible
+        (:func:`~jointlock.planning.halt_motion.minimum_halt_time`, for the same halt
+        configuration); an infeasible halt always reports it.
     progress
         Show progress bars on stderr.
 
@@ -330,7 +335,9 @@ def plan_halt(
         base=base, n_samples=n_samples,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
-    motion = optimal_halt_motion(problem, solver=solver, rng=rng, ga_settings=ga, progress=bar)
+    motion = optimal_halt_motion(
+        problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar
+    )
     if bar is not None:
         bar.close()
     return HaltPlan(
@@ -381,6 +388,7 @@ def halt_from_scenario(
         samples=int(t["samples"]),
         n_samples=int(t["n_samples"]),
         ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
+        minimum_T=bool(t["minimum_T"]),
         progress=progress,
         _names=names,
     )
