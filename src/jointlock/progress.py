@@ -18,23 +18,49 @@ T = TypeVar("T")
 class Progress:
     """Progress reporter: ``with Progress(total, "sampling") as p: p.update(k)``."""
 
-    def __init__(self, total: int, desc: str = "", *, enabled: bool | None = None, stream=None) -> None:
+    def __init__(
+        self,
+        total: int,
+        desc: str = "",
+        *,
+        enabled: bool | None = None,
+        stream=None,
+        unit: str | None = None,
+        initial: int = 0,
+    ) -> None:
         self.total = max(int(total), 1)
         self.desc = desc
         self.stream = stream if stream is not None else sys.stderr
         self.enabled = self.stream.isatty() if enabled is None else enabled
-        self.done = 0
+        self.unit = unit
+        self.done = int(initial)
+        self._initial = int(initial)
         self._start = time.perf_counter()
         self._last = 0.0
+        self._width = 0
 
-    def update(self, n: int = 1) -> None:
+    def update(self, n: int = 1, *, note: str = "") -> None:
+        """Count ``n`` more items done; ``note`` (e.g. "3 failed") is shown after the bar.
+
+        With a ``unit`` the line also shows done/total, the rate since the bar started (items
+        counted in ``initial`` excluded) and the time left at that rate."""
         self.done += n
         now = time.perf_counter()
         if self.enabled and (now - self._last > 0.1 or self.done >= self.total):
             self._last = now
             frac = min(self.done / self.total, 1.0)
             bar = "#" * int(30 * frac)
-            self.stream.write(f"\r{self.desc} [{bar:<30}] {100 * frac:5.1f}% {now - self._start:6.1f}s")
+            elapsed = now - self._start
+            line = f"\r{self.desc} [{bar:<30}] {100 * frac:5.1f}% {elapsed:6.1f}s"
+            if self.unit is not None:
+                rate = (self.done - self._initial) / elapsed if elapsed > 0 else 0.0
+                left = (self.total - self.done) / rate if rate > 0 else float("nan")
+                eta = _clock(left) if left == left else "?"
+                line += f" {self.done}/{self.total} {self.unit}, {rate:.3g}/s, ETA {eta}"
+            if note:
+                line += f", {note}"
+            self.stream.write(line + " " * max(self._width - len(line), 0))
+            self._width = len(line)
             self.stream.flush()
 
     def close(self) -> None:
@@ -47,6 +73,13 @@ class Progress:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def _clock(seconds: float) -> str:
+    """``"1:02:03"`` / ``"2:03"`` from seconds."""
+    m, sec = divmod(int(round(seconds)), 60)
+    h, m = divmod(m, 60)
+    return f"{h}:{m:02d}:{sec:02d}" if h else f"{m}:{sec:02d}"
 
 
 def track(items: Iterable[T], total: int, desc: str = "", *, enabled: bool | None = None) -> Iterator[T]:
