@@ -13,6 +13,7 @@ import json
 import math
 import os
 import tempfile
+from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
@@ -44,6 +45,38 @@ def to_plain(obj: Any) -> Any:
 def json_text(obj: Any) -> str:
     """``obj`` as indented JSON text (see :func:`to_plain`), with a final newline."""
     return json.dumps(to_plain(obj), indent=2, allow_nan=False) + "\n"
+
+
+def toml_value(value: Any) -> str:
+    """One TOML value: a string, boolean, integer, float or a list of them."""
+    if isinstance(value, (bool, np.bool_)):
+        return "true" if value else "false"
+    if isinstance(value, str):
+        return json.dumps(value)  # a JSON string is a TOML basic string
+    if isinstance(value, (list, tuple, np.ndarray)):
+        return "[" + ", ".join(toml_value(x) for x in value) + "]"
+    if isinstance(value, (int, np.integer)):
+        return str(int(value))
+    return repr(float(value))
+
+
+def toml_document(data: Mapping[str, Any]) -> str:
+    """``data`` as TOML text: its plain values first, then each table (``[name]``, nested
+    tables as ``[name.sub]``); ``None`` values are left out (TOML has no null)."""
+
+    def write(table: Mapping[str, Any], prefix: str) -> list[str]:
+        lines = [f"{_toml_key(k)} = {toml_value(v)}" for k, v in table.items() if v is not None and not isinstance(v, Mapping)]
+        for key, sub in table.items():
+            if isinstance(sub, Mapping):
+                name = f"{prefix}{_toml_key(key)}"
+                lines += ["", f"[{name}]", *write(sub, name + ".")]
+        return lines
+
+    return "\n".join(write(data, "")).lstrip("\n") + "\n"
+
+
+def _toml_key(key: str) -> str:
+    return key if key.replace("_", "").replace("-", "").isalnum() and key.isascii() else json.dumps(key)
 
 
 def _umask() -> int:
