@@ -30,3 +30,7 @@ class InfeasibleError(JointlockError):
 
 class SingularityWarning(UserWarning):
     """A result was computed at or near a singular configuration and may be ill-conditioned."""
+
+
+class CampaignError(JointlockError, ValueError):
+    """A campaign file, one of its cases, or a campaign output folder (ledger) is invalid."""

@@ -32,6 +32,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "workspace",
     "singular",
     "run",
+    "campaign",
     "reproduce",
     "demo",
 )
@@ -62,7 +63,7 @@ def build_parser() -> argparse.ArgumentParser:
         if importlib.util.find_spec(f"{__name__}.{name}") is None:
             continue
         importlib.import_module(f"{__name__}.{name}").register(sub)
-    for command_parser in sub.choices.values():
+    for command_parser in _all_parsers(sub):
         # --debug after the subcommand too; SUPPRESS keeps the top-level value when absent
         if not any("--debug" in a.option_strings for a in command_parser._actions):
             command_parser.add_argument(
@@ -70,6 +71,17 @@ def build_parser() -> argparse.ArgumentParser:
             )
     parser.set_defaults(_commands=sub.choices)
     return parser
+
+
+def _all_parsers(sub: argparse._SubParsersAction) -> list[argparse.ArgumentParser]:
+    """The subcommands' parsers, those of nested subcommands (``campaign run``) included."""
+    out = []
+    for parser in sub.choices.values():
+        out.append(parser)
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction):
+                out += _all_parsers(action)
+    return out
 
 
 def _os_error_text(exc: OSError) -> str:

@@ -1,0 +1,405 @@
+"""The report of a campaign: a self-contained HTML page (:func:`write_campaign_report`) with
+what varied, the headline numbers, heatmaps of every recorded result over two varied fields
+(e.g. failure joint x failure time -> share of feasible halts, smallest halt time, base torque,
+jump reduction), their distributions, the worst cases -- each written as a plain scenario file
+that ``jointlock run`` re-runs exactly -- and the failed cases with their errors."""
+
+from __future__ import annotations
+
+import html
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from .. import report as rp
+from ..errors import CampaignError
+from ..io.files import atomic_write_text, figure_png, toml_document
+from ..plots._common import offscreen_figure
+from ..plots.campaign import plot_distribution, plot_heatmap
+from ..scenario import apply_overrides
+from ._cases import params_text
+from ._columns import WORSE, is_numeric
+from ._ledger import open_ledger
+from ._results import CampaignStatus, CampaignTable, campaign_status, campaign_table
+from ._spec import spec_from_dict
+
+#: Distinct values above which a numeric field is binned on a heatmap axis.
+MAX_CATEGORIES = 24
+#: Bins of a binned heatmap axis.
+AXIS_BINS = 10
+#: Most heatmaps and histograms in one report.
+MAX_FIGURES = 10
+#: Folder (in the campaign's output folder) of the worst cases' scenario files.
+WORST_DIR = "worst"
+#: Columns that rank the worst cases by default, the first recorded one (else any of
+#: :data:`~jointlock.campaign._columns.WORSE`).
+WORST_FIRST = (
+    "halt.minimum_T_s",
+    "halt.global_torque_Nm",
+    "jump.jump_after|mean",
+    "jump.mean_reduction",
+    "replan.max_tracking_position_error_m",
+    "workspace.share_kept",
+    "singular.sigma_min",
+)
+#: Preferred heatmap axes, in order (y first: the failing joint reads best down the side).
+_PREFERRED_Y = ("failure.joint", "robot", "base")
+_PREFERRED_X = ("failure.time_s", "failure.angle_deg", "halt.T")
+
+
+@dataclass(frozen=True, eq=False)
+class CampaignReport:
+    """What a campaign's report shows (``write()`` writes it).
+
+    Attributes
+    ----------
+    status, table
+        The campaign's counts and its finished cases.
+    x, y
+        The varied fields of the heatmaps' axes (None when fewer are varied).
+    worst_column, worse
+        The result the worst cases are ranked by and which way is worse.
+    worst
+        The worst cases' table rows, worst first.
+    """
+
+    status: CampaignStatus
+    table: CampaignTable
+    spec: dict[str, Any]
+    x: str | None
+    y: str | None
+    worst_column: str | None
+    worse: str
+    worst: tuple[dict[str, Any], ...]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {
+            "status": self.status.to_dict(),
+            "x": self.x,
+            "y": self.y,
+            "worst_column": self.worst_column,
+            "worse": self.worse,
+            "worst": [{k: r[k] for k in ("index", "key", *self.table.params, self.worst_column)} for r in self.worst]
+            if self.worst_column
+            else [],
+        }
+
+    def summary(self) -> list[str]:
+        lines = self.status.summary()[:3]
+        if self.worst_column and self.worst:
+            lines.append(f"worst cases by {self.worst_column} ({self.worse} is worse):")
+            for r in self.worst[:5]:
+                lines.append(f"  #{r['index']} ({params_text({p: r[p] for p in self.table.params}, limit=80)}): "
+                             f"{_fmt(r[self.worst_column])}")  # fmt: skip
+        return lines
+
+    def write(self, path: str | Path | None = None) -> list[Path]:
+        """Write ``report.html`` (default: in the campaign's output folder) and the worst
+        cases' scenario files (``worst/case-INDEX.toml`` beside it); returns the paths."""
+        out = Path(self.status.out)
+        page = Path(path) if path is not None else out / "report.html"
+        page.parent.mkdir(parents=True, exist_ok=True)
+        written = self._write_worst(page.parent)
+        atomic_write_text(page, self.html(page.parent))
+        return [page, *written]
+
+    def _case_file(self, row: dict[str, Any]) -> str:
+        return f"{WORST_DIR}/case-{row['index']}-{row['key'][:8]}.toml"
+
+    def _write_worst(self, folder: Path) -> list[Path]:
+        spec = spec_from_dict(self.spec)
+        written = []
+        for row in self.worst:
+            overrides = {**spec.fixed, **{p: row[p] for p in self.table.params if row.get(p) is not None}}
+            overrides["seed"] = row["case_seed"]  # the seed the case ran with (from its key)
+            data = apply_overrides(spec.scenario, overrides, source=spec.scenario_source)
+            data["title"] = f"{spec.title}: case {row['index']} ({params_text({p: row[p] for p in self.table.params})})"
+            data.pop("out", None)
+            robot = Path(str(data.get("robot", "")))
+            if robot.suffix.lower() in (".toml", ".urdf") and not robot.is_absolute():
+                data["robot"] = str((spec.scenario_dir / robot).resolve())
+            header = (
+                f"# Case {row['index']} of the campaign {spec.source} (key {row['key']}), as a plain scenario:\n"
+                f"#   jointlock run {self._case_file(row)}\n# gives the same numbers as the campaign (same seed).\n"
+            )
+            path = folder / self._case_file(row)
+            atomic_write_text(path, header + toml_document(data))
+            written.append(path)
+        return written
+
+    def html(self, folder: Path | None = None) -> str:
+        """The report page (links to the worst cases' files relative to ``folder``)."""
+        s, t = self.status, self.table
+        sections = [_overview(s, self.spec), _varied(self.spec)]
+        ok_rows = [r for r in t.rows if r["status"] == "ok"]
+        numeric = [m for m in t.metrics if is_numeric([r.get(m) for r in ok_rows])]
+        sections.append(_headline(ok_rows, numeric))
+        # a result with one value over every case says all in the table: no figure for it
+        varying = [m for m in numeric if len({r.get(m) for r in ok_rows if r.get(m) is not None}) > 1]
+        if self.x or self.y:
+            sections.append(self._heatmaps(list(t.rows), varying))
+        sections.append(_distributions(ok_rows, varying))
+        if self.worst_column:
+            sections.append(self._worst_section())
+        sections.append(_failures(s, t))
+        page = rp.render_html(
+            f"jointlock campaign: {s.title}",
+            [sec for sec in sections if sec is not None],
+            intro=(
+                f"Campaign <code>{html.escape(s.source)}</code>: {s.planned} cases, {s.ok} ok, {s.failed} failed"
+                + (f", <b>{s.remaining} not run yet</b>" if s.remaining else "")
+                + f". Every number is in <code>{html.escape(str(Path(s.out) / 'ledger.sqlite'))}</code> "
+                "(<code>jointlock campaign export</code> writes it as CSV or Parquet)."
+            ),
+            toc=True,
+            footer="Generated by <code>jointlock campaign report</code>.",
+        )
+        return page
+
+    def _heatmaps(self, rows: list[dict[str, Any]], numeric: list[str]) -> rp.Section:
+        """One heatmap per result over (x, y); first, when some cases failed, the share of
+        cases that ran every job."""
+        sec = rp.Section("Heatmaps")
+        xs, x_labels = _axis(rows, self.x)
+        ys, y_labels = _axis(rows, self.y)
+        sec.paragraphs.append(
+            f"Each cell: the mean over the cases in it (a share for yes/no results) of "
+            f"{html.escape(self.y or '-')} (rows) x {html.escape(self.x or '-')} (columns), other varied "
+            "fields pooled; blank: no finished case."
+        )
+        ran = "ran every job (no error)"
+        failed = any(r["status"] != "ok" for r in rows)
+        for metric in ([ran] if failed else []) + numeric[:MAX_FIGURES]:
+            values = [r["status"] == "ok" for r in rows] if metric == ran else [r.get(metric) for r in rows]
+            share = all(isinstance(v, bool) for v in values if v is not None)
+            grid = np.full((len(y_labels), len(x_labels)), np.nan)
+            sums = np.zeros_like(grid)
+            n = np.zeros_like(grid)
+            for xi, yi, v in zip(xs, ys, values):
+                if v is not None and math.isfinite(float(v)):
+                    sums[yi, xi] += float(v)
+                    n[yi, xi] += 1
+            np.divide(sums, n, out=grid, where=n > 0)
+            fig = offscreen_figure((min(2.5 + 0.6 * len(x_labels), 12.0), min(2.0 + 0.45 * len(y_labels), 9.0)))
+            plot_heatmap(
+                grid, x_labels, y_labels, x_name=self.x or "", y_name=self.y or "",
+                label=("share " if share else "mean ") + metric, title=metric, share=share, ax=fig.add_subplot(),
+            )  # fmt: skip
+            fig.tight_layout()
+            sec.images.append(((f"share of cases with {metric} = yes" if share else f"mean of {metric}"), figure_png(fig)))
+        return sec
+
+    def _worst_section(self) -> rp.Section:
+        col = self.worst_column or ""
+        sec = rp.Section(f"Worst cases by {col}")
+        sec.paragraphs.append(
+            f"The {len(self.worst)} cases with the {'highest' if self.worse == 'higher' else 'lowest'} "
+            f"{html.escape(col)}. Each is a plain scenario file: <code>jointlock run FILE</code> re-runs it "
+            "with the campaign's seed for that case and writes its full report."
+        )
+        others = [m for m in self.table.metrics if m != col][:4]
+        header = ["#", *self.table.params, col, *others]
+        sec.tables.append((header, [[r["index"], *(r[p] for p in self.table.params), r[col], *(r.get(m) for m in others)]
+                                    for r in self.worst]))  # fmt: skip
+        links = ", ".join(
+            f'<a href="{html.escape(self._case_file(r))}">case {r["index"]}</a>' for r in self.worst
+        )
+        sec.paragraphs.append(f"Scenario files: {links}.")
+        return sec
+
+
+def _fmt(v: Any) -> str:
+    if isinstance(v, float):
+        return f"{v:.6g}"
+    return str(v)
+
+
+def _overview(s: CampaignStatus, spec: dict[str, Any]) -> rp.Section:
+    sec = rp.Section("Campaign")
+    sec.facts += [
+        ("campaign file", s.source),
+        ("base scenario", spec.get("scenario_source", "?")),
+        ("campaign seed", spec.get("seed")),
+        ("cases", f"{s.planned} planned: {s.ok} ok, {s.failed} failed, {s.remaining} not run"),
+        ("work", f"{s.case_seconds:.1f} s of case time over {len(s.runs)} run(s)"),
+    ]
+    if spec.get("set"):
+        sec.facts.append(("the same for every case", params_text(spec["set"], limit=400)))
+    sec.tables.append(
+        (
+            ["run", "started", "engine", "sent", "ok", "failed", "ended"],
+            [
+                [r["id"], r["started_at"], r["engine"], r["to_run"], r["ok"], r["failed"],
+                 f"stopped by {r['stopped_by']}" if r["stopped_by"] else ("finished" if r["finished_at"] else "cut off")]
+                for r in s.runs
+            ],
+        )
+    )  # fmt: skip
+    return sec
+
+
+def _varied(spec: dict[str, Any]) -> rp.Section:
+    sec = rp.Section("What varied")
+    rows = [[name, "grid", len(v), _values(v)] for name, v in spec.get("grid", {}).items()]
+    rows += [[name, "zip", len(v), _values(v)] for name, v in spec.get("zip", {}).items()]
+    sample = spec.get("sample")
+    if sample:
+        rows += [
+            [name, f"sample ({sample['method']})", sample["n"], f"[{lo:g}, {hi:g}]"]
+            for name, (lo, hi) in sample["ranges"].items()
+        ]
+    sec.tables.append((["field", "how", "values", "of"], rows))
+    if spec.get("exclude"):
+        sec.notes += [f"excluded: cases with {params_text(f, limit=300)}" for f in spec["exclude"]]
+    return sec
+
+
+def _values(values: Sequence[Any]) -> str:
+    text = ", ".join(_fmt(v) for v in values)
+    return text if len(text) <= 120 else text[:117] + "..."
+
+
+def _headline(rows: list[dict[str, Any]], numeric: list[str]) -> rp.Section:
+    sec = rp.Section("Results over every finished case")
+    table = []
+    for m in numeric:
+        vals = [r[m] for r in rows if r.get(m) is not None]
+        if vals and all(isinstance(v, bool) for v in vals):
+            table.append([m, len(vals), f"yes in {100 * sum(vals) / len(vals):.1f} %", None, None, None])
+        elif vals:
+            a = np.asarray(vals, dtype=float)
+            table.append([m, len(vals), float(a.min()), float(np.median(a)), float(a.mean()), float(a.max())])
+    sec.tables.append((["result", "cases", "min", "median", "mean", "max"], table))
+    if not rows:
+        sec.paragraphs.append("No case finished yet.")
+    return sec
+
+
+def _distributions(rows: list[dict[str, Any]], numeric: list[str]) -> rp.Section | None:
+    metrics = [m for m in numeric if not all(isinstance(r.get(m), bool) for r in rows if r.get(m) is not None)]
+    if not rows or not metrics:
+        return None
+    sec = rp.Section("Distributions")
+    for m in metrics[:MAX_FIGURES]:
+        fig = offscreen_figure((5.0, 3.2))
+        plot_distribution([np.nan if r.get(m) is None else float(r[m]) for r in rows], name=m, ax=fig.add_subplot())
+        fig.tight_layout()
+        sec.images.append((f"distribution of {m}", figure_png(fig)))
+    return sec
+
+
+def _failures(s: CampaignStatus, t: CampaignTable) -> rp.Section:
+    sec = rp.Section("Failed cases")
+    if not s.failures:
+        sec.paragraphs.append("None: every finished case ran every job.")
+        return sec
+    sec.paragraphs.append(
+        f"{len(s.failures)} case(s) raised; each is recorded with its error and the campaign went on. "
+        "<code>jointlock campaign status</code> lists them; <code>run --retry-failed</code> runs them again."
+    )
+    sec.tables.append(
+        (
+            ["#", *t.params, "error", "message"],
+            [[f["index"], *(f["params"].get(p) for p in t.params), f["error_type"], (f["error_message"] or "")[:300]]
+             for f in s.failures[:100]],
+        )
+    )  # fmt: skip
+    return sec
+
+
+def _axis(rows: list[dict[str, Any]], name: str | None) -> tuple[list[int], list[str]]:
+    """Each row's position on one heatmap axis and the axis labels: one per distinct value
+    (sorted), or :data:`AXIS_BINS` equal bins of a numeric field with many values."""
+    if name is None:
+        return [0] * len(rows), ["all"]
+    values = [r.get(name) for r in rows]
+    distinct = sorted({_hashable(v) for v in values}, key=_sort_key)
+    numeric = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in distinct)
+    if len(distinct) <= MAX_CATEGORIES or not numeric:
+        where = {v: i for i, v in enumerate(distinct)}
+        return [where[_hashable(v)] for v in values], [_fmt(v) for v in distinct]
+    lo, hi = float(min(distinct)), float(max(distinct))
+    edges = np.linspace(lo, hi, AXIS_BINS + 1)
+    index = np.clip(np.searchsorted(edges, np.asarray(values, dtype=float), side="right") - 1, 0, AXIS_BINS - 1)
+    labels = [f"{0.5 * (a + b):.3g}" for a, b in zip(edges[:-1], edges[1:])]
+    return [int(i) for i in index], labels
+
+
+def _hashable(v: Any) -> Any:
+    return tuple(v) if isinstance(v, list) else v
+
+
+def _sort_key(v: Any) -> tuple[int, Any]:
+    return (0, v) if isinstance(v, (int, float)) else (1, str(v))
+
+
+def _choose_axes(params: Sequence[str], rows: list[dict[str, Any]], x: str | None, y: str | None) -> tuple[str | None, str | None]:
+    """The heatmap axes: those given, else the preferred names present (failure joint down
+    the side, failure time / angle / halt time across), else the first varied fields."""
+    varied = [p for p in params if len({_hashable(r.get(p)) for r in rows}) > 1] or list(params)
+    if y is None:
+        y = next((p for p in _PREFERRED_Y if p in varied and p != x), None)
+    if x is None:
+        x = next((p for p in _PREFERRED_X if p in varied and p != y), None)
+        x = x or next((p for p in varied if p != y), None)
+    if y is None:
+        y = next((p for p in varied if p != x), None)
+    return x, y
+
+
+def campaign_report(
+    out: str | Path,
+    *,
+    x: str | None = None,
+    y: str | None = None,
+    worst: str | None = None,
+    worse: str | None = None,
+    top: int = 10,
+) -> CampaignReport:
+    """The report of the campaign in ``out`` (axes and ranking default to the file's
+    ``[report]``, else chosen from what varied and the recorded columns).
+
+    Parameters
+    ----------
+    x, y
+        Varied fields of the heatmaps' axes.
+    worst, worse
+        Column ranking the worst cases and ``"higher"``/``"lower"`` (which way is worse;
+        default: known for the headline columns, else higher).
+    top
+        Worst cases listed (and written as scenario files).
+    """
+    status = campaign_status(out)
+    table = campaign_table(out)
+    with open_ledger(out) as ledger:
+        spec = ledger.meta("spec") or {}
+    conf = spec.get("report", {})
+    x, y = x or conf.get("x"), y or conf.get("y")
+    for axis, name in (("x", x), ("y", y)):
+        if name is not None and name not in table.params:
+            raise CampaignError(f"report {axis} = {name!r} is not a varied field; varied: {', '.join(table.params)}")
+    ok_rows = [r for r in table.rows if r["status"] == "ok"]
+    x, y = _choose_axes(table.params, ok_rows, x, y)
+    has_values = [m for m in table.metrics if any(r.get(m) is not None for r in ok_rows)]
+    worst = worst or conf.get("worst") or next((m for m in WORST_FIRST if m in has_values), None)
+    worst = worst or next((m for m in has_values if m in WORSE), None)
+    if worst is not None and worst not in table.metrics:
+        raise CampaignError(f"report: worst = {worst!r} is not a recorded column; columns: {', '.join(table.metrics)}")
+    worse = worse or conf.get("worse") or WORSE.get(worst or "", "higher")
+    if worse not in ("higher", "lower"):
+        raise CampaignError(f"report: worse must be 'higher' or 'lower'; got {worse!r}")
+    ranked: list[dict[str, Any]] = []
+    if worst is not None:
+        scored = [r for r in ok_rows if r.get(worst) is not None]
+        ranked = sorted(scored, key=lambda r: float(r[worst]), reverse=worse == "higher")[: max(int(top), 0)]
+    return CampaignReport(status, table, spec, x, y, worst, worse, tuple(ranked))
+
+
+def write_campaign_report(out: str | Path, path: str | Path | None = None, **options: Any) -> list[Path]:
+    """Write the report of the campaign in ``out`` (:func:`campaign_report`'s ``options``);
+    returns the files written (``report.html`` first)."""
+    return campaign_report(out, **options).write(path)

@@ -1,0 +1,230 @@
+"""``jointlock campaign plan|run|status|export|report``: failure campaigns (docs/campaigns.md).
+
+A thin shell over :mod:`jointlock.campaign` (imported when a subcommand runs, so that the
+command line starts fast): parse, call, print, write.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from ..errors import CampaignError
+from ._common import check_out_dir, print_json
+
+DESCRIPTION = (
+    "Sweep failure cases: a campaign file (TOML) names a base scenario and what to vary with the names "
+    "of `jointlock run --set` ([grid], [zip], [sample]); each case is keyed by its resolved inputs and "
+    "its result goes to one SQLite ledger (DIR/ledger.sqlite), so running again resumes exactly what is "
+    "left. Format: docs/campaigns.md."
+)
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1; got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be an integer >= 1; got {text!r}")
+    return value
+
+
+def _seconds(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds > 0; got {text!r}") from None
+    if not 0 < value < 86400:
+        raise argparse.ArgumentTypeError(f"must be a number of seconds in (0, 86400); got {text!r}")
+    return value
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "campaign", help="sweep thousands of failure cases (process pool or Dask), resumable", description=DESCRIPTION
+    )
+    cmds = p.add_subparsers(dest="campaign_command", metavar="SUBCOMMAND")
+    cmds.required = True
+
+    plan = cmds.add_parser("plan", help="count the cases, those done, and estimate the time", description=(
+        "Validate CAMPAIGN.toml, count its cases and those already finished in the output folder, and "
+        "time a few cases (in this process) to estimate the run. Nothing is written."))  # fmt: skip
+    plan.add_argument("campaign", metavar="CAMPAIGN.toml")
+    plan.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
+    plan.add_argument("--workers", type=_positive_int, help="workers the estimate assumes (default: cores)")
+    plan.add_argument("--probe", type=int, default=3, help="cases to time for the estimate (0: none; default 3)")
+    plan.add_argument("--json", action="store_true", help="print one JSON object")
+    plan.set_defaults(func=_plan)
+
+    run = cmds.add_parser("run", help="run the cases not yet in the ledger", description=(
+        "Run every case of CAMPAIGN.toml not yet finished in DIR: a local process pool by default "
+        "(one worker per core), or a Dask cluster. Ctrl-C (SIGINT) or SIGTERM stops it with everything "
+        "finished committed; the same command resumes. A case that raises is recorded with its error."))  # fmt: skip
+    run.add_argument("campaign", metavar="CAMPAIGN.toml")
+    run.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
+    engine = run.add_mutually_exclusive_group()
+    engine.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
+    engine.add_argument("--in-process", action="store_true", help="run every case in this process (no pool)")
+    engine.add_argument(
+        "--dask", metavar="ADDRESS",
+        help="run on Dask: 'local' (a LocalCluster of --dask-workers processes) or a scheduler's address "
+        "tcp://HOST:8786 (needs the 'dask' extra)",
+    )  # fmt: skip
+    engine.add_argument("--dask-scheduler-file", metavar="FILE", help="run on the Dask cluster of this scheduler file (HPC)")
+    run.add_argument("--dask-workers", type=_positive_int, help="workers of --dask local (default: cores)")
+    run.add_argument("--retry-failed", action="store_true", help="run again the cases recorded as failed")
+    run.add_argument(
+        "--batch-seconds", type=_seconds, default=None,
+        help="work per batch sent to a worker [s] (default 10; 5-30 keeps the engine's overhead small)",
+    )  # fmt: skip
+    run.add_argument("--yes", action="store_true", help="confirm a campaign of more than 100,000 cases")
+    run.add_argument("--report", action="store_true", help="write report.html when the run ends")
+    run.add_argument("--json", action="store_true", help="print one JSON object (no progress bar)")
+    run.add_argument("--quiet", action="store_true", help="no progress bar, no summary")
+    run.set_defaults(func=_run)
+
+    status = cmds.add_parser("status", help="cases done, failed, left; the failures", description=(
+        "What the ledger in DIR holds: cases planned, finished, failed (with their errors) and left, and "
+        "each run."))  # fmt: skip
+    status.add_argument("out", metavar="DIR")
+    status.add_argument("--json", action="store_true", help="print one JSON object")
+    status.set_defaults(func=_status)
+
+    export = cmds.add_parser("export", help="one row per case as CSV or Parquet", description=(
+        "Write the finished cases of DIR, one row each (key, varied fields, recorded results, error), "
+        "as CSV and/or Parquet (Parquet needs pyarrow: the 'parquet' extra)."))  # fmt: skip
+    export.add_argument("out", metavar="DIR")
+    export.add_argument("--csv", metavar="FILE", help="write CSV")
+    export.add_argument("--parquet", metavar="FILE", help="write Parquet")
+    export.add_argument("--all", action="store_true", help="also the cases no longer in the campaign file")
+    export.set_defaults(func=_export)
+
+    report = cmds.add_parser("report", help="self-contained HTML report: heatmaps, distributions, worst cases",
+                             description=(
+        "Write DIR/report.html: what varied, headline numbers, heatmaps of each result over two varied "
+        "fields, distributions, the worst cases (each as a scenario file that `jointlock run` re-runs) and "
+        "the failed cases."))  # fmt: skip
+    report.add_argument("out", metavar="DIR")
+    report.add_argument("--output", metavar="FILE", help="where to write the page (default DIR/report.html)")
+    report.add_argument("--x", metavar="FIELD", help="varied field across the heatmaps (default: chosen)")
+    report.add_argument("--y", metavar="FIELD", help="varied field down the heatmaps (default: chosen)")
+    report.add_argument("--worst", metavar="COLUMN", help="result ranking the worst cases")
+    report.add_argument("--worse", choices=("higher", "lower"), help="which way is worse for --worst")
+    report.add_argument("--top", type=_positive_int, default=10, help="worst cases listed (default 10)")
+    report.add_argument("--json", action="store_true", help="print one JSON object")
+    report.set_defaults(func=_report)
+
+
+def _out(args: argparse.Namespace, spec: object) -> Path:
+    out = check_out_dir(args.out) if args.out else spec.default_out()  # type: ignore[attr-defined]
+    return Path(out)
+
+
+def _plan(args: argparse.Namespace) -> int:
+    from ..campaign import load_campaign, plan_campaign
+
+    if args.probe < 0:
+        raise CampaignError(f"--probe must be an integer >= 0; got {args.probe}")
+    spec = load_campaign(args.campaign)
+    plan = plan_campaign(spec, _out(args, spec), workers=args.workers, probe=args.probe)
+    if args.json:
+        print_json(plan.to_dict())
+    else:
+        print("\n".join(plan.summary()))
+    return 0
+
+
+def _engine(args: argparse.Namespace) -> object | None:
+    from ..campaign import dask_cluster, in_process
+
+    if args.in_process:
+        return in_process()
+    if args.dask_scheduler_file:
+        return dask_cluster(None, scheduler_file=args.dask_scheduler_file)
+    if args.dask:
+        return dask_cluster(args.dask, workers=args.dask_workers)
+    if args.dask_workers is not None:
+        raise CampaignError("--dask-workers sizes a --dask local cluster; give --dask local (or use --workers)")
+    return None
+
+
+def _run(args: argparse.Namespace) -> int:
+    from ..campaign import BATCH_SECONDS, CONFIRM_CASES, load_campaign, run_campaign, write_campaign_report
+
+    spec = load_campaign(args.campaign)
+    out = _out(args, spec)
+    quiet = args.quiet or args.json
+    engine = _engine(args)
+    try:
+        if engine is not None and not quiet and engine.dashboard:  # type: ignore[attr-defined]
+            print(f"engine: {engine.description}; dashboard: {engine.dashboard}", file=sys.stderr)  # type: ignore[attr-defined]
+        result = run_campaign(
+            spec,
+            out,
+            engine=engine,  # type: ignore[arg-type]
+            workers=args.workers,
+            retry_failed=args.retry_failed,
+            max_cases=None if args.yes else CONFIRM_CASES,
+            batch_seconds=args.batch_seconds or BATCH_SECONDS,
+            progress=not quiet and sys.stderr.isatty(),
+        )
+    finally:
+        if engine is not None:
+            engine.close(cancel=True)  # type: ignore[attr-defined]
+    written = write_campaign_report(out) if args.report and not result.interrupted else []
+    if args.json:
+        print_json(result.to_dict() | {"files": [str(p) for p in written]})
+    elif not args.quiet:
+        print("\n".join(result.summary()))
+        if written:
+            print(f"  report: {written[0]}")
+    if result.interrupted:
+        print(
+            f"jointlock campaign: stopped by {result.stopped_by}; {result.planned - result.remaining} of "
+            f"{result.planned} cases are in the ledger. Run the same command again to resume the remaining "
+            f"{result.remaining}: jointlock campaign run {args.campaign}" + (f" --out {args.out}" if args.out else ""),
+            file=sys.stderr,
+        )
+        return 130 if result.stopped_by == "SIGINT" else 143
+    return 0
+
+
+def _status(args: argparse.Namespace) -> int:
+    from ..campaign import campaign_status
+
+    status = campaign_status(args.out)
+    if args.json:
+        print_json(status.to_dict())
+    else:
+        print("\n".join(status.summary()))
+    return 0
+
+
+def _export(args: argparse.Namespace) -> int:
+    from ..campaign import campaign_table
+
+    if not args.csv and not args.parquet:
+        raise CampaignError("export needs --csv FILE and/or --parquet FILE")
+    table = campaign_table(args.out, include_outside=args.all)
+    written = []
+    if args.parquet:
+        written.append(table.write_parquet(args.parquet))
+    if args.csv:
+        written.append(table.write_csv(args.csv))
+    print(f"wrote {len(table.rows)} cases x {len(table.names)} columns to {', '.join(map(str, written))}")
+    return 0
+
+
+def _report(args: argparse.Namespace) -> int:
+    from ..campaign import campaign_report
+
+    rep = campaign_report(args.out, x=args.x, y=args.y, worst=args.worst, worse=args.worse, top=args.top)
+    written = rep.write(args.output)
+    if args.json:
+        print_json(rep.to_dict() | {"files": [str(p) for p in written]})
+    else:
+        print("\n".join(rep.summary()))
+        print(f"wrote {written[0]}" + (f" and {len(written) - 1} worst-case scenario file(s)" if len(written) > 1 else ""))
+    return 0
