@@ -108,7 +108,7 @@ def test_a_local_cluster(campaign_file, pool_ledger, tmp_path):
     proc = start_cli("campaign", "run", str(campaign_file), "--out", str(out), "--dask", "local", "--dask-workers", "2")
     stdout, stderr = proc.communicate(timeout=180)
     assert proc.returncode == 0, stderr
-    assert "engine: dask (LocalCluster), 2 worker thread(s); dashboard: http://" in stderr
+    assert "engine: dask (LocalCluster), 2 worker(s); dashboard: http://" in stderr
     assert records(out) == records(pool_ledger)
 
 

@@ -31,7 +31,7 @@ BODY = (
     '"limits.vmax_deg_s" = [40.0, 45.0, 50.0, 30.0]\n'
     '[[exclude]]\n"limits.vmax_deg_s" = 30.0\n"failure.joint" = { gt = 2 }\n'
 )
-N_CASES, N_FAILING = 5 * 2 * 4 - 3 * 2, 2 * 2
+N_CASES, N_FAILING = 5 * 2 * 4 - 3 * 2, 2 * 2  # 34 cases, 4 failing
 
 
 @pytest.fixture(scope="module")
@@ -257,14 +257,17 @@ def test_a_worker_that_dies_loses_only_its_batch(campaign_file, serial, tmp_path
 
 
 def test_a_second_coordinator_on_the_same_folder_is_refused(campaign_file, tmp_path):
+    import fcntl
+
     out = tmp_path / "out"
-    proc = start_cli("campaign", "run", str(campaign_file), "--out", str(out), "--in-process", "--batch-seconds", "0.3")
-    wait_for_cases(out, 1, proc)
-    if proc.poll() is None:
+    out.mkdir()
+    with open(out / ".campaign.lock", "w") as fh:  # as a running coordinator holds it
+        fh.write("4242")
+        fh.flush()
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
         code, _, stderr = _cli("campaign", "run", str(campaign_file), "--out", str(out), "--in-process")
-        assert code == 2 and "another `jointlock campaign run`" in stderr
-    proc.send_signal(signal.SIGINT)
-    proc.communicate(timeout=60)
+    assert code == 2 and "another `jointlock campaign run` (pid 4242)" in stderr
+    assert not (out / "ledger.sqlite").exists()
 
 
 def test_plan_estimates_from_timed_cases(campaign_file, tmp_path):
@@ -272,8 +275,9 @@ def test_plan_estimates_from_timed_cases(campaign_file, tmp_path):
     assert plan.cases == plan.to_run == N_CASES and len(plan.probe_seconds) == 2
     assert plan.estimate_s == pytest.approx(plan.seconds_per_case * N_CASES / 2)
     assert not (tmp_path / "none").exists()  # plan writes nothing
+    assert plan.probe_errors == () and plan.unknown_columns == ()
     text = "\n".join(plan.summary())
-    assert "cases: 40 (43 described, 3 excluded by filters)" in text.replace(str(N_CASES), "40") or "excluded" in text
+    assert f"cases: {N_CASES} ({N_CASES + 6} described, 6 excluded by filters)" in text
 
 
 def test_replicates_vary_the_seed_and_each_runs_with_its_own(tmp_path):
@@ -289,3 +293,90 @@ def test_replicates_vary_the_seed_and_each_runs_with_its_own(tmp_path):
     assert len(set(cps)) == 3  # three Monte Carlo searches
     with open_ledger(out) as ledger:
         assert [ledger.result(k)["halt_config"]["seed"] for k in table.column("key")] == seeds
+
+
+def test_a_misspelt_column_is_reported_and_fixed_without_running_again(campaign_file, serial, tmp_path):
+    text = campaign_file.read_text().replace("[grid]", 'columns = ["halt.feasable", "halt.k"]\n[grid]', 1)
+    edited = tmp_path / "typo.toml"
+    edited.write_text(text)
+    plan = plan_campaign(edited, tmp_path / "none", probe=1)
+    assert plan.unknown_columns == ("'halt.feasable' is not in the halt job's result (did you mean 'halt.feasible'?)",)
+    with pytest.raises(jl.errors.CampaignError, match="reads the jump job, which no case runs"):
+        bad = tmp_path / "job.toml"
+        bad.write_text(campaign_file.read_text().replace("[grid]", 'columns = ["jump.kappa"]\n[grid]', 1))
+        plan_campaign(bad, tmp_path / "none", probe=0)
+
+
+def test_a_fault_in_every_batch_stops_the_run_with_one_line(campaign_file, tmp_path, monkeypatch):
+    import jointlock.campaign._worker as worker
+
+    monkeypatch.setattr(worker, "__version__", "0.0.0-elsewhere")
+    with pytest.raises(jl.errors.CampaignError, match=r"not in one of its cases: RuntimeError: jointlock 0.0.0-elsewhere"):
+        run_campaign(campaign_file, tmp_path / "out", engine=in_process())
+    assert campaign_status(tmp_path / "out").ok == 0  # nothing recorded as a case's error
+
+
+class _PoisonPool:
+    """A stand-in for a local process pool that breaks whole when one batch holds the poison
+    case: every batch not yet returned fails with BrokenProcessPool (as a real pool does when
+    one worker dies); the others run for real, in a thread, after a short delay."""
+
+    def __init__(self, poison: str) -> None:
+        import concurrent.futures as cf
+        import threading
+
+        self.poison, self.cf = poison, cf
+        self.pending: list = []
+        self.lock = threading.Lock()
+        self.thread = threading.Thread(target=self._loop, daemon=True)
+        self.alive = True
+        self.thread.start()
+
+    def submit(self, fn, task):
+        future = self.cf.Future()
+        with self.lock:
+            self.pending.append((future, fn, task))
+        return future
+
+    def _loop(self) -> None:
+        from concurrent.futures.process import BrokenProcessPool
+
+        while self.alive:
+            time.sleep(0.05)
+            with self.lock:
+                batch, self.pending = self.pending, []
+            if any(self.poison in [key for key, _, _ in task.cases] for _, _, task in batch):
+                for future, _, _ in batch:
+                    future.set_exception(BrokenProcessPool("a worker died"))
+                continue
+            for future, fn, task in batch:
+                future.set_result(fn(task))
+
+    def shutdown(self, wait=True, cancel_futures=False):
+        self.alive = False
+
+
+def test_a_case_that_kills_its_worker_is_found_and_only_it_is_lost(campaign_file, serial, tmp_path):
+    from jointlock.campaign import Engine, plan_cases
+
+    cases = plan_cases(load_campaign(campaign_file)).cases
+    poison = cases[7].key
+    pools = [_PoisonPool(poison)]
+
+    def restart():
+        pools.append(_PoisonPool(poison))
+        return pools[-1]
+
+    engine = Engine("poison pool", pools[0], 2, "poison pool", _restart=restart)
+    out = tmp_path / "out"
+    result = run_campaign(campaign_file, out, engine=engine, batch_seconds=0.3)
+    engine.close()
+    assert result.restarts >= 2 and result.remaining == 0
+    rows = records(out)
+    assert rows[poison][0] == "error" and rows[poison][2] == "WorkerLost"
+    expected = {k: v for k, v in records(serial[0]).items() if k != poison}
+    assert {k: v for k, v in rows.items() if k != poison} == expected  # every other case, as serially
+    # the lost case runs again on the next run (and here is lost again)
+    again = run_campaign(campaign_file, out, engine=Engine("poison pool", _PoisonPool(poison), 2, "p",
+                                                           _restart=restart), batch_seconds=0.3)  # fmt: skip
+    assert again.to_run == 1 and again.failed == 1

@@ -231,13 +231,14 @@ def test_inline_base_scenario(tmp_path):
 # -- the example campaigns and the documented file ---------------------------------------------
 
 
-@pytest.mark.parametrize("name,cases", [("halt7", 105), ("jump_canadarm7", 42)])
+@pytest.mark.parametrize("name,cases", [("halt7", 105), ("jump_canadarm7", 42), ("tolerance_puma6", 66)])
 def test_example_campaigns_plan_and_their_first_case_runs(name, cases, tmp_path):
     from jointlock.campaign import plan_campaign
 
     plan = plan_campaign(EXAMPLES / "campaigns" / f"{name}.toml", tmp_path / "out", probe=1)
     assert plan.cases == plan.to_run == cases
     assert len(plan.probe_seconds) == 1 and plan.estimate_s > 0
+    assert plan.probe_errors == () and plan.unknown_columns == ()  # the case ran every job
 
 
 def test_the_campaign_file_in_the_docs_is_valid(tmp_path):

@@ -241,9 +241,13 @@ def plan_cases(
         try:
             scenario = resolve_case(spec, case_overrides(spec, params))
         except JointlockError as exc:
+            advice = (
+                f"check the base scenario ({spec.scenario_source}) and [set], then the sweep"
+                if position == 0
+                else "fix the sweep or drop such cases with an [[exclude]] filter"
+            )
             raise CampaignError(
-                f"{spec.source}: case {position} ({params_text(params)}) is not a valid scenario: {exc} -- "
-                "fix the sweep or drop such cases with an [[exclude]] filter"
+                f"{spec.source}: case {position} ({params_text(params)}) is not a valid scenario: {exc} -- {advice}"
             ) from None
         key = case_key(scenario, spec.seed)
         jobs.update(scenario.jobs)

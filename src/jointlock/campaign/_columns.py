@@ -15,6 +15,10 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import CampaignError
+from ._cases import CasePlan
+from ._spec import CampaignSpec
+
 #: Headline figures of each job, recorded when a campaign names no ``columns``.
 DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
     "halt_config": ("halt_config.best.cp", "halt_config.refinement.gain"),
@@ -38,7 +42,7 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
         "jump.share_improved",
         "jump.limits_ok",
     ),
-    "tolerance_angle": ("tolerance_angle.chosen.gamma_deg",),
+    "tolerance_angle": ("tolerance_angle.roots|len", "tolerance_angle.chosen.gamma_deg"),
     "replan": (
         "replan.absorbed_waypoints",
         "replan.waypoints",
@@ -64,7 +68,7 @@ WORSE: dict[str, str] = {
     "jump.mean_reduction": "lower",
     "jump.share_improved": "lower",
     "jump.limits_ok": "lower",
-    "tolerance_angle.chosen.gamma_deg": "higher",
+    "tolerance_angle.roots|len": "lower",
     "replan.max_tracking_position_error_m": "higher",
     "workspace.share_kept": "lower",
     "singular.sigma_min": "lower",
@@ -114,6 +118,46 @@ def _reduce(value: Any, reducer: str) -> Any:
     return float(out)
 
 
+def _paths(value: Any, prefix: str) -> list[str]:
+    """Every path below ``value`` (dictionary keys; a list as one path)."""
+    if isinstance(value, Mapping):
+        out = []
+        for key, sub in value.items():
+            out += [f"{prefix}.{key}", *_paths(sub, f"{prefix}.{key}")]
+        return out
+    return []
+
+
+def missing_columns(results: Mapping[str, Any], columns: Sequence[str]) -> list[str]:
+    """The columns whose path is absent from the result of a job that ran (a misspelt key), each
+    as ``"'halt.feasable' is not in the halt job's result (did you mean 'halt.feasible'?)"``."""
+    import difflib
+
+    out = []
+    for col in columns:
+        path = col.partition("|")[0]
+        job = path.split(".", 1)[0]
+        if job not in results:
+            continue
+        value: Any = results
+        for part in path.split("."):
+            if value is None:  # a null on the way (e.g. no gamma chosen): this case cannot tell
+                break
+            if isinstance(value, Mapping) and part in value:
+                value = value[part]
+            elif isinstance(value, list) and part.lstrip("-").isdigit() and -len(value) <= int(part) < len(value):
+                value = value[int(part)]
+            elif isinstance(value, list) and part.lstrip("-").isdigit():  # a shorter list in this case
+                break
+            else:
+                known = _paths(results[job], job)
+                close = difflib.get_close_matches(path, known, n=1, cutoff=0.6)
+                hint = f" (did you mean {close[0]!r}?)" if close else ""
+                out.append(f"{col!r} is not in the {job} job's result{hint}")
+                break
+    return out
+
+
 def record(results: Mapping[str, Any], columns: Sequence[str]) -> dict[str, Any]:
     """``{column: value}`` for one case."""
     return {col: column_value(results, col) for col in columns}
@@ -123,3 +167,18 @@ def is_numeric(values: Sequence[Any]) -> bool:
     """Whether a column holds numbers or booleans (and at least one value)."""
     present = [v for v in values if v is not None]
     return bool(present) and all(isinstance(v, (int, float, bool)) for v in present)
+
+
+def check_columns(spec: CampaignSpec, plan: CasePlan) -> tuple[str, ...]:
+    """The columns to record: the file's (each reading a job that some case runs), else the
+    headline columns of the jobs the cases run."""
+    if not spec.columns:
+        return default_columns(plan.jobs)
+    for col in spec.columns:
+        job = col.split(".", 1)[0]
+        if job not in plan.jobs:
+            raise CampaignError(
+                f"{spec.source}: columns: {col!r} reads the {job} job, which no case runs (jobs: "
+                f"{', '.join(plan.jobs)})"
+            )
+    return tuple(spec.columns)

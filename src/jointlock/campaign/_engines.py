@@ -20,6 +20,7 @@ from __future__ import annotations
 import concurrent.futures as cf
 import multiprocessing
 import os
+import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -35,7 +36,7 @@ class InProcessExecutor(cf.Executor):
         future.set_running_or_notify_cancel()
         try:
             future.set_result(fn(*args, **kwargs))
-        except BaseException as exc:  # noqa: BLE001 - handed to the caller through the future
+        except Exception as exc:  # handed to the caller through the future (not Ctrl-C: that stops)
             future.set_exception(exc)
         return future
 
@@ -206,8 +207,19 @@ def dask_cluster(
             f"cannot reach the Dask cluster ({scheduler_file or address}): {type(exc).__name__}: {exc}"
         ) from None
 
+    known = {"workers": 0, "at": -1e9}
+
     def count() -> int:
-        return sum(w.get("nthreads", 1) for w in client.scheduler_info()["workers"].values())
+        """Worker processes now (asked at most every 2 s; the last answer while the scheduler
+        does not reply).  ``Client.nthreads`` lists every worker, whatever the cluster's size."""
+        now = time.monotonic()
+        if now - known["at"] > 2.0:
+            known["at"] = now
+            try:
+                known["workers"] = len(client.nthreads())
+            except Exception:  # noqa: BLE001 - a busy or restarting scheduler: keep the last count
+                pass
+        return int(known["workers"])
 
     executor = client.get_executor(pure=False)
 
@@ -217,12 +229,12 @@ def dask_cluster(
         if cluster is not None:
             cluster.close()
 
-    threads = count()
+    n_workers = count()
     return Engine(
         "dask",
         executor,
-        max(threads, 1),
-        f"dask ({where}), {threads} worker thread(s)" + ("" if threads else " so far"),
+        max(n_workers, 1),
+        f"dask ({where}), {n_workers} worker(s)" + ("" if n_workers else " so far"),
         dashboard=client.dashboard_link,
         _close=close,
         _count=count,

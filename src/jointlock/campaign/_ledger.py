@@ -125,6 +125,10 @@ class Ledger:
             rows = self._db.execute("SELECT key FROM cases WHERE status = ?", (status,))
         return {r[0] for r in rows}
 
+    def keys_with_error(self, error_type: str) -> set[str]:
+        """Keys of the cases that failed with ``error_type``."""
+        return {r[0] for r in self._db.execute("SELECT key FROM cases WHERE error_type = ?", (error_type,))}
+
     # -- runs and outcomes -------------------------------------------------------------------
 
     def start_run(self, engine: str, workers: int, planned: int, to_run: int) -> int:
@@ -274,19 +278,23 @@ def open_ledger(out: str | Path, *, create: bool = False) -> Ledger:
             f"{str(out)!r} holds no campaign ledger ({LEDGER_NAME}); run `jointlock campaign run "
             "CAMPAIGN.toml --out DIR` first"
         )
-    if create:
-        Path(out).mkdir(parents=True, exist_ok=True)
     try:
-        db = sqlite3.connect(str(path), timeout=30.0)
-        db.execute("PRAGMA journal_mode=WAL")
-        db.execute("PRAGMA synchronous=NORMAL")
-        db.executescript(_SCHEMA)
+        if create:  # the coordinator: the only writer
+            Path(out).mkdir(parents=True, exist_ok=True)
+            db = sqlite3.connect(str(path), timeout=30.0)
+            db.execute("PRAGMA journal_mode=WAL")
+            db.execute("PRAGMA synchronous=NORMAL")  # a power cut may lose the last batches: they run again
+            db.executescript(_SCHEMA)
+        else:  # readers (status, export, report, plan) never write, and work on a read-only copy
+            db = sqlite3.connect(f"{path.resolve().as_uri()}?mode=ro", uri=True, timeout=30.0)
         ledger = Ledger(path, db)
         fmt = ledger.meta("format")
-        if fmt is None:
+        if fmt is None and create:
             ledger.set_meta(format=LEDGER_FORMAT, created_at=_now())
         elif fmt != LEDGER_FORMAT:
-            raise CampaignError(f"{path}: ledger format {fmt} is not {LEDGER_FORMAT} (another jointlock version)")
+            raise CampaignError(f"{path}: ledger format {fmt} is not {LEDGER_FORMAT} (another jointlock version?)")
+    except sqlite3.OperationalError as exc:
+        raise CampaignError(f"{path}: cannot open the campaign ledger: {exc}") from None
     except sqlite3.DatabaseError as exc:
         raise CampaignError(f"{path}: not a jointlock campaign ledger ({exc})") from None
     return ledger

@@ -3,14 +3,17 @@ those already finished, and times a few of the others for an estimate."""
 
 from __future__ import annotations
 
+import json
 import statistics
+import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from ..progress import Progress
 from ._cases import plan_cases
-from ._columns import default_columns
+from ._columns import check_columns, missing_columns
 from ._engines import default_workers
 from ._ledger import LEDGER_NAME, open_ledger
 from ._read import as_spec
@@ -36,6 +39,8 @@ class CampaignPlan:
     jobs: tuple[str, ...]
     workers: int
     probe_seconds: tuple[float, ...] = ()
+    probe_errors: tuple[str, ...] = ()
+    unknown_columns: tuple[str, ...] = ()
 
     @property
     def seconds_per_case(self) -> float | None:
@@ -63,6 +68,8 @@ class CampaignPlan:
             "jobs": list(self.jobs),
             "workers": self.workers,
             "probe_seconds": list(self.probe_seconds),
+            "probe_errors": list(self.probe_errors),
+            "unknown_columns": list(self.unknown_columns),
             "seconds_per_case": self.seconds_per_case,
             "estimate_s": self.estimate_s,
         }
@@ -85,6 +92,10 @@ class CampaignPlan:
                 f"timed {len(self.probe_seconds)} case(s): {self.seconds_per_case:.3g} s each (median) -> about "
                 f"{_duration(est)} with {self.workers} worker(s)"
             )
+        if self.probe_errors:
+            lines.append(f"{len(self.probe_errors)} timed case(s) raised (recorded, not fatal, in a run); first: "
+                         f"{self.probe_errors[0]}")  # fmt: skip
+        lines += [f"column {text}" for text in self.unknown_columns]
         return lines
 
 
@@ -120,6 +131,7 @@ def plan_campaign(
     workers: int | None = None,
     probe: int = 3,
     max_cases: int | None = None,
+    progress: bool = False,
 ) -> CampaignPlan:
     """Count a campaign's cases, those already finished in ``out``, and time ``probe`` of the
     cases still to run (in this process; nothing is written).
@@ -136,9 +148,14 @@ def plan_campaign(
         Cases to run and time for the estimate (0: none).
     max_cases
         Refuse larger campaigns (None: any size up to :data:`MAX_CASES`).
+    progress
+        A progress bar on stderr while the cases are resolved (from 1000 cases on).
     """
     spec = as_spec(campaign)
-    plan = plan_cases(spec, max_cases=max_cases)
+    n = spec.count_before_filters()
+    with Progress(n, "resolving cases", enabled=None if progress and n >= 1000 else False) as bar:
+        plan = plan_cases(spec, max_cases=max_cases, progress=bar.update)
+    columns = check_columns(spec, plan)
     out = Path(out) if out is not None else spec.default_out()
     ok = failed = 0
     if (out / LEDGER_NAME).is_file():
@@ -150,11 +167,16 @@ def plan_campaign(
     else:
         todo = list(plan.cases)
     timings: list[float] = []
+    errors: list[str] = []
+    unknown: list[str] = []
     if probe > 0 and todo:
         picks = {round(i * (len(todo) - 1) / max(probe - 1, 1)) for i in range(min(probe, len(todo)))}
-        columns = spec.columns or default_columns(plan.jobs)
         outcomes = run_batch(make_task(spec, [todo[i] for i in sorted(picks)], columns))
         timings = [o.seconds for o in outcomes]
+        errors = [f"{o.error_type}: {o.error_message}" for o in outcomes if not o.ok]
+        for o in outcomes:
+            if o.ok and o.result is not None:
+                unknown += [t for t in missing_columns(json.loads(zlib.decompress(o.result)), columns) if t not in unknown]
     return CampaignPlan(
         title=spec.title,
         source=spec.source,
@@ -170,6 +192,8 @@ def plan_campaign(
         jobs=plan.jobs,
         workers=default_workers() if workers is None else workers,
         probe_seconds=tuple(timings),
+        probe_errors=tuple(errors),
+        unknown_columns=tuple(unknown),
     )
 
 

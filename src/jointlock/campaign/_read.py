@@ -355,6 +355,8 @@ def _report(raw: Any, source: str) -> ReportSpec:
     if raw.get("worse") not in (None, "higher", "lower"):
         raise CampaignError(f"{source}: report.worse must be 'higher' or 'lower'; got {raw['worse']!r}")
     names = {k: scenario_field(raw[k], f"{source}: report.{k}")[0] for k in ("x", "y") if k in raw}
+    if len(names) == 2 and names["x"] == names["y"]:
+        raise CampaignError(f"{source}: report.x and report.y are both {names['x']!r}; give two different fields")
     if "worst" in raw:
         _columns([raw["worst"]], f"{source}: report.worst")
     return ReportSpec(x=names.get("x"), y=names.get("y"), worst=raw.get("worst"), worse=raw.get("worse"))

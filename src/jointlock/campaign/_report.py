@@ -389,6 +389,10 @@ def campaign_report(
     worst = worst or next((m for m in has_values if m in WORSE), None)
     if worst is not None and worst not in table.metrics:
         raise CampaignError(f"report: worst = {worst!r} is not a recorded column; columns: {', '.join(table.metrics)}")
+    if worst is not None and not is_numeric([r.get(worst) for r in ok_rows]):
+        raise CampaignError(f"report: worst = {worst!r} does not hold numbers or yes/no values; it cannot rank cases")
+    if x is not None and x == y:
+        raise CampaignError(f"report: x and y are both {x!r}; give two different varied fields")
     worse = worse or conf.get("worse") or WORSE.get(worst or "", "higher")
     if worse not in ("higher", "lower"):
         raise CampaignError(f"report: worse must be 'higher' or 'lower'; got {worse!r}")

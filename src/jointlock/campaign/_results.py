@@ -7,6 +7,7 @@ from __future__ import annotations
 import csv
 import io
 import json
+import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -100,7 +101,7 @@ class CampaignStatus:
             if len(self.failures) > MAX_FAILURES_SHOWN:
                 lines.append(f"  ... and {len(self.failures) - MAX_FAILURES_SHOWN} more (export lists them all)")
         if not self.complete:
-            lines.append(f"resume: jointlock campaign run {self.source} --out {self.out}")
+            lines.append(f"resume: {shlex.join(['jointlock', 'campaign', 'run', self.source, '--out', self.out])}")
         return lines
 
 

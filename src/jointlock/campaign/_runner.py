@@ -13,14 +13,13 @@ as an error (``WorkerLost``).  SIGINT and SIGTERM stop the run: running batches 
 from __future__ import annotations
 
 import concurrent.futures as cf
-import contextlib
+import json
 import math
-import os
-import signal
-import threading
+import shlex
 import time
+import zlib
 from collections import deque
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -30,16 +29,22 @@ from .._version import __version__
 from ..errors import CampaignError
 from ..progress import Progress
 from ._cases import Case, CasePlan, plan_cases
-from ._columns import default_columns, record
+from ._columns import check_columns, missing_columns, record
 from ._engines import Engine, in_process, process_pool
+from ._guard import Stop, exclusive
 from ._ledger import LEDGER_NAME, Ledger, open_ledger
 from ._read import as_spec
 from ._spec import CONFIRM_CASES, CampaignSpec
-from ._worker import CaseOutcome, make_task, run_batch
+from ._worker import WORKER_LOST, CaseOutcome, make_task, run_batch
 
-#: Times a batch may be lost with its worker before it is split (and a single case recorded
-#: as an error).
-MAX_ATTEMPTS = 3
+#: Times a batch may be lost while alone in flight before it is split (a single case is then
+#: recorded as ``WorkerLost``, and runs again on resume).
+MAX_ATTEMPTS = 2
+#: Local pool breaks in a row, with no batch returned, after which the run stops.
+MAX_BREAKS = 40
+#: Exceptions (by class name: Dask's are imported only with Dask) that mean a batch's worker,
+#: or the connection to it, was lost: the batch is sent again.
+LOSS_NAMES = ("KilledWorker", "CommClosedError", "FutureCancelledError")
 #: Most cases in one batch.
 MAX_BATCH = 2000
 #: Default work per batch [s] (5-30 s keeps a Dask task's overhead far below 1 %).
@@ -86,6 +91,7 @@ class CampaignRun:
     excluded: int = 0
     duplicates: int = 0
     columns: tuple[str, ...] = field(default_factory=tuple)
+    unknown_columns: tuple[str, ...] = field(default_factory=tuple)
 
     @property
     def interrupted(self) -> bool:
@@ -118,6 +124,7 @@ class CampaignRun:
             "excluded": self.excluded,
             "duplicates": self.duplicates,
             "columns": list(self.columns),
+            "unknown_columns": list(self.unknown_columns),
         }
 
     def summary(self) -> list[str]:
@@ -129,74 +136,18 @@ class CampaignRun:
         if self.lost_batches:
             lines.append(f"  {self.lost_batches} batch(es) lost with a worker and sent again; pool restarts: {self.restarts}")
         if self.failed:
-            lines.append(f"  failed cases are recorded with their error: jointlock campaign status {self.out}")
+            lines.append(f"  failed cases are recorded with their error: jointlock campaign status {shlex.quote(self.out)}")
+        for text in self.unknown_columns:
+            lines.append(f"  column {text}; fix `columns` and run again: nothing is computed again")
         lines.append(f"  ledger: {Path(self.out) / LEDGER_NAME}")
         return lines
-
-
-@contextlib.contextmanager
-def _exclusive(out: Path) -> Iterator[None]:
-    """Hold ``out/.campaign.lock`` for the run: one coordinator writes a ledger at a time."""
-    try:
-        import fcntl
-    except ImportError:  # not POSIX: no lock
-        yield
-        return
-    out.mkdir(parents=True, exist_ok=True)
-    with open(out / ".campaign.lock", "a+") as fh:
-        try:
-            fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-        except OSError:
-            fh.seek(0)
-            other = fh.read().strip() or "?"
-            raise CampaignError(
-                f"another `jointlock campaign run` (pid {other}) is writing {str(out)!r}; wait for it or stop it"
-            ) from None
-        fh.seek(0)
-        fh.truncate()
-        fh.write(str(os.getpid()))
-        fh.flush()
-        try:
-            yield
-        finally:
-            fcntl.flock(fh, fcntl.LOCK_UN)
-
-
-class _Stop:
-    """SIGINT/SIGTERM while a campaign runs: remember which, and raise KeyboardInterrupt
-    where the coordinator is (everything it committed stays; the ledger rolls back a
-    transaction cut short)."""
-
-    def __init__(self) -> None:
-        self.signal: str | None = None
-        self._old: dict[int, Any] = {}
-
-    def __enter__(self) -> _Stop:
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                self._old[sig] = signal.signal(sig, self._handle)
-        return self
-
-    def _handle(self, signum: int, frame: Any) -> None:
-        if self.signal is None:
-            self.signal = signal.Signals(signum).name
-            raise KeyboardInterrupt
-
-    def quiet(self) -> None:
-        """Ignore further signals while the run closes."""
-        for sig in self._old:
-            signal.signal(sig, signal.SIG_IGN)
-
-    def __exit__(self, *exc: object) -> None:
-        for sig, old in self._old.items():
-            signal.signal(sig, old)
 
 
 def run_campaign(
     campaign: CampaignSpec | str | Path,
     out: str | Path | None = None,
     *,
-    engine: Engine | None = None,
+    engine: Engine | Callable[[], Engine] | None = None,
     workers: int | None = None,
     retry_failed: bool = False,
     max_cases: int | None = CONFIRM_CASES,
@@ -214,11 +165,12 @@ def run_campaign(
         ``<file stem>-campaign``).  Running again resumes exactly the cases not finished.
     engine
         Where batches run (:func:`process_pool`, :func:`dask_cluster`, :func:`in_process`);
-        default: a local process pool of ``workers`` processes (one per core), closed at the end.
-        An engine passed in stays open.
+        default: a local process pool of ``workers`` processes (one per core).  An engine
+        passed in stays open; a function returning one is called once the campaign is checked
+        and there is work (nothing starts for a bad file), and its engine is closed at the end.
     retry_failed
         Run again the cases recorded as failed (they are skipped otherwise: a case's error is
-        deterministic).
+        deterministic; a case whose worker was lost runs again in any case).
     max_cases
         Refuse a larger campaign (None: any size); the CLI's ``--yes`` lifts it.
     batch_seconds
@@ -240,15 +192,23 @@ def run_campaign(
     out = Path(out) if out is not None else spec.default_out()
     if out.exists() and not out.is_dir():
         raise CampaignError(f"output folder {str(out)!r} exists and is not a folder")
-    columns = spec.columns or default_columns(plan.jobs)
-    with _exclusive(out), open_ledger(out, create=True) as ledger:
+    columns = check_columns(spec, plan)
+    with exclusive(out), open_ledger(out, create=True) as ledger:
         _remember(ledger, spec, columns)
         ledger.set_plan(plan.cases)
-        finished = ledger.finished_keys(status=None if not retry_failed else "ok")
+        finished = ledger.finished_keys(status="ok")
+        if not retry_failed:
+            finished |= ledger.finished_keys(status="error") - ledger.keys_with_error(WORKER_LOST)
         todo = [c for c in plan.cases if c.key not in finished]
-        own = engine is None
-        if engine is None:
-            engine = process_pool(workers) if todo else in_process()
+        own = not isinstance(engine, Engine)  # made here: closed here
+        if not own:
+            pass
+        elif not todo:
+            engine = in_process()  # nothing to run: no workers to start
+        elif engine is None:
+            engine = process_pool(workers)
+        else:
+            engine = engine()
         try:
             return _coordinate(spec, plan, todo, columns, ledger, engine, out, batch_seconds, progress, own)
         finally:
@@ -265,6 +225,165 @@ def _remember(ledger: Ledger, spec: CampaignSpec, columns: Sequence[str]) -> Non
     ledger.set_meta(spec=spec.to_dict(), columns=list(columns), jointlock=__version__)
 
 
+@dataclass
+class _Batch:
+    """Cases sent together; ``attempts``: times lost while alone in flight (the culprit for
+    sure); ``suspect``: lost with others, so sent again alone to find which one killed the pool."""
+
+    cases: list[Case]
+    attempts: int = 0
+    suspect: bool = False
+
+
+def _is_loss(exc: BaseException) -> bool:
+    """Whether a batch's exception means its worker (or the connection to it) was lost, rather
+    than a fault that would recur (a version mismatch, something that cannot be pickled)."""
+    return isinstance(exc, (BrokenProcessPool, cf.CancelledError)) or type(exc).__name__ in LOSS_NAMES
+
+
+class _Coordinator:
+    """The loop of :func:`run_campaign` (see the module docstring)."""
+
+    def __init__(
+        self,
+        spec: CampaignSpec,
+        todo: list[Case],
+        columns: Sequence[str],
+        ledger: Ledger,
+        engine: Engine,
+        run_id: int,
+        batch_seconds: float,
+        bar: Progress,
+    ) -> None:
+        self.spec, self.columns, self.ledger, self.engine = spec, tuple(columns), ledger, engine
+        self.run_id, self.batch_seconds, self.bar = run_id, batch_seconds, bar
+        self.by_key = {c.key: c for c in todo}
+        self.queue: deque[Case] = deque(todo)
+        self.retry: deque[_Batch] = deque()
+        self.in_flight: dict[cf.Future, _Batch] = {}
+        self.counts = {"ok": 0, "failed": 0, "lost": 0, "restarts": 0}
+        self.case_seconds = 0.0
+        self.breaks = 0  # pool breaks since a batch last came back
+        self.unknown_columns: tuple[str, ...] | None = None
+
+    def run(self) -> None:
+        while self.queue or self.retry or self.in_flight:
+            self._submit()
+            self._collect()
+
+    # -- sending -----------------------------------------------------------------------------
+
+    def _batch_size(self, limit: int) -> int:
+        finished = self.counts["ok"] + self.counts["failed"]
+        if finished == 0:
+            return 1  # the first batches measure the time per case
+        want = max(1, int(self.batch_seconds / max(self.case_seconds / finished, 1e-6)))
+        fair = math.ceil(len(self.queue) / (2 * limit))  # the last batches end together
+        return max(1, min(want, fair, MAX_BATCH))
+
+    def _submit(self) -> None:
+        limit = 2 * self.engine.current_workers()
+        while len(self.in_flight) < limit and (self.queue or self.retry):
+            if any(b.suspect for b in self.in_flight.values()):
+                return  # a suspect runs alone
+            if self.retry and self.retry[0].suspect:
+                if self.in_flight:
+                    return  # wait until it can run alone
+                batch = self.retry.popleft()
+            elif self.retry:
+                batch = self.retry.popleft()
+            else:
+                batch = _Batch([self.queue.popleft() for _ in range(min(self._batch_size(limit), len(self.queue)))])
+            future = self.engine.executor.submit(run_batch, make_task(self.spec, batch.cases, self.columns))
+            self.in_flight[future] = batch
+
+    # -- receiving ---------------------------------------------------------------------------
+
+    def _collect(self) -> None:
+        finished, _ = cf.wait(list(self.in_flight), timeout=0.25, return_when=cf.FIRST_COMPLETED)
+        broken: list[_Batch] = []
+        for future in finished:
+            batch = self.in_flight.pop(future)
+            try:
+                outcomes = future.result()
+            except BrokenProcessPool:
+                broken.append(batch)
+            except Exception as exc:
+                if not _is_loss(exc):
+                    raise CampaignError(
+                        f"a batch failed in the engine ({self.engine.description}), not in one of its cases: "
+                        f"{type(exc).__name__}: {str(exc)[:300]}"
+                    ) from exc
+                self._lost(batch, alone=True, reason=f"{type(exc).__name__}: {str(exc)[:200]}")
+            else:
+                self.store(outcomes)
+        if broken:
+            self._pool_broke(broken)
+
+    def _pool_broke(self, broken: list[_Batch]) -> None:
+        """A local pool breaks whole when one worker dies: batches that came back before are
+        kept, every other one in flight is lost with it (charged only when it was alone)."""
+        for future, batch in list(self.in_flight.items()):
+            if future.done() and not future.cancelled() and future.exception() is None:
+                self.store(future.result())
+            else:
+                broken.append(batch)
+        self.in_flight.clear()
+        for batch in broken:
+            self._lost(batch, alone=len(broken) == 1, reason="its worker process died")
+        self.breaks += 1
+        if self.breaks >= MAX_BREAKS:
+            raise CampaignError(
+                f"the local pool broke {self.breaks} times in a row without returning a batch (a worker "
+                "process dies at start or on every case?); run with --in-process to see the error"
+            )
+        if not self.engine.restart():
+            raise CampaignError(f"the engine ({self.engine.description}) broke and cannot restart")
+        self.counts["restarts"] += 1
+
+    def _lost(self, batch: _Batch, *, alone: bool, reason: str) -> None:
+        self.counts["lost"] += 1
+        if not alone:  # lost with others: which one killed the worker is not known yet
+            self.retry.appendleft(_Batch(batch.cases, batch.attempts, suspect=True))
+            return
+        attempts = batch.attempts + 1
+        if attempts < MAX_ATTEMPTS:
+            self.retry.appendleft(_Batch(batch.cases, attempts, suspect=True))
+        elif len(batch.cases) > 1:  # split, to find the case
+            half = len(batch.cases) // 2
+            self.retry.appendleft(_Batch(batch.cases[half:], MAX_ATTEMPTS - 1, suspect=True))
+            self.retry.appendleft(_Batch(batch.cases[:half], MAX_ATTEMPTS - 1, suspect=True))
+        else:
+            message = f"the worker running this case was lost {attempts} times ({reason}); it runs again on resume"
+            self.store([CaseOutcome(batch.cases[0].key, False, None, None, WORKER_LOST, message, (), 0.0, "")])
+
+    def store(self, outcomes: list[CaseOutcome]) -> None:
+        """Commit one returned batch (one transaction) and count it."""
+        self.ledger.record(outcomes, self.by_key, self.run_id)
+        self.breaks = 0 if any(o.error_type != WORKER_LOST for o in outcomes) else self.breaks
+        for o in outcomes:
+            self.counts["ok" if o.ok else "failed"] += 1
+            self.case_seconds += o.seconds
+        if self.unknown_columns is None:
+            first = next((o for o in outcomes if o.ok and o.result is not None), None)
+            if first is not None:
+                self.unknown_columns = tuple(missing_columns(json.loads(zlib.decompress(first.result)), self.columns))
+        failed = self.counts["failed"]
+        self.bar.update(len(outcomes), note=f"{failed} failed" if failed else "")
+
+    def stop(self, own_engine: bool) -> None:
+        """After SIGINT/SIGTERM: keep the batches that came back, drop the others (they run
+        again on resume), stop the workers of an engine this run made."""
+        for future in list(self.in_flight):
+            if future.done() and not future.cancelled() and future.exception() is None:
+                self.store(future.result())
+            else:
+                future.cancel()
+        self.in_flight.clear()
+        if own_engine:
+            self.engine.close(cancel=True)
+
+
 def _coordinate(
     spec: CampaignSpec,
     plan: CasePlan,
@@ -277,93 +396,23 @@ def _coordinate(
     progress: bool,
     own_engine: bool,
 ) -> CampaignRun:
-    """The coordinator's loop (see the module docstring)."""
-    by_key = {c.key: c for c in todo}
-    queue: deque[Case] = deque(todo)
-    retry: deque[tuple[list[Case], int]] = deque()
-    in_flight: dict[cf.Future, tuple[list[Case], int]] = {}
     done_before = len(plan) - len(todo)
     run_id = ledger.start_run(engine.description, engine.workers, len(plan), len(todo))
-    counts = {"ok": 0, "failed": 0, "lost": 0, "restarts": 0}
-    case_seconds = 0.0
-    max_in_flight = 2 * engine.workers
     start = time.perf_counter()
     bar = Progress(len(plan), "cases", enabled=None if progress else False, unit="cases", initial=done_before)
-
-    def batch_size() -> int:
-        finished = counts["ok"] + counts["failed"]
-        if finished == 0:
-            return 1  # the first batches measure the time per case
-        want = max(1, int(batch_seconds / max(case_seconds / finished, 1e-6)))
-        return max(1, min(want, math.ceil(len(queue) / max_in_flight), MAX_BATCH))
-
-    def lost(batch: list[Case], attempts: int, reason: str) -> None:
-        counts["lost"] += 1
-        attempts += 1
-        if attempts < MAX_ATTEMPTS:
-            retry.appendleft((batch, attempts))
-        elif len(batch) > 1:
-            half = len(batch) // 2
-            retry.appendleft((batch[half:], MAX_ATTEMPTS - 1))
-            retry.appendleft((batch[:half], MAX_ATTEMPTS - 1))
-        else:
-            message = f"the worker running this case was lost {attempts} times ({reason})"
-            store([CaseOutcome(batch[0].key, False, None, None, "WorkerLost", message, (), 0.0, "")])
-
-    def store(outcomes: list[CaseOutcome]) -> None:
-        nonlocal case_seconds
-        ledger.record(outcomes, by_key, run_id)
-        for o in outcomes:
-            counts["ok" if o.ok else "failed"] += 1
-            case_seconds += o.seconds
-        bar.update(len(outcomes), note=f"{counts['failed']} failed" if counts["failed"] else "")
-
-    stop = _Stop()
+    loop = _Coordinator(spec, todo, columns, ledger, engine, run_id, batch_seconds, bar)
+    stop = Stop()
     with stop:
         try:
-            while queue or retry or in_flight:
-                max_in_flight = 2 * engine.current_workers()
-                while len(in_flight) < max_in_flight and (queue or retry):
-                    if retry:
-                        batch, attempts = retry.popleft()
-                    else:
-                        batch, attempts = [queue.popleft() for _ in range(min(batch_size(), len(queue)))], 0
-                    future = engine.executor.submit(run_batch, make_task(spec, batch, columns))
-                    in_flight[future] = (batch, attempts)
-                finished, _ = cf.wait(list(in_flight), timeout=0.25, return_when=cf.FIRST_COMPLETED)
-                broken = False
-                for future in finished:
-                    batch, attempts = in_flight.pop(future)
-                    try:
-                        outcomes = future.result()
-                    except BrokenProcessPool:
-                        broken = True
-                        lost(batch, attempts, "its process died")
-                    except cf.CancelledError:
-                        retry.appendleft((batch, attempts))
-                    except Exception as exc:  # e.g. Dask's KilledWorker: the batch is sent again
-                        lost(batch, attempts, f"{type(exc).__name__}: {str(exc)[:200]}")
-                    else:
-                        store(outcomes)
-                if broken:  # a local pool breaks whole: every batch in flight went with it
-                    for batch, attempts in in_flight.values():
-                        lost(batch, attempts, "its pool broke")
-                    in_flight.clear()
-                    if not engine.restart():
-                        raise CampaignError(f"the engine ({engine.description}) broke and cannot restart")
-                    counts["restarts"] += 1
+            loop.run()
         except KeyboardInterrupt:
             stop.signal = stop.signal or "SIGINT"
         finally:
-            if stop.signal is not None or in_flight:
-                stop.quiet()
-                for future in in_flight:
-                    future.cancel()
-                if own_engine:
-                    engine.close(cancel=True)
+            stop.quiet()
+            if stop.signal is not None or loop.in_flight:
+                loop.stop(own_engine)
             bar.close()
-            ledger.finish_run(run_id, counts["ok"], counts["failed"], stop.signal)
-    remaining = ledger.counts()["remaining"]
+            ledger.finish_run(run_id, loop.counts["ok"], loop.counts["failed"], stop.signal)
     return CampaignRun(
         title=spec.title,
         out=str(out),
@@ -372,15 +421,16 @@ def _coordinate(
         planned=len(plan),
         done_before=done_before,
         to_run=len(todo),
-        ok=counts["ok"],
-        failed=counts["failed"],
-        remaining=remaining,
+        ok=loop.counts["ok"],
+        failed=loop.counts["failed"],
+        remaining=ledger.counts()["remaining"],
         seconds=time.perf_counter() - start,
-        case_seconds=case_seconds,
+        case_seconds=loop.case_seconds,
         stopped_by=stop.signal,
-        lost_batches=counts["lost"],
-        restarts=counts["restarts"],
+        lost_batches=loop.counts["lost"],
+        restarts=loop.counts["restarts"],
         excluded=plan.excluded,
         duplicates=plan.duplicates,
         columns=tuple(columns),
+        unknown_columns=loop.unknown_columns or (),
     )

@@ -24,12 +24,18 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from .._version import __version__
 from ..io.files import json_text
 from ..run import run_scenario
 from ._cases import Case, case_key, case_overrides, resolve_case
 from ._columns import record
 from ._spec import CampaignSpec
 
+#: The error type of a case whose worker was lost again and again (it runs again on resume).
+WORKER_LOST = "WorkerLost"
+#: One batch at a time per process: the BLAS limit and the recorded warnings are the
+#: process's (a Dask worker may run several tasks in threads).
+_BATCH_LOCK = threading.Lock()
 #: Longest error message kept per case [characters].
 MAX_MESSAGE = 2000
 #: Distinct warnings kept per case.
@@ -51,6 +57,8 @@ class BatchTask:
         the seed it runs with (:func:`~jointlock.campaign.case_seed`).
     columns
         Columns to record.
+    version
+        The coordinator's jointlock version (a worker with another one refuses the batch).
     """
 
     scenario: Mapping[str, Any]
@@ -59,6 +67,7 @@ class BatchTask:
     campaign_seed: int
     cases: tuple[tuple[str, Mapping[str, Any], int], ...]
     columns: tuple[str, ...]
+    version: str = __version__
 
 
 @dataclass(frozen=True)
@@ -109,8 +118,20 @@ def make_task(spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str])
 
 
 def run_batch(task: BatchTask) -> list[CaseOutcome]:
-    """Run every case of ``task`` in this process; never raises for a case's error."""
+    """Run every case of ``task`` in this process; never raises for a case's error.
+
+    Raises
+    ------
+    RuntimeError
+        This worker's jointlock is another version than the coordinator's.
+    """
     from threadpoolctl import threadpool_limits
+
+    if task.version != __version__:
+        raise RuntimeError(
+            f"jointlock {__version__} on worker {socket.gethostname()}, {task.version} in the coordinator: "
+            "install the same version everywhere"
+        )
 
     spec = CampaignSpec(
         source=task.scenario_source,
@@ -121,7 +142,7 @@ def run_batch(task: BatchTask) -> list[CaseOutcome]:
         seed=task.campaign_seed,
     )
     worker = f"{socket.gethostname()}:{os.getpid()}"
-    with threadpool_limits(limits=1):
+    with _BATCH_LOCK, threadpool_limits(limits=1):
         return [_run_case(spec, key, overrides, seed, task.columns, worker) for key, overrides, seed in task.cases]
 
 

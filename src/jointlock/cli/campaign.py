@@ -7,11 +7,18 @@ command line starts fast): parse, call, print, write.
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import shlex
 import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from ..errors import CampaignError
 from ._common import check_out_dir, print_json
+
+if TYPE_CHECKING:
+    from ..campaign import Engine
 
 DESCRIPTION = (
     "Sweep failure cases: a campaign file (TOML) names a base scenario and what to vary with the names "
@@ -128,7 +135,9 @@ def _plan(args: argparse.Namespace) -> int:
     if args.probe < 0:
         raise CampaignError(f"--probe must be an integer >= 0; got {args.probe}")
     spec = load_campaign(args.campaign)
-    plan = plan_campaign(spec, _out(args, spec), workers=args.workers, probe=args.probe)
+    plan = plan_campaign(
+        spec, _out(args, spec), workers=args.workers, probe=args.probe, progress=sys.stderr.isatty() and not args.json
+    )
     if args.json:
         print_json(plan.to_dict())
     else:
@@ -136,18 +145,47 @@ def _plan(args: argparse.Namespace) -> int:
     return 0
 
 
-def _engine(args: argparse.Namespace) -> object | None:
+def _engine(args: argparse.Namespace, quiet: bool) -> Callable[[], Engine] | None:
+    """The engine the options ask for, as a function that starts it (called by the run once
+    the campaign is checked and there is work: nothing starts for a bad file)."""
     from ..campaign import dask_cluster, in_process
 
-    if args.in_process:
-        return in_process()
-    if args.dask_scheduler_file:
-        return dask_cluster(None, scheduler_file=args.dask_scheduler_file)
-    if args.dask:
-        return dask_cluster(args.dask, workers=args.dask_workers)
-    if args.dask_workers is not None:
+    if args.dask_workers is not None and args.dask != "local":
         raise CampaignError("--dask-workers sizes a --dask local cluster; give --dask local (or use --workers)")
-    return None
+    if args.in_process:
+        return in_process
+    if not (args.dask or args.dask_scheduler_file):
+        return None
+
+    def start() -> Engine:
+        if args.dask_scheduler_file:
+            engine = dask_cluster(None, scheduler_file=args.dask_scheduler_file)
+        else:
+            engine = dask_cluster(args.dask, workers=args.dask_workers)
+        if not quiet:
+            print(f"engine: {engine.description}; dashboard: {engine.dashboard}", file=sys.stderr)
+        return engine
+
+    return start
+
+
+def resume_command(args: argparse.Namespace) -> str:
+    """The command that resumes this run (the same options)."""
+    argv = ["jointlock", "campaign", "run", args.campaign]
+    for option, value in (
+        ("--out", args.out),
+        ("--workers", args.workers),
+        ("--dask", args.dask),
+        ("--dask-scheduler-file", args.dask_scheduler_file),
+        ("--dask-workers", args.dask_workers),
+        ("--batch-seconds", args.batch_seconds),
+    ):
+        if value is not None:
+            argv += [option, str(value)]
+    for flag, on in (("--in-process", args.in_process), ("--yes", args.yes), ("--retry-failed", args.retry_failed)):
+        if on:
+            argv.append(flag)
+    return shlex.join(argv)
 
 
 def _run(args: argparse.Namespace) -> int:
@@ -156,23 +194,16 @@ def _run(args: argparse.Namespace) -> int:
     spec = load_campaign(args.campaign)
     out = _out(args, spec)
     quiet = args.quiet or args.json
-    engine = _engine(args)
-    try:
-        if engine is not None and not quiet and engine.dashboard:  # type: ignore[attr-defined]
-            print(f"engine: {engine.description}; dashboard: {engine.dashboard}", file=sys.stderr)  # type: ignore[attr-defined]
-        result = run_campaign(
-            spec,
-            out,
-            engine=engine,  # type: ignore[arg-type]
-            workers=args.workers,
-            retry_failed=args.retry_failed,
-            max_cases=None if args.yes else CONFIRM_CASES,
-            batch_seconds=args.batch_seconds or BATCH_SECONDS,
-            progress=not quiet and sys.stderr.isatty(),
-        )
-    finally:
-        if engine is not None:
-            engine.close(cancel=True)  # type: ignore[attr-defined]
+    result = run_campaign(
+        spec,
+        out,
+        engine=_engine(args, quiet),
+        workers=args.workers,
+        retry_failed=args.retry_failed,
+        max_cases=None if args.yes else CONFIRM_CASES,
+        batch_seconds=args.batch_seconds or BATCH_SECONDS,
+        progress=not quiet and sys.stderr.isatty(),
+    )
     written = write_campaign_report(out) if args.report and not result.interrupted else []
     if args.json:
         print_json(result.to_dict() | {"files": [str(p) for p in written]})
@@ -184,7 +215,7 @@ def _run(args: argparse.Namespace) -> int:
         print(
             f"jointlock campaign: stopped by {result.stopped_by}; {result.planned - result.remaining} of "
             f"{result.planned} cases are in the ledger. Run the same command again to resume the remaining "
-            f"{result.remaining}: jointlock campaign run {args.campaign}" + (f" --out {args.out}" if args.out else ""),
+            f"{result.remaining}: {resume_command(args)}",
             file=sys.stderr,
         )
         return 130 if result.stopped_by == "SIGINT" else 143
@@ -207,6 +238,8 @@ def _export(args: argparse.Namespace) -> int:
 
     if not args.csv and not args.parquet:
         raise CampaignError("export needs --csv FILE and/or --parquet FILE")
+    if args.parquet and importlib.util.find_spec("pyarrow") is None:  # before writing anything
+        raise CampaignError("--parquet needs pyarrow: pip install 'jointlock[parquet]' (or export --csv only)")
     table = campaign_table(args.out, include_outside=args.all)
     written = []
     if args.parquet:
