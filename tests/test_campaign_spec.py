@@ -94,7 +94,7 @@ def test_missing_files_and_bad_toml_are_one_line(tmp_path):
     nobase = tmp_path / "nobase.toml"
     nobase.write_text('scenario = "missing.toml"\n[grid]\n"failure.joint" = [1]\n')
     code, _, err = cli("campaign", "plan", str(nobase))
-    assert code == 2 and "missing.toml" in err and "not found" in err
+    assert code == 2 and "base scenario file" in err and "missing.toml' does not exist" in err
     code, _, err = cli("campaign", "status", str(tmp_path))
     assert code == 2 and "holds no campaign ledger" in err
 

@@ -8,12 +8,12 @@ Nothing runs and nothing is written before the whole file is valid.
 
 from __future__ import annotations
 
-import tomllib
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from ..errors import CampaignError, ScenarioError
+from ..io.files import read_toml_file
 from ..scenario import JOB_ORDER
 from ..scenario._fields import _hint
 from ..scenario._read import _check
@@ -44,16 +44,7 @@ def load_campaign(path: str | Path) -> CampaignSpec:
         :data:`MAX_CASES` cases, or a base scenario that is itself invalid.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CampaignError(f"campaign file {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CampaignError(f"cannot read campaign file {str(path)!r}: {exc}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignError(f"{path}: not valid TOML: {exc}") from None
+    data = read_toml_file(path, "campaign file", CampaignError)
     return campaign_from_dict(data, source=str(path), base_dir=path.resolve().parent)
 
 
@@ -153,16 +144,7 @@ def _base_scenario(value: Any, source: str, base_dir: Path) -> tuple[dict[str, A
         )
     path = Path(value)
     path = path if path.is_absolute() else (base_dir / path).resolve()
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise CampaignError(f"{source}: scenario: file {value!r} not found (looked for {path})") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CampaignError(f"{source}: scenario: cannot read {str(path)!r}: {exc}") from None
-    try:
-        return tomllib.loads(text), str(path), path.parent
-    except tomllib.TOMLDecodeError as exc:
-        raise CampaignError(f"{source}: scenario {str(path)!r} is not valid TOML: {exc}") from None
+    return read_toml_file(path, f"{source}: base scenario file", CampaignError), str(path), path.parent
 
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:

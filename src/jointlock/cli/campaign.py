@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from ..errors import CampaignError
-from ._common import check_out_dir, print_json
+from ._common import check_out_dir, int_at_least, print_json
 
 if TYPE_CHECKING:
     from ..campaign import Engine
@@ -26,16 +26,6 @@ DESCRIPTION = (
     "its result goes to one SQLite ledger (DIR/ledger.sqlite), so running again resumes exactly what is "
     "left. Format: docs/campaigns.md."
 )
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1; got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be an integer >= 1; got {text!r}")
-    return value
 
 
 def _seconds(text: str) -> float:
@@ -60,8 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "time a few cases (in this process) to estimate the run. Nothing is written."))  # fmt: skip
     plan.add_argument("campaign", metavar="CAMPAIGN.toml")
     plan.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
-    plan.add_argument("--workers", type=_positive_int, help="workers the estimate assumes (default: cores)")
-    plan.add_argument("--probe", type=int, default=3, help="cases to time for the estimate (0: none; default 3)")
+    plan.add_argument("--workers", type=int_at_least(1), help="workers the estimate assumes (default: cores)")
+    plan.add_argument("--probe", type=int_at_least(0), default=3, help="cases to time for the estimate (0: none; default 3)")
     plan.add_argument("--json", action="store_true", help="print one JSON object")
     plan.set_defaults(func=_plan)
 
@@ -72,7 +62,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     run.add_argument("campaign", metavar="CAMPAIGN.toml")
     run.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
     engine = run.add_mutually_exclusive_group()
-    engine.add_argument("--workers", type=_positive_int, help="local worker processes (default: one per core)")
+    engine.add_argument("--workers", type=int_at_least(1), help="local worker processes (default: one per core)")
     engine.add_argument("--in-process", action="store_true", help="run every case in this process (no pool)")
     engine.add_argument(
         "--dask", metavar="ADDRESS",
@@ -80,7 +70,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "tcp://HOST:8786 (needs the 'dask' extra)",
     )  # fmt: skip
     engine.add_argument("--dask-scheduler-file", metavar="FILE", help="run on the Dask cluster of this scheduler file (HPC)")
-    run.add_argument("--dask-workers", type=_positive_int, help="workers of --dask local (default: cores)")
+    run.add_argument("--dask-workers", type=int_at_least(1), help="workers of --dask local (default: cores)")
     run.add_argument("--retry-failed", action="store_true", help="run again the cases recorded as failed")
     run.add_argument(
         "--batch-seconds", type=_seconds, default=None,
@@ -119,7 +109,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     report.add_argument("--y", metavar="FIELD", help="varied field down the heatmaps (default: chosen)")
     report.add_argument("--worst", metavar="COLUMN", help="result ranking the worst cases")
     report.add_argument("--worse", choices=("higher", "lower"), help="which way is worse for --worst")
-    report.add_argument("--top", type=_positive_int, default=10, help="worst cases listed (default 10)")
+    report.add_argument("--top", type=int_at_least(1), default=10, help="worst cases listed (default 10)")
     report.add_argument("--json", action="store_true", help="print one JSON object")
     report.set_defaults(func=_report)
 
@@ -132,8 +122,6 @@ def _out(args: argparse.Namespace, spec: object) -> Path:
 def _plan(args: argparse.Namespace) -> int:
     from ..campaign import load_campaign, plan_campaign
 
-    if args.probe < 0:
-        raise CampaignError(f"--probe must be an integer >= 0; got {args.probe}")
     spec = load_campaign(args.campaign)
     plan = plan_campaign(
         spec, _out(args, spec), workers=args.workers, probe=args.probe, progress=sys.stderr.isatty() and not args.json

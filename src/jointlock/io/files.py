@@ -47,6 +47,24 @@ def json_text(obj: Any) -> str:
     return json.dumps(to_plain(obj), indent=2, allow_nan=False) + "\n"
 
 
+def read_toml_file(path: str | Path, what: str, error: type[Exception]) -> dict[str, Any]:
+    """The TOML data of ``path``; a missing, unreadable or invalid file raises ``error`` with
+    one line naming ``what`` (e.g. "scenario file") and the path."""
+    import tomllib
+
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise error(f"{what} {str(path)!r} does not exist") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise error(f"cannot read {what} {str(path)!r}: {exc}") from None
+    try:
+        return tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise error(f"{path}: not valid TOML: {exc}") from None
+
+
 def toml_value(value: Any) -> str:
     """One TOML value: a string, boolean, integer, float or a list of them."""
     if isinstance(value, (bool, np.bool_)):

@@ -12,6 +12,7 @@ from typing import Any
 
 from .._deprecate import warn_once
 from ..errors import ScenarioError
+from ..io.files import read_toml_file
 from ..robots import BUILTIN_ROBOTS
 from ._checks import _check_semantics, _inherit_singular_base, _resolve_robot
 from ._fields import (
@@ -46,16 +47,7 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
         malformed model file -- the message names the file, the field and what is allowed.
     """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise ScenarioError(f"scenario file {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {exc}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"{path}: not valid TOML: {exc}") from None
+    data = read_toml_file(path, "scenario file", ScenarioError)
     applied: dict[str, Any] = {}
     if overrides:
         for key, value in overrides.items():
