@@ -118,3 +118,13 @@ def test_an_unreachable_scheduler_is_one_clear_error():
 
     with pytest.raises(CampaignError, match=r"cannot reach the Dask cluster \(tcp://127.0.0.1:9\)"):
         dask_cluster("tcp://127.0.0.1:9", timeout_s=1.0)
+
+
+def test_a_misspelt_address_and_a_missing_scheduler_file_are_one_line(tmp_path):
+    from jointlock.campaign import dask_cluster
+    from jointlock.errors import CampaignError
+
+    with pytest.raises(CampaignError, match="did you mean 'local'"):
+        dask_cluster("lcoal")
+    with pytest.raises(CampaignError, match="does not exist: start the scheduler first"):
+        dask_cluster(None, scheduler_file=str(tmp_path / "nosuch.json"))

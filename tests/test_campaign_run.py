@@ -380,3 +380,39 @@ def test_a_case_that_kills_its_worker_is_found_and_only_it_is_lost(campaign_file
     again = run_campaign(campaign_file, out, engine=Engine("poison pool", _PoisonPool(poison), 2, "p",
                                                            _restart=restart), batch_seconds=0.3)  # fmt: skip
     assert again.to_run == 1 and again.failed == 1
+
+
+def test_export_to_stdout_and_to_a_folder(serial, tmp_path):
+    out, _ = serial
+    code, stdout, stderr = _cli("campaign", "export", str(out), "--csv", "-")
+    assert code == 0 and stdout.splitlines()[0].startswith("key,index,status,case_seed,")
+    assert len(stdout.splitlines()) == N_CASES + 1 and f"wrote {N_CASES} cases" in stderr
+    code, _, stderr = _cli("campaign", "export", str(out), "--csv", str(tmp_path))
+    assert code == 2 and stderr.count("\n") == 1 and "is a folder" in stderr and ".tmp" not in stderr
+
+
+def test_status_while_a_run_writes_and_another_campaign_in_the_folder(campaign_file, serial, tmp_path):
+    import fcntl
+
+    out = tmp_path / "copy"
+    out.mkdir()
+    with sqlite3.connect(str(serial[0] / "ledger.sqlite")) as src, sqlite3.connect(str(out / "ledger.sqlite")) as dst:
+        src.backup(dst)
+    with open(out / ".campaign.lock", "w") as fh:
+        fh.write("777")
+        fh.flush()
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        status = campaign_status(out)
+    assert status.running_pid == "777" and "a run is in progress (pid 777)" in "\n".join(status.summary())
+    assert campaign_status(out).running_pid is None
+    other = write_campaign(tmp_path, BODY.replace("[1, 2, 3, 4, 5]", "[6]"), name="other.toml")
+    result = run_campaign(other, out, engine=in_process())
+    assert result.other_campaign == str(campaign_file)
+    assert any("held another campaign" in line for line in result.summary())
+    lines = "\n".join(campaign_status(out).summary())
+    assert "older case(s) no longer in the file" in lines and f"({campaign_file})" in lines
+
+
+def test_a_worst_column_without_values_is_one_clear_error(serial):
+    with pytest.raises(jl.errors.CampaignError, match="has no value in any finished case"):
+        campaign_report(serial[0], worst="halt.minimum_T_s")

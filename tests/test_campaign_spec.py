@@ -50,13 +50,18 @@ BAD = {
     "filter on a fixed field": ('[grid]\n"failure.joint" = [1, 2]\n[[exclude]]\n"halt.T" = 8.0\n', "is not varied"),
     "invalid case": ('[grid]\n"failure.joint" = [1, 9]\n', "case 1 (failure.joint=9) is not a valid scenario"),
     "filters drop all": ('[grid]\n"failure.joint" = [1]\n[[exclude]]\n"failure.joint" = 1\n', "drop every case"),
+    "bad comparison": ('[grid]\n"failure.joint" = [1, 2]\n[[exclude]]\n"failure.joint" = { less = 2 }\n',
+                       "unknown comparison 'less'"),  # fmt: skip
+    "a list in [set]": ('[set]\n"failure.joint" = [1, 2]\n[grid]\n"halt.T" = [9.0]\n', "to vary it, list its values in [grid]"),
+    "top-level key after a table": ('[grid]\n"halt.T" = [9.0]\ncolumns = ["halt.k"]\n', "write it before the first [table]"),
+    "x equals y": ('[grid]\n"halt.T" = [9.0, 10.0]\n[report]\nx = "halt.T"\ny = "halt.T"\n', "both 'halt.T'"),
 }
 
 
 @pytest.mark.parametrize("name", sorted(BAD))
 def test_bad_campaign_files_give_one_line_and_start_nothing(tmp_path, name):
     body, expected = BAD[name]
-    path = write_campaign(tmp_path, body)
+    path = write_campaign(tmp_path, body, fast="[set]" not in body)
     out = tmp_path / "out"
     for argv in (("plan", str(path), "--probe", "0"), ("run", str(path), "--out", str(out), "--in-process")):
         code, stdout, stderr = cli("campaign", *argv)
@@ -250,3 +255,11 @@ def test_the_campaign_file_in_the_docs_is_valid(tmp_path):
     path.write_text(block.replace('scenario = "halt_000.toml"', f'scenario = "{EXAMPLES / "halt_000.toml"}"'))
     plan = plan_cases(load_campaign(path))
     assert (plan.described, plan.excluded) == (7 * 3 * 2 * 16, 2 * 16)
+
+
+def test_the_default_output_folder_is_beside_the_campaign_file(tmp_path, monkeypatch):
+    path = write_campaign(tmp_path, '[grid]\n"halt.T" = [9.0]\n', name="mine.toml")
+    monkeypatch.chdir(EXAMPLES)
+    assert load_campaign(path).default_out() == tmp_path / "mine-campaign"
+    other = write_campaign(tmp_path, 'out = "results/here"\n[grid]\n"halt.T" = [9.0]\n', name="o.toml")
+    assert load_campaign(other).default_out() == tmp_path / "results" / "here"

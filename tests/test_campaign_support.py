@@ -74,3 +74,31 @@ def test_progress_shows_count_rate_and_time_left(note):
     text = stream.getvalue()
     assert "10/10 cases" in text and "/s, ETA 0:00" in text and "100.0%" in text
     assert (note in text) if note else "failed" not in text
+
+
+def test_atomic_writes_go_through_links_and_refuse_folders(tmp_path):
+    from jointlock.io.files import atomic_write_text
+
+    real = tmp_path / "real.csv"
+    real.write_text("old")
+    link = tmp_path / "link.csv"
+    link.symlink_to(real)
+    atomic_write_text(link, "new")
+    assert link.is_symlink() and real.read_text() == "new"
+    with pytest.raises(IsADirectoryError, match="is a folder"):
+        atomic_write_text(tmp_path, "x")
+    assert not list(tmp_path.glob(".*.tmp"))
+
+
+def test_progress_off_a_terminal_logs_a_line_now_and_then():
+    stream = io.StringIO()  # not a terminal: no bar
+    bar = Progress(5, "cases", stream=stream, unit="cases", log_every_s=3600.0)
+    for _ in range(5):
+        bar.update(1)
+    bar.close()
+    lines = stream.getvalue().splitlines()
+    assert len(lines) == 2 and "\r" not in stream.getvalue()  # the first and the last
+    assert lines[-1].startswith("cases [") and "5/5 cases" in lines[-1]
+    quiet = io.StringIO()
+    Progress(5, "cases", stream=quiet, unit="cases").update(5)  # no log_every_s: silent
+    assert quiet.getvalue() == ""

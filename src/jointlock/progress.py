@@ -27,11 +27,15 @@ class Progress:
         stream=None,
         unit: str | None = None,
         initial: int = 0,
+        log_every_s: float | None = None,
     ) -> None:
         self.total = max(int(total), 1)
         self.desc = desc
         self.stream = stream if stream is not None else sys.stderr
-        self.enabled = self.stream.isatty() if enabled is None else enabled
+        tty = self.stream.isatty()
+        self.enabled = tty if enabled is None else enabled
+        # off a terminal (a batch job's log): a plain line every log_every_s seconds instead
+        self._log_every = log_every_s if enabled is None and not tty else None
         self.unit = unit
         self.done = int(initial)
         self._initial = int(initial)
@@ -46,22 +50,30 @@ class Progress:
         counted in ``initial`` excluded) and the time left at that rate."""
         self.done += n
         now = time.perf_counter()
-        if self.enabled and (now - self._last > 0.1 or self.done >= self.total):
+        if self._log_every is not None and (now - self._last >= self._log_every or self.done >= self.total):
             self._last = now
-            frac = min(self.done / self.total, 1.0)
-            bar = "#" * int(30 * frac)
-            elapsed = now - self._start
-            line = f"\r{self.desc} [{bar:<30}] {100 * frac:5.1f}% {elapsed:6.1f}s"
-            if self.unit is not None:
-                rate = (self.done - self._initial) / elapsed if elapsed > 0 else 0.0
-                left = (self.total - self.done) / rate if rate > 0 else float("nan")
-                eta = _clock(left) if left == left else "?"
-                line += f" {self.done}/{self.total} {self.unit}, {rate:.3g}/s, ETA {eta}"
+            self.stream.write(self._status(now).lstrip("\r") + (f", {note}" if note else "") + "\n")
+            self.stream.flush()
+        elif self.enabled and (now - self._last > 0.1 or self.done >= self.total):
+            self._last = now
+            line = self._status(now)
             if note:
                 line += f", {note}"
             self.stream.write(line + " " * max(self._width - len(line), 0))
             self._width = len(line)
             self.stream.flush()
+
+    def _status(self, now: float) -> str:
+        frac = min(self.done / self.total, 1.0)
+        bar = "#" * int(30 * frac)
+        elapsed = now - self._start
+        line = f"\r{self.desc} [{bar:<30}] {100 * frac:5.1f}% {elapsed:6.1f}s"
+        if self.unit is not None:
+            rate = (self.done - self._initial) / elapsed if elapsed > 0 else 0.0
+            left = (self.total - self.done) / rate if rate > 0 else float("nan")
+            eta = _clock(left) if left == left else "?"
+            line += f" {self.done}/{self.total} {self.unit}, {rate:.3g}/s, ETA {eta}"
+        return line
 
     def close(self) -> None:
         if self.enabled:

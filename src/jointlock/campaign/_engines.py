@@ -18,11 +18,14 @@ An :class:`Engine` is the parallel resource passed to
 from __future__ import annotations
 
 import concurrent.futures as cf
+import difflib
+import logging
 import multiprocessing
 import os
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 from ..errors import CampaignError
@@ -181,6 +184,16 @@ def dask_cluster(
         raise CampaignError(
             "the Dask engine needs the optional 'dask' extra: pip install 'jointlock[dask]'"
         ) from None
+    if scheduler_file is not None and not Path(scheduler_file).is_file():
+        raise CampaignError(
+            f"Dask scheduler file {scheduler_file!r} does not exist: start the scheduler first "
+            f"(dask scheduler --scheduler-file {scheduler_file})"
+        )
+    if address not in (None, "local") and "://" not in address and ":" not in address:
+        hint = " (did you mean 'local'?)" if difflib.get_close_matches(address, ["local"], cutoff=0.6) else ""
+        raise CampaignError(f"--dask must be 'local' or a scheduler's address tcp://HOST:PORT; got {address!r}{hint}")
+    if logging.getLogger().getEffectiveLevel() > logging.DEBUG:  # Dask's INFO lines, unless --debug
+        logging.getLogger("distributed").setLevel(logging.ERROR)
     cluster = None
     try:
         if scheduler_file is not None:
@@ -192,7 +205,11 @@ def dask_cluster(
             # large numpy temporary is then mapped and unmapped, ~1.3x slower halt cases
             with dask.config.set({"distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_": None}):
                 cluster = LocalCluster(
-                    n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0"
+                    n_workers=n,
+                    threads_per_worker=1,
+                    processes=True,
+                    dashboard_address=":0",
+                    silence_logs=logging.getLogger("distributed").getEffectiveLevel(),
                 )
             client = Client(cluster)
             client.wait_for_workers(n, timeout=max(timeout_s, 60.0))

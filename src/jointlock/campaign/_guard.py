@@ -42,6 +42,25 @@ def exclusive(out: Path) -> Iterator[None]:
             fcntl.flock(fh, fcntl.LOCK_UN)
 
 
+def running_pid(out: str | Path) -> str | None:
+    """The pid of the coordinator writing ``out`` now, or None when no run holds its lock."""
+    path = Path(out) / ".campaign.lock"
+    try:
+        import fcntl
+    except ImportError:
+        return None
+    try:
+        with open(path) as fh:
+            try:
+                fcntl.flock(fh, fcntl.LOCK_SH | fcntl.LOCK_NB)
+            except OSError:
+                return fh.read().strip() or "?"
+            fcntl.flock(fh, fcntl.LOCK_UN)
+    except OSError:  # no lock file: never run here
+        return None
+    return None
+
+
 class Stop:
     """SIGINT/SIGTERM while a campaign runs: remember which, and raise KeyboardInterrupt
     where the coordinator is (everything it committed stays; the ledger rolls back a

@@ -10,7 +10,8 @@ FROM cases``):
 * ``cases(key, status, params, seed, record, result, error_type, error_message, warnings,
   seconds, worker, finished_at, run_id)`` -- one row per case ever finished (``status`` 'ok' or
   'error'; ``result`` is the jobs' ``to_dict()`` as zlib-compressed JSON).
-* ``runs(id, started_at, finished_at, engine, workers, planned, to_run, ok, failed, stopped_by)``.
+* ``runs(id, started_at, finished_at, engine, workers, planned, to_run, ok, failed, stopped_by,
+  source, jointlock)``: each ``run`` with its campaign file and jointlock version.
 
 Keys identify cases by their resolved inputs, so a row is never written twice for one case: a
 re-run case (``--retry-failed``) replaces its row.
@@ -58,7 +59,7 @@ CREATE TABLE IF NOT EXISTS runs (
     id INTEGER PRIMARY KEY AUTOINCREMENT,
     started_at TEXT NOT NULL, finished_at TEXT, engine TEXT NOT NULL, workers INTEGER NOT NULL,
     planned INTEGER NOT NULL, to_run INTEGER NOT NULL, ok INTEGER NOT NULL DEFAULT 0,
-    failed INTEGER NOT NULL DEFAULT 0, stopped_by TEXT);
+    failed INTEGER NOT NULL DEFAULT 0, stopped_by TEXT, source TEXT, jointlock TEXT);
 """
 
 
@@ -131,11 +132,13 @@ class Ledger:
 
     # -- runs and outcomes -------------------------------------------------------------------
 
-    def start_run(self, engine: str, workers: int, planned: int, to_run: int) -> int:
+    def start_run(self, engine: str, workers: int, planned: int, to_run: int, source: str, version: str) -> int:
+        """Record a run of the campaign file ``source`` by jointlock ``version``; its id."""
         with self._transaction() as db:
             cur = db.execute(
-                "INSERT INTO runs (started_at, engine, workers, planned, to_run) VALUES (?, ?, ?, ?, ?)",
-                (_now(), engine, workers, planned, to_run),
+                "INSERT INTO runs (started_at, engine, workers, planned, to_run, source, jointlock) "
+                "VALUES (?, ?, ?, ?, ?, ?, ?)",
+                (_now(), engine, workers, planned, to_run, source, version),
             )
         return int(cur.lastrowid)
 
@@ -252,8 +255,8 @@ class Ledger:
 
     def runs(self) -> list[dict[str, Any]]:
         cur = self._db.execute(
-            "SELECT id, started_at, finished_at, engine, workers, planned, to_run, ok, failed, stopped_by "
-            "FROM runs ORDER BY id"
+            "SELECT id, started_at, finished_at, engine, workers, planned, to_run, ok, failed, stopped_by, "
+            "source, jointlock FROM runs ORDER BY id"
         )
         names = [d[0] for d in cur.description]
         return [dict(zip(names, row)) for row in cur]

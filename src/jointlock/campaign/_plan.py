@@ -90,7 +90,8 @@ class CampaignPlan:
             est = self.estimate_s or 0.0
             lines.append(
                 f"timed {len(self.probe_seconds)} case(s): {self.seconds_per_case:.3g} s each (median) -> about "
-                f"{_duration(est)} with {self.workers} worker(s)"
+                f"{_duration(est)} with {self.workers} worker(s) if they scale perfectly (cases sharing a "
+                "machine's memory run slower: allow up to 1.5x)"
             )
         if self.probe_errors:
             lines.append(f"{len(self.probe_errors)} timed case(s) raised (recorded, not fatal, in a run); first: "

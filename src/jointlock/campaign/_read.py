@@ -14,7 +14,7 @@ from typing import Any
 
 from ..errors import CampaignError, ScenarioError
 from ..io.files import read_toml_file
-from ..scenario import JOB_ORDER
+from ..scenario import DEPRECATED_FIELDS, JOB_ORDER
 from ..scenario._fields import _hint
 from ..scenario._read import _check
 from ._spec import (
@@ -29,6 +29,7 @@ from ._spec import (
     ReportSpec,
     SampleSpec,
     scenario_field,
+    varied_names,
 )
 
 
@@ -149,15 +150,24 @@ def _base_scenario(value: Any, source: str, base_dir: Path) -> tuple[dict[str, A
 
 def _flatten(table: Mapping[str, Any], prefix: str = "") -> dict[str, Any]:
     """``{"failure": {"joint": v}}`` (TOML's dotted keys) and ``{"failure.joint": v}`` (a
-    quoted key) both as ``{"failure.joint": v}``; a table of comparisons stays one value."""
+    quoted key) both as ``{"failure.joint": v}``; the value of a known field stays one value
+    even when it is a table (an ``[[exclude]]`` condition such as ``{ lt = 2 }``)."""
     out: dict[str, Any] = {}
+    fields = _known_names()
     for key, value in table.items():
         name = f"{prefix}{key}"
-        if isinstance(value, dict) and value and not set(value) <= set(COMPARISONS):
+        if isinstance(value, dict) and value and name not in fields:
             out.update(_flatten(value, name + "."))
         else:
             out[name] = value
     return out
+
+
+def _known_names() -> set[str]:
+    """Every field name a campaign may use, former names included."""
+    names = set(varied_names())
+    names |= {f"{t}.{old}" for t, olds in DEPRECATED_FIELDS.items() for old in olds}
+    return names
 
 
 def _named_table(data: Mapping[str, Any], key: str, source: str) -> dict[str, Any]:
@@ -185,7 +195,9 @@ def _value(value: Any, name: str, where: str, base_dir: Path) -> Any:
     try:
         checked = _check(value, spec, where)
     except ScenarioError as exc:
-        raise CampaignError(str(exc)) from None
+        in_set = isinstance(value, list) and ": set." in where and spec.kind not in ("numbers", "strings")
+        vary = " -- to vary it, list its values in [grid] or [zip]" if in_set else ""
+        raise CampaignError(f"{exc}{vary}") from None
     if name == "robot" and Path(checked).suffix.lower() in (".toml", ".urdf") and not Path(checked).is_absolute():
         checked = str((base_dir / checked).resolve())
     return checked

@@ -21,18 +21,19 @@ from ..io.files import atomic_write_text, figure_png, toml_document
 from ..plots._common import offscreen_figure
 from ..plots.campaign import plot_distribution, plot_heatmap
 from ..scenario import apply_overrides
+from ..scenario._fields import _hint
 from ._cases import params_text
 from ._columns import WORSE, is_numeric
 from ._ledger import open_ledger
-from ._results import CampaignStatus, CampaignTable, campaign_status, campaign_table
+from ._results import CampaignStatus, CampaignTable, campaign_status, campaign_table, run_ending
 from ._spec import spec_from_dict
 
 #: Distinct values above which a numeric field is binned on a heatmap axis.
 MAX_CATEGORIES = 24
 #: Bins of a binned heatmap axis.
 AXIS_BINS = 10
-#: Most heatmaps and histograms in one report.
-MAX_FIGURES = 10
+#: Most heatmaps and histograms in one report (the rest are named in a note).
+MAX_FIGURES = 16
 #: Folder (in the campaign's output folder) of the worst cases' scenario files.
 WORST_DIR = "worst"
 #: Columns that rank the worst cases by default, the first recorded one (else any of
@@ -173,6 +174,8 @@ class CampaignReport:
         )
         ran = "ran every job (no error)"
         failed = any(r["status"] != "ok" for r in rows)
+        if len(numeric) > MAX_FIGURES:
+            sec.notes.append(f"not drawn (more than {MAX_FIGURES} results): {', '.join(numeric[MAX_FIGURES:])}")
         for metric in ([ran] if failed else []) + numeric[:MAX_FIGURES]:
             values = [r["status"] == "ok" for r in rows] if metric == ran else [r.get(metric) for r in rows]
             share = all(isinstance(v, bool) for v in values if v is not None)
@@ -233,8 +236,7 @@ def _overview(s: CampaignStatus, spec: dict[str, Any]) -> rp.Section:
         (
             ["run", "started", "engine", "sent", "ok", "failed", "ended"],
             [
-                [r["id"], r["started_at"], r["engine"], r["to_run"], r["ok"], r["failed"],
-                 f"stopped by {r['stopped_by']}" if r["stopped_by"] else ("finished" if r["finished_at"] else "cut off")]
+                [r["id"], r["started_at"], r["engine"], r["to_run"], r["ok"], r["failed"], run_ending(r)]
                 for r in s.runs
             ],
         )
@@ -284,6 +286,8 @@ def _distributions(rows: list[dict[str, Any]], numeric: list[str]) -> rp.Section
     if not rows or not metrics:
         return None
     sec = rp.Section("Distributions")
+    if len(metrics) > MAX_FIGURES:
+        sec.notes.append(f"not drawn (more than {MAX_FIGURES} results): {', '.join(metrics[MAX_FIGURES:])}")
     for m in metrics[:MAX_FIGURES]:
         fig = offscreen_figure((5.0, 3.2))
         plot_distribution([np.nan if r.get(m) is None else float(r[m]) for r in rows], name=m, ax=fig.add_subplot())
@@ -381,7 +385,10 @@ def campaign_report(
     x, y = x or conf.get("x"), y or conf.get("y")
     for axis, name in (("x", x), ("y", y)):
         if name is not None and name not in table.params:
-            raise CampaignError(f"report {axis} = {name!r} is not a varied field; varied: {', '.join(table.params)}")
+            raise CampaignError(
+                f"report {axis} = {name!r} is not a varied field{_hint(name, table.params)}; varied: "
+                f"{', '.join(table.params)}"
+            )
     ok_rows = [r for r in table.rows if r["status"] == "ok"]
     x, y = _choose_axes(table.params, ok_rows, x, y)
     has_values = [m for m in table.metrics if any(r.get(m) is not None for r in ok_rows)]
@@ -389,7 +396,13 @@ def campaign_report(
     worst = worst or next((m for m in has_values if m in WORSE), None)
     if worst is not None and worst not in table.metrics:
         raise CampaignError(f"report: worst = {worst!r} is not a recorded column; columns: {', '.join(table.metrics)}")
-    if worst is not None and not is_numeric([r.get(worst) for r in ok_rows]):
+    values = [r.get(worst) for r in ok_rows] if worst is not None else []
+    if worst is not None and not any(v is not None for v in values):
+        raise CampaignError(
+            f"report: worst = {worst!r} has no value in any finished case (e.g. halt.minimum_T_s of a feasible "
+            "halt needs halt.minimum_T = true); choose another column"
+        )
+    if worst is not None and not is_numeric(values):
         raise CampaignError(f"report: worst = {worst!r} does not hold numbers or yes/no values; it cannot rank cases")
     if x is not None and x == y:
         raise CampaignError(f"report: x and y are both {x!r}; give two different varied fields")

@@ -16,6 +16,7 @@ from typing import Any
 from ..errors import CampaignError
 from ..io.files import atomic_write_bytes, atomic_write_text
 from ._cases import params_text
+from ._guard import running_pid
 from ._ledger import open_ledger
 
 #: Failures listed by ``status`` (all of them are in the ledger and the export).
@@ -53,6 +54,7 @@ class CampaignStatus:
     case_seconds: float
     warned: int = 0
     columns: tuple[str, ...] = field(default_factory=tuple)
+    running_pid: str | None = None
 
     @property
     def complete(self) -> bool:
@@ -69,6 +71,7 @@ class CampaignStatus:
             "remaining": self.remaining,
             "outside": self.outside,
             "complete": self.complete,
+            "running_pid": self.running_pid,
             "case_seconds": self.case_seconds,
             "cases_with_warnings": self.warned,
             "columns": list(self.columns),
@@ -78,6 +81,8 @@ class CampaignStatus:
 
     def summary(self) -> list[str]:
         state = "complete" if self.complete else f"{self.remaining} to run"
+        if self.running_pid is not None:
+            state += f"; a run is in progress (pid {self.running_pid})"
         lines = [
             f"{self.title} ({self.source})",
             f"cases: {self.planned} planned, {self.ok} ok, {self.failed} failed, {state}"
@@ -85,24 +90,40 @@ class CampaignStatus:
             f"work: {self.case_seconds:.1f} s over {len(self.runs)} run(s)"
             + (f"; {self.warned} case(s) raised warnings" if self.warned else ""),
         ]
-        for r in self.runs:
-            how = f"stopped by {r['stopped_by']}" if r["stopped_by"] else ("finished" if r["finished_at"] else "cut off")
+        for i, r in enumerate(self.runs):
+            running = self.running_pid is not None and i == len(self.runs) - 1 and not r["finished_at"]
+            how = run_ending(r, running=running)
+            source = f" ({r['source']})" if r.get("source") and r["source"] != self.source else ""
             lines.append(
-                f"  run {r['id']} {r['started_at']}: {r['engine']}; {r['ok']} ok, {r['failed']} failed of "
-                f"{r['to_run']} sent; {how}"
+                f"  run {r['id']} {r['started_at']}{source}: {r['engine']}; {r['ok']} ok, {r['failed']} failed "
+                f"of {r['to_run']} sent; {how}"
             )
         if self.failures:
             lines.append(f"failed cases ({len(self.failures)}):")
             for f in self.failures[:MAX_FAILURES_SHOWN]:
-                lines.append(
-                    f"  #{f['index']} ({params_text(f['params'], limit=80)}): {f['error_type']}: "
-                    f"{_one_line(f['error_message'])}"
-                )
+                message = _one_line(_without_prefix(f["error_message"] or ""), limit=240)
+                lines.append(f"  #{f['index']} ({params_text(f['params'], limit=80)}): {f['error_type']}: {message}")
             if len(self.failures) > MAX_FAILURES_SHOWN:
                 lines.append(f"  ... and {len(self.failures) - MAX_FAILURES_SHOWN} more (export lists them all)")
-        if not self.complete:
+        if not self.complete and self.running_pid is None:
             lines.append(f"resume: {shlex.join(['jointlock', 'campaign', 'run', self.source, '--out', self.out])}")
         return lines
+
+
+def run_ending(run: dict[str, Any], *, running: bool = False) -> str:
+    """How a run ended, in words."""
+    if running:
+        return "running"
+    if run["stopped_by"]:
+        return f"stopped by {run['stopped_by']}"
+    return "finished" if run["finished_at"] else "cut off (the coordinator was killed)"
+
+
+def _without_prefix(message: str) -> str:
+    """A case's error without the scenario file in front (the same for every case): from the
+    job's name on (``job [halt]: ...``)."""
+    at = message.find("job [")
+    return message[at:] if at > 0 else message
 
 
 def _one_line(text: str | None, limit: int = 160) -> str:
@@ -135,6 +156,7 @@ def campaign_status(out: str | Path) -> CampaignStatus:
             case_seconds=sum(r["seconds"] or 0.0 for r in rows),
             warned=sum(1 for r in rows if r["warnings"]),
             columns=tuple(ledger.meta("columns") or ()),
+            running_pid=running_pid(out),
         )
 
 

@@ -13,6 +13,7 @@ as an error (``WorkerLost``).  SIGINT and SIGTERM stop the run: running batches 
 from __future__ import annotations
 
 import concurrent.futures as cf
+import dataclasses
 import json
 import math
 import shlex
@@ -47,6 +48,8 @@ MAX_BREAKS = 40
 LOSS_NAMES = ("KilledWorker", "CommClosedError", "FutureCancelledError")
 #: Most cases in one batch.
 MAX_BATCH = 2000
+#: Off a terminal (a batch job's log), a progress line this often [s].
+LOG_EVERY_S = 30.0
 #: Default work per batch [s] (5-30 s keeps a Dask task's overhead far below 1 %).
 BATCH_SECONDS = 10.0
 
@@ -92,6 +95,7 @@ class CampaignRun:
     duplicates: int = 0
     columns: tuple[str, ...] = field(default_factory=tuple)
     unknown_columns: tuple[str, ...] = field(default_factory=tuple)
+    other_campaign: str | None = None
 
     @property
     def interrupted(self) -> bool:
@@ -125,6 +129,7 @@ class CampaignRun:
             "duplicates": self.duplicates,
             "columns": list(self.columns),
             "unknown_columns": list(self.unknown_columns),
+            "other_campaign": self.other_campaign,
         }
 
     def summary(self) -> list[str]:
@@ -137,6 +142,11 @@ class CampaignRun:
             lines.append(f"  {self.lost_batches} batch(es) lost with a worker and sent again; pool restarts: {self.restarts}")
         if self.failed:
             lines.append(f"  failed cases are recorded with their error: jointlock campaign status {shlex.quote(self.out)}")
+        if self.other_campaign:
+            lines.append(
+                f"  note: this folder held another campaign ({self.other_campaign}); its cases stay in the "
+                "ledger, outside this campaign's plan (status counts them as older cases)"
+            )
         for text in self.unknown_columns:
             lines.append(f"  column {text}; fix `columns` and run again: nothing is computed again")
         lines.append(f"  ledger: {Path(self.out) / LEDGER_NAME}")
@@ -176,7 +186,8 @@ def run_campaign(
     batch_seconds
         Work per batch [s] (> 0).
     progress
-        Show a progress bar on stderr (cases done, rate, time left, failures).
+        Show a progress bar on stderr (cases done, rate, time left, failures); off a terminal,
+        a line every :data:`LOG_EVERY_S` seconds.
 
     Returns
     -------
@@ -194,6 +205,8 @@ def run_campaign(
         raise CampaignError(f"output folder {str(out)!r} exists and is not a folder")
     columns = check_columns(spec, plan)
     with exclusive(out), open_ledger(out, create=True) as ledger:
+        previous = (ledger.meta("spec") or {}).get("source")
+        other = previous if previous is not None and not _same_file(previous, spec.source) else None
         _remember(ledger, spec, columns)
         ledger.set_plan(plan.cases)
         finished = ledger.finished_keys(status="ok")
@@ -204,16 +217,24 @@ def run_campaign(
         if not own:
             pass
         elif not todo:
-            engine = in_process()  # nothing to run: no workers to start
+            engine = dataclasses.replace(in_process(), description="none (nothing left to run)")
         elif engine is None:
             engine = process_pool(workers)
         else:
             engine = engine()
         try:
-            return _coordinate(spec, plan, todo, columns, ledger, engine, out, batch_seconds, progress, own)
+            result = _coordinate(spec, plan, todo, columns, ledger, engine, out, batch_seconds, progress, own)
+            return dataclasses.replace(result, other_campaign=other)
         finally:
             if own:
                 engine.close()
+
+
+def _same_file(a: str, b: str) -> bool:
+    try:
+        return Path(a).resolve() == Path(b).resolve()
+    except OSError:
+        return a == b
 
 
 def _remember(ledger: Ledger, spec: CampaignSpec, columns: Sequence[str]) -> None:
@@ -334,8 +355,10 @@ class _Coordinator:
         self.breaks += 1
         if self.breaks >= MAX_BREAKS:
             raise CampaignError(
-                f"the local pool broke {self.breaks} times in a row without returning a batch (a worker "
-                "process dies at start or on every case?); run with --in-process to see the error"
+                f"the local pool broke {self.breaks} times in a row without returning a batch: a worker "
+                "process dies at start or on every case. From a script, guard its entry point with "
+                "`if __name__ == \"__main__\":` (the workers import it again); else run with "
+                "--in-process (engine=in_process()) to see the error"
             )
         if not self.engine.restart():
             raise CampaignError(f"the engine ({self.engine.description}) broke and cannot restart")
@@ -397,9 +420,10 @@ def _coordinate(
     own_engine: bool,
 ) -> CampaignRun:
     done_before = len(plan) - len(todo)
-    run_id = ledger.start_run(engine.description, engine.workers, len(plan), len(todo))
+    run_id = ledger.start_run(engine.description, engine.workers, len(plan), len(todo), spec.source, __version__)
     start = time.perf_counter()
-    bar = Progress(len(plan), "cases", enabled=None if progress else False, unit="cases", initial=done_before)
+    bar = Progress(len(plan), "cases", enabled=None if progress else False, unit="cases", initial=done_before,
+                   log_every_s=LOG_EVERY_S)  # fmt: skip
     loop = _Coordinator(spec, todo, columns, ledger, engine, run_id, batch_seconds, bar)
     stop = Stop()
     with stop:

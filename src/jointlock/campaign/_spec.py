@@ -132,12 +132,10 @@ class CampaignSpec:
         return n
 
     def default_out(self) -> Path:
-        """The output folder: ``out`` (relative to the campaign file), else
-        ``<campaign file stem>-campaign`` in the working folder."""
-        if self.out:
-            path = Path(self.out)
-            return path if path.is_absolute() else self.base_dir / path
-        return Path(f"{Path(self.source).stem}-campaign")
+        """The output folder: ``out``, else ``<campaign file stem>-campaign``, both relative to
+        the campaign file's folder (so a run resumes from wherever it is started)."""
+        path = Path(self.out or f"{Path(self.source).stem}-campaign")
+        return path if path.is_absolute() else self.base_dir / path
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data from which :func:`spec_from_dict` rebuilds the spec (kept in the ledger)."""
@@ -202,6 +200,11 @@ def scenario_field(name: str, where: str) -> tuple[str, Field]:
         if key in ALL_TABLES[table]:
             return f"{table}.{key}", ALL_TABLES[table][key]
     names = varied_names()
+    if name in _TOP_KEYS:
+        raise CampaignError(
+            f"{where}: {name!r} is a top-level key of the campaign file: write it before the first "
+            "[table] (TOML puts every line after a [table] header into that table)"
+        )
     raise CampaignError(
         f"{where}: unknown scenario field {name!r}{_hint(name, names)}; fields are the names of "
         "`jointlock run --set`: TABLE.FIELD (e.g. failure.joint, halt.T) or a top-level field "

@@ -49,7 +49,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Validate CAMPAIGN.toml, count its cases and those already finished in the output folder, and "
         "time a few cases (in this process) to estimate the run. Nothing is written."))  # fmt: skip
     plan.add_argument("campaign", metavar="CAMPAIGN.toml")
-    plan.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
+    plan.add_argument(
+        "--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign beside the file)"
+    )
     plan.add_argument("--workers", type=int_at_least(1), help="workers the estimate assumes (default: cores)")
     plan.add_argument("--probe", type=int_at_least(0), default=3, help="cases to time for the estimate (0: none; default 3)")
     plan.add_argument("--json", action="store_true", help="print one JSON object")
@@ -60,7 +62,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(one worker per core), or a Dask cluster. Ctrl-C (SIGINT) or SIGTERM stops it with everything "
         "finished committed; the same command resumes. A case that raises is recorded with its error."))  # fmt: skip
     run.add_argument("campaign", metavar="CAMPAIGN.toml")
-    run.add_argument("--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign)")
+    run.add_argument(
+        "--out", metavar="DIR", help="output folder (default: the file's out, else <name>-campaign beside the file)"
+    )
     engine = run.add_mutually_exclusive_group()
     engine.add_argument("--workers", type=int_at_least(1), help="local worker processes (default: one per core)")
     engine.add_argument("--in-process", action="store_true", help="run every case in this process (no pool)")
@@ -93,7 +97,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "Write the finished cases of DIR, one row each (key, varied fields, recorded results, error), "
         "as CSV and/or Parquet (Parquet needs pyarrow: the 'parquet' extra)."))  # fmt: skip
     export.add_argument("out", metavar="DIR")
-    export.add_argument("--csv", metavar="FILE", help="write CSV")
+    export.add_argument("--csv", metavar="FILE", help="write CSV ('-': to stdout)")
     export.add_argument("--parquet", metavar="FILE", help="write Parquet")
     export.add_argument("--all", action="store_true", help="also the cases no longer in the campaign file")
     export.set_defaults(func=_export)
@@ -170,7 +174,9 @@ def resume_command(args: argparse.Namespace) -> str:
     ):
         if value is not None:
             argv += [option, str(value)]
-    for flag, on in (("--in-process", args.in_process), ("--yes", args.yes), ("--retry-failed", args.retry_failed)):
+    flags = (("--in-process", args.in_process), ("--yes", args.yes), ("--retry-failed", args.retry_failed),
+             ("--report", args.report), ("--quiet", args.quiet), ("--json", args.json))  # fmt: skip
+    for flag, on in flags:
         if on:
             argv.append(flag)
     return shlex.join(argv)
@@ -190,15 +196,15 @@ def _run(args: argparse.Namespace) -> int:
         retry_failed=args.retry_failed,
         max_cases=None if args.yes else CONFIRM_CASES,
         batch_seconds=args.batch_seconds or BATCH_SECONDS,
-        progress=not quiet and sys.stderr.isatty(),
+        progress=not quiet,
     )
+    if not quiet:  # before the report: what ran is said even if the report's settings are wrong
+        print("\n".join(result.summary()))
     written = write_campaign_report(out) if args.report and not result.interrupted else []
     if args.json:
         print_json(result.to_dict() | {"files": [str(p) for p in written]})
-    elif not args.quiet:
-        print("\n".join(result.summary()))
-        if written:
-            print(f"  report: {written[0]}")
+    elif written and not args.quiet:
+        print(f"  report: {written[0]}")
     if result.interrupted:
         print(
             f"jointlock campaign: stopped by {result.stopped_by}; {result.planned - result.remaining} of "
@@ -229,12 +235,18 @@ def _export(args: argparse.Namespace) -> int:
     if args.parquet and importlib.util.find_spec("pyarrow") is None:  # before writing anything
         raise CampaignError("--parquet needs pyarrow: pip install 'jointlock[parquet]' (or export --csv only)")
     table = campaign_table(args.out, include_outside=args.all)
-    written = []
+    written: list[str] = []
     if args.parquet:
-        written.append(table.write_parquet(args.parquet))
-    if args.csv:
-        written.append(table.write_csv(args.csv))
-    print(f"wrote {len(table.rows)} cases x {len(table.names)} columns to {', '.join(map(str, written))}")
+        written.append(str(table.write_parquet(args.parquet)))
+    if args.csv == "-":
+        sys.stdout.write(table.csv_text())
+        written.append("stdout")
+    elif args.csv:
+        written.append(str(table.write_csv(args.csv)))
+    print(
+        f"wrote {len(table.rows)} cases x {len(table.names)} columns to {', '.join(written)}",
+        file=sys.stderr if args.csv == "-" else sys.stdout,
+    )
     return 0
 
 

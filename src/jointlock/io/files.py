@@ -8,6 +8,7 @@ files never touches the user's plotting backend.
 
 from __future__ import annotations
 
+import errno
 import io
 import json
 import math
@@ -105,8 +106,23 @@ def _umask() -> int:
 
 def atomic_write_bytes(path: str | Path, data: bytes) -> None:
     """Write ``data`` to ``path`` via a temporary file and a rename, so an interrupted run
-    never leaves a half-written file (parent folders are created)."""
-    path = Path(path)
+    never leaves a half-written file (parent folders are created).
+
+    A symbolic link is written through (the file it points to is replaced, the link kept); a
+    path under ``/dev`` or ``/proc`` (``/dev/stdout``) or that is not a regular file (a pipe)
+    is written directly; a folder is refused (:class:`IsADirectoryError` naming it)."""
+    given = Path(path)
+    if str(given).startswith(("/dev/", "/proc/")):  # a device, a pipe, a redirected stdout
+        with open(given, "ab") as fh:  # appending: a redirected stdout keeps what came before
+            fh.write(data)
+        return
+    path = Path(os.path.realpath(given))
+    if path.is_dir():
+        raise IsADirectoryError(errno.EISDIR, "is a folder, not a file", str(given))
+    if path.exists() and not path.is_file():  # a named pipe: no rename over it
+        with open(path, "wb") as fh:
+            fh.write(data)
+        return
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     try:
