@@ -22,7 +22,6 @@ from __future__ import annotations
 import datetime as _dt
 import json
 import sqlite3
-import zlib
 from collections.abc import Iterable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
@@ -30,7 +29,7 @@ from typing import Any
 
 from ..errors import CampaignError
 from ._cases import Case
-from ._worker import CaseOutcome
+from ._worker import CaseOutcome, decode_result
 
 #: File name of the ledger in a campaign's output folder.
 LEDGER_NAME = "ledger.sqlite"
@@ -234,17 +233,10 @@ class Ledger:
             out.append(item)
         return out
 
-    def planned_rows(self) -> list[dict[str, Any]]:
-        """The planned cases (``key``, ``index``, ``params``, ``seed``), in order."""
-        return [
-            {"key": k, "index": i, "params": json.loads(p), "seed": s}
-            for k, i, p, s in self._db.execute("SELECT key, idx, params, seed FROM planned ORDER BY idx")
-        ]
-
     def result(self, key: str) -> dict[str, Any] | None:
         """The jobs' ``to_dict()`` of a finished case, or None."""
         row = self._db.execute("SELECT result FROM cases WHERE key = ?", (key,)).fetchone()
-        return None if row is None or row[0] is None else json.loads(zlib.decompress(row[0]))
+        return None if row is None or row[0] is None else decode_result(row[0])
 
     def results(self, keys: Iterable[str]) -> Iterator[tuple[str, dict[str, Any]]]:
         """``(key, result)`` of the finished, successful cases among ``keys``."""

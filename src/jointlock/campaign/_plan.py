@@ -3,9 +3,7 @@ those already finished, and times a few of the others for an estimate."""
 
 from __future__ import annotations
 
-import json
 import statistics
-import zlib
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,7 +16,7 @@ from ._engines import default_workers
 from ._ledger import LEDGER_NAME, open_ledger
 from ._read import as_spec
 from ._spec import CampaignSpec
-from ._worker import make_task, run_batch
+from ._worker import decode_result, make_task, run_batch
 
 
 @dataclass(frozen=True)
@@ -177,7 +175,7 @@ def plan_campaign(
         errors = [f"{o.error_type}: {o.error_message}" for o in outcomes if not o.ok]
         for o in outcomes:
             if o.ok and o.result is not None:
-                unknown += [t for t in missing_columns(json.loads(zlib.decompress(o.result)), columns) if t not in unknown]
+                unknown += [t for t in missing_columns(decode_result(o.result), columns) if t not in unknown]
     return CampaignPlan(
         title=spec.title,
         source=spec.source,

@@ -7,7 +7,6 @@ that ``jointlock run`` re-runs exactly -- and the failed cases with their errors
 from __future__ import annotations
 
 import html
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -179,13 +178,14 @@ class CampaignReport:
         for metric in ([ran] if failed else []) + numeric[:MAX_FIGURES]:
             values = [r["status"] == "ok" for r in rows] if metric == ran else [r.get(metric) for r in rows]
             share = all(isinstance(v, bool) for v in values if v is not None)
-            grid = np.full((len(y_labels), len(x_labels)), np.nan)
-            sums = np.zeros_like(grid)
-            n = np.zeros_like(grid)
-            for xi, yi, v in zip(xs, ys, values):
-                if v is not None and math.isfinite(float(v)):
-                    sums[yi, xi] += float(v)
-                    n[yi, xi] += 1
+            v = np.array([np.nan if x is None else float(x) for x in values])
+            ok = np.isfinite(v)
+            cell = (np.asarray(ys)[ok], np.asarray(xs)[ok])
+            sums = np.zeros((len(y_labels), len(x_labels)))
+            n = np.zeros_like(sums)
+            np.add.at(sums, cell, v[ok])
+            np.add.at(n, cell, 1.0)
+            grid = np.full_like(sums, np.nan)
             np.divide(sums, n, out=grid, where=n > 0)
             fig = offscreen_figure((min(2.5 + 0.6 * len(x_labels), 12.0), min(2.0 + 0.45 * len(y_labels), 9.0)))
             plot_heatmap(

@@ -14,11 +14,9 @@ from __future__ import annotations
 
 import concurrent.futures as cf
 import dataclasses
-import json
 import math
 import shlex
 import time
-import zlib
 from collections import deque
 from collections.abc import Callable, Sequence
 from concurrent.futures.process import BrokenProcessPool
@@ -36,7 +34,7 @@ from ._guard import Stop, exclusive
 from ._ledger import LEDGER_NAME, Ledger, open_ledger
 from ._read import as_spec
 from ._spec import CONFIRM_CASES, CampaignSpec
-from ._worker import WORKER_LOST, CaseOutcome, make_task, run_batch
+from ._worker import WORKER_LOST, CaseOutcome, decode_result, make_task, run_batch
 
 #: Times a batch may be lost while alone in flight before it is split (a single case is then
 #: recorded as ``WorkerLost``, and runs again on resume).
@@ -344,12 +342,7 @@ class _Coordinator:
     def _pool_broke(self, broken: list[_Batch]) -> None:
         """A local pool breaks whole when one worker dies: batches that came back before are
         kept, every other one in flight is lost with it (charged only when it was alone)."""
-        for future, batch in list(self.in_flight.items()):
-            if future.done() and not future.cancelled() and future.exception() is None:
-                self.store(future.result())
-            else:
-                broken.append(batch)
-        self.in_flight.clear()
+        broken += [batch for _, batch in self._drain()]
         for batch in broken:
             self._lost(batch, alone=len(broken) == 1, reason="its worker process died")
         self.breaks += 1
@@ -363,6 +356,17 @@ class _Coordinator:
         if not self.engine.restart():
             raise CampaignError(f"the engine ({self.engine.description}) broke and cannot restart")
         self.counts["restarts"] += 1
+
+    def _drain(self) -> list[tuple[cf.Future, _Batch]]:
+        """Empty the in-flight set: store the batches that came back, return the others."""
+        rest = []
+        for future, batch in self.in_flight.items():
+            if future.done() and not future.cancelled() and future.exception() is None:
+                self.store(future.result())
+            else:
+                rest.append((future, batch))
+        self.in_flight.clear()
+        return rest
 
     def _lost(self, batch: _Batch, *, alone: bool, reason: str) -> None:
         self.counts["lost"] += 1
@@ -390,19 +394,15 @@ class _Coordinator:
         if self.unknown_columns is None:
             first = next((o for o in outcomes if o.ok and o.result is not None), None)
             if first is not None:
-                self.unknown_columns = tuple(missing_columns(json.loads(zlib.decompress(first.result)), self.columns))
+                self.unknown_columns = tuple(missing_columns(decode_result(first.result), self.columns))
         failed = self.counts["failed"]
         self.bar.update(len(outcomes), note=f"{failed} failed" if failed else "")
 
     def stop(self, own_engine: bool) -> None:
         """After SIGINT/SIGTERM: keep the batches that came back, drop the others (they run
         again on resume), stop the workers of an engine this run made."""
-        for future in list(self.in_flight):
-            if future.done() and not future.cancelled() and future.exception() is None:
-                self.store(future.result())
-            else:
-                future.cancel()
-        self.in_flight.clear()
+        for future, _ in self._drain():
+            future.cancel()
         if own_engine:
             self.engine.close(cancel=True)
 

@@ -12,6 +12,7 @@ matrices are 6x7; threads only contend), so a case gives the same numbers on eve
 from __future__ import annotations
 
 import dataclasses
+import json
 import os
 import signal
 import socket
@@ -105,6 +106,16 @@ class CaseOutcome:
     worker: str
 
 
+def encode_result(results: Mapping[str, Any]) -> bytes:
+    """``{job: to_dict()}`` as stored in outcomes and the ledger: zlib-compressed JSON."""
+    return zlib.compress(json_text(results).encode(), 6)
+
+
+def decode_result(blob: bytes) -> dict[str, Any]:
+    """The ``{job: to_dict()}`` of :func:`encode_result`'s bytes."""
+    return json.loads(zlib.decompress(blob))
+
+
 def make_task(spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str]) -> BatchTask:
     """The task of running ``cases`` of ``spec`` and recording ``columns``."""
     return BatchTask(
@@ -162,7 +173,7 @@ def _run_case(
             scenario = dataclasses.replace(scenario, data={**scenario.data, "seed": seed})
             run = run_scenario(scenario)
             results = {job: result.to_dict() for job, result in run.jobs.items()}
-            outcome = (record(results, columns), zlib.compress(json_text(results).encode(), 6), None, None)
+            outcome = (record(results, columns), encode_result(results), None, None)
         except Exception as exc:  # a case that raises is recorded, and the campaign goes on
             message = str(exc)
             if len(message) > MAX_MESSAGE:
