@@ -36,7 +36,7 @@ BAD = {
     "empty sweep": ('[grid]\n"failure.joint" = []\n', "grid.failure.joint is empty"),
     "range lo > hi": ('[sample]\nn = 4\nranges = { "halt.T" = [12.0, 8.0] }\n', "lo must be <= hi"),
     "wrong type": ('[grid]\n"failure.joint" = [1, "two"]\n', "grid.failure.joint[1] must be an integer"),
-    "out of range": ('[grid]\n"halt.T" = [10.0, -1.0]\n', "grid.halt.T[1] must be a finite number > 0"),
+    "out of range": ('[grid]\n"halt.T" = [10.0, -1.0]\n', "grid.halt.T[1] must be a finite number >= 0.001 and <= 1e+06 [s]"),
     "not a list": ('[grid]\n"failure.joint" = 3\n', "must be a list of the values to run"),
     "zip lengths": ('[zip]\n"failure.joint" = [1, 2]\n"halt.T" = [8.0]\n', "equal lengths"),
     "field twice": ('[grid]\n"halt.T" = [8.0]\n[zip]\n"halt.T" = [9.0]\n', "in one place"),

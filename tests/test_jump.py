@@ -369,7 +369,7 @@ def test_load_jump_task_unreadable_files(tmp_path):
         load_jump_task(tmp_path)
     bad = tmp_path / "latin1.toml"
     bad.write_bytes("kp = 1.5 # \xe9\n".encode("latin-1"))
-    with pytest.raises(jl.ScenarioError, match="is not UTF-8 text"):
+    with pytest.raises(jl.ScenarioError, match="not UTF-8 text"):
         load_jump_task(bad)
 
 

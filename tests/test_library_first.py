@@ -216,9 +216,8 @@ def test_kinematics_and_ik_jobs_are_their_commands(argv, call, capsys):
     assert to_plain(pickle.loads(pickle.dumps(report)).to_dict()) == to_plain(report.to_dict())
 
 
-@pytest.mark.filterwarnings("ignore::RuntimeWarning")  # the too-small voxel overflows first (issue 17)
 def test_a_job_error_with_its_own_arguments_keeps_the_scenario_context(tmp_path):
     path = tmp_path / "voxel.toml"
-    path.write_text('robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 10\n[workspace]\nvoxel = 1e-9\nsamples = 2000\n')
-    with pytest.raises(jl.ScenarioError, match=r"voxel\.toml: job \[workspace\]: voxel 1e-09 m is too small"):
+    path.write_text('robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 10\n[workspace]\nvoxel = 1e-5\nsamples = 2000\n')
+    with pytest.raises(jl.ScenarioError, match=r"voxel\.toml: job \[workspace\]: voxel 1e-05 m is too small"):
         jl.run_scenario(path)

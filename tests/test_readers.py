@@ -68,11 +68,11 @@ def test_toml_model_equals_the_builtin(tmp_path, rng):
         ('convention = "dh_standard"\n', r"at least one \[\[joint\]\]"),
         (
             'convention = "dh_standard"\n[[joint]]\nd_m = "long"\n',
-            "field 'd_m' must be a finite number; got 'long'",
+            "field 'd_m' must be a finite real number; got 'long'",
         ),
         (
             'convention = "dh_standard"\n[[joint]]\nmass_kg = -3\n',
-            "joint 1: .*mass must be a finite number >= 0",
+            r"joint 1: .*mass must be a number in \[0, 1e\+09\] kg",
         ),
         (
             'convention = "dh_standard"\n[[joint]]\nlower_deg = 10\nupper_deg = -10\n',
@@ -82,7 +82,7 @@ def test_toml_model_equals_the_builtin(tmp_path, rng):
             'convention = "dh_standard"\n[[joint]]\n[base]\nmass_kg = 0\n',
             "must be > 0 for a free-floating base",
         ),
-        ("convention = \n", "malformed TOML"),
+        ("convention = \n", "not valid TOML"),
     ],
 )
 def test_toml_errors_name_file_and_field(tmp_path, content, message):
@@ -93,7 +93,7 @@ def test_toml_errors_name_file_and_field(tmp_path, content, message):
 
 
 def test_missing_model_file():
-    with pytest.raises(jl.ModelError, match="cannot read model file"):
+    with pytest.raises(jl.ModelError, match="model file .* does not exist"):
         jl.read_model_toml("/nonexistent/arm.toml")
 
 

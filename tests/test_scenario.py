@@ -312,8 +312,8 @@ def test_limit_names_in_errors_and_hints(tmp_path, fresh_warnings):
             "[limits]\nvmax_dg = 1\n",
             ["[limits]", "'vmax_dg'", "did you mean 'vmax_deg_s'", "allowed: vmax_deg_s, amax_deg_s2, eps_m"],
         ),
-        ("[limits]\namax_deg_s2 = -1\n", ["limits.amax_deg_s2 must be a finite number > 0 [deg/s^2]"]),
-        ("[limits]\nvmax_deg = -1\n", ["limits.vmax_deg must be a finite number > 0 [deg/s]"]),
+        ("[limits]\namax_deg_s2 = -1\n", ["limits.amax_deg_s2 must be a finite number > 0 and <= 1e+06 [deg/s^2]"]),
+        ("[limits]\nvmax_deg = -1\n", ["limits.vmax_deg must be a finite number > 0 and <= 1e+06 [deg/s]"]),
         ("[jump]\nvmax_deg = 1\n", ["[jump] unknown field 'vmax_deg'", "did you mean 'vmax_deg_s'"]),
     ]
     for i, (table, words) in enumerate(cases):

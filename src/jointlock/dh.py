@@ -24,6 +24,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .bounds import shown
 from .errors import ModelError
 from .model import ArmModel, Body, Joint
 from .spatial import rot_x, rot_z, translation
@@ -37,7 +38,7 @@ def _column(values: ArrayLike | None, n: int, name: str, default: float = 0.0) -
     arr = np.asarray(values, dtype=float)
     if arr.shape != (n,) or not np.all(np.isfinite(arr)):
         raise ModelError(
-            f"DH column {name} must hold {n} finite numbers; got {np.asarray(values).tolist()!r}"
+            f"DH column {name} must hold {n} finite numbers; got {shown(np.asarray(values).tolist())}"
         )
     return arr
 
@@ -83,7 +84,7 @@ def from_dh(
         Provenance and readings, kept with the model.
     """
     if convention not in ("standard", "modified"):
-        raise ModelError(f"convention must be 'standard' or 'modified'; got {convention!r}")
+        raise ModelError(f"convention must be 'standard' or 'modified'; got {shown(convention)}")
     a_arr = np.asarray(a, dtype=float)
     n = a_arr.size
     if n == 0:
@@ -98,7 +99,7 @@ def from_dh(
     if vmax.shape != (n,) or not np.all(vmax > 0):
         raise ModelError(
             f"velocity_limit must hold {n} numbers > 0 [rad/s] (inf for unlimited); "
-            f"got {np.asarray(velocity_limit).tolist()!r}"
+            f"got {shown(np.asarray(velocity_limit).tolist())}"
         )
     if bodies is None:
         bodies = [Body(0.0, name=f"link{i + 1}") for i in range(n)]

@@ -17,7 +17,7 @@ from numpy.typing import ArrayLike
 
 from ._chain import SYM, composite, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
-from .errors import ModelError
+from .errors import ConfigurationError, ModelError
 from .kinematics import ChainState, _world_inertias, com_jacobians, com_positions, state_at
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import skew
@@ -335,7 +335,12 @@ def rnea(
     q = as_joint_array(model, q, "q")
     dq = as_joint_array(model, dq, "dq")
     ddq = as_joint_array(model, ddq, "ddq")
-    shape = np.broadcast_shapes(q.shape, dq.shape, ddq.shape)
+    try:
+        shape = np.broadcast_shapes(q.shape, dq.shape, ddq.shape)
+    except ValueError:
+        raise ConfigurationError(
+            f"q, dq and ddq must have broadcastable batch shapes; got {q.shape}, {dq.shape} and {ddq.shape}"
+        ) from None
     batch = shape[:-1]
     if base not in ("fixed", "floating"):
         raise ModelError(f"base must be 'fixed' or 'floating'; got {base!r}")

@@ -20,6 +20,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from .bounds import as_real
 from .errors import ModelError
 from .model import ArmModel, LockedJoint
 from .spatial import axis_angle_rotation, pose
@@ -51,9 +52,7 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
     if isinstance(joint, bool) or not isinstance(joint, (int, np.integer)):
         raise ModelError(f"joint must be an integer joint number (1-based); got {joint!r}")
     index = model.index_of(int(joint))
-    angle = float(angle)
-    if not math.isfinite(angle):
-        raise ModelError(f"lock angle of joint {joint} must be finite [rad]; got {angle}")
+    angle = as_real(angle, f"lock angle of joint {joint}", unit="rad", error=ModelError)
     jnt = model.joints[index]
     if check_limits and not (jnt.lower - LOCK_LIMIT_SLACK <= angle <= jnt.upper + LOCK_LIMIT_SLACK):
         raise ModelError(

@@ -26,6 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .bounds import MAX_INERTIA_KGM2, MAX_JOINT_VALUE, MAX_LENGTH_M, MAX_MASS_KG, shown
 from .errors import ConfigurationError, ModelError
 
 FloatArray = NDArray[np.float64]
@@ -46,7 +47,9 @@ def _readonly(array: ArrayLike) -> FloatArray:
 def _vector3(value: ArrayLike, name: str) -> FloatArray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
-        raise ModelError(f"{name} must be 3 finite numbers [m]; got {np.asarray(value).tolist()!r}")
+        raise ModelError(f"{name} must be 3 finite numbers [m]; got {shown(np.asarray(value).tolist())}")
+    if np.any(np.abs(arr) > MAX_LENGTH_M):
+        raise ModelError(f"{name} must lie within +-{MAX_LENGTH_M:g} m; got {shown(arr.tolist())}")
     return arr
 
 
@@ -54,6 +57,10 @@ def _transform(value: ArrayLike, name: str) -> FloatArray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
         raise ModelError(f"{name} must be a finite 4x4 homogeneous transform; got shape {arr.shape}")
+    if np.any(np.abs(arr[:3, 3]) > MAX_LENGTH_M):
+        raise ModelError(
+            f"{name}: the translation must lie within +-{MAX_LENGTH_M:g} m; got {shown(arr[:3, 3].tolist())}"
+        )
     rot = arr[:3, :3]
     if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-9) or np.linalg.det(rot) < 0:
         raise ModelError(f"{name}: the upper-left 3x3 block is not a rotation matrix")
@@ -99,14 +106,17 @@ class Body:
     name: str = ""
 
     def __post_init__(self) -> None:
-        label = f"body {self.name!r}" if self.name else "body"
+        label = f"body {shown(self.name)}" if self.name else "body"
         mass = float(self.mass)
-        if not math.isfinite(mass) or mass < 0:
-            raise ModelError(f"{label}: mass must be a finite number >= 0 [kg]; got {self.mass!r}")
+        if not math.isfinite(mass) or not 0 <= mass <= MAX_MASS_KG:
+            raise ModelError(f"{label}: mass must be a number in [0, {MAX_MASS_KG:g}] kg; got {shown(self.mass)}")
         com = _vector3(self.com, f"{label}: com")
         inertia = inertia_matrix(self.inertia, f"{label}: inertia")
-        if not np.all(np.isfinite(inertia)):
-            raise ModelError(f"{label}: inertia must be finite; got {inertia.tolist()}")
+        if not np.all(np.isfinite(inertia)) or np.any(np.abs(inertia) > MAX_INERTIA_KGM2):
+            raise ModelError(
+                f"{label}: inertia must be finite, each entry within +-{MAX_INERTIA_KGM2:g} kg m^2; "
+                f"got {shown(inertia.tolist())}"
+            )
         scale = max(float(np.max(np.abs(inertia))), 1e-300)
         if not np.allclose(inertia, inertia.T, rtol=0, atol=INERTIA_SYMMETRY_RTOL * scale):
             raise ModelError(f"{label}: inertia must be symmetric; got {inertia.tolist()}")
@@ -184,8 +194,10 @@ class Joint:
         label = self.name or f"joint {self.number}"
         placement = _transform(self.placement, f"{label}: placement")
         axis = np.asarray(self.axis, dtype=float)
-        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-12:
-            raise ModelError(f"{label}: axis must be a non-zero 3-vector; got {axis.tolist()}")
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.max(np.abs(axis)) < 1e-12:
+            raise ModelError(f"{label}: axis must be a non-zero 3-vector; got {shown(axis.tolist())}")
+        if not 1e-100 < np.max(np.abs(axis)) < 1e100:  # a direction: rescaled, so that its norm cannot overflow
+            axis = axis / np.max(np.abs(axis))
         lower, upper = float(self.lower), float(self.upper)
         if math.isnan(lower) or math.isnan(upper) or lower > upper:
             raise ModelError(f"{label}: limits must satisfy lower <= upper [rad]; got [{lower}, {upper}]")
@@ -247,20 +259,20 @@ class ArmModel:
         bodies = tuple(self.bodies)
         if len(joints) != len(bodies):
             raise ModelError(
-                f"model {self.name!r}: {len(joints)} joints but {len(bodies)} bodies; "
+                f"model {shown(self.name)}: {len(joints)} joints but {len(bodies)} bodies; "
                 "each joint carries exactly one body"
             )
         numbers = [j.number for j in joints]
         if len(set(numbers)) != len(numbers):
-            raise ModelError(f"model {self.name!r}: joint numbers must be unique; got {numbers}")
+            raise ModelError(f"model {shown(self.name)}: joint numbers must be unique; got {numbers}")
         if self.floating and self.root_body.mass <= 0:
             raise ModelError(
-                f"model {self.name!r}: a free-floating base needs a spacecraft body with mass > 0 "
+                f"model {shown(self.name)}: a free-floating base needs a spacecraft body with mass > 0 "
                 f"[kg]; got {self.root_body.mass}"
             )
         object.__setattr__(self, "joints", joints)
         object.__setattr__(self, "bodies", bodies)
-        object.__setattr__(self, "tool", _readonly(_transform(self.tool, f"model {self.name!r}: tool")))
+        object.__setattr__(self, "tool", _readonly(_transform(self.tool, f"model {shown(self.name)}: tool")))
         object.__setattr__(self, "locked", tuple(self.locked))
 
     # -- sizes and limits -------------------------------------------------------------
@@ -308,7 +320,7 @@ class ArmModel:
         extra = f" (joint {number} is locked)" if number in locked else ""
         raise ModelError(
             f"joint must be one of the movable joints {list(self.joint_numbers)} of model "
-            f"{self.name!r}; got {number!r}{extra}"
+            f"{shown(self.name)}; got {shown(number)}{extra}"
         )
 
     # -- variants ---------------------------------------------------------------------
@@ -370,7 +382,8 @@ class ArmModel:
 
 
 def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray:
-    """Validate a joint-space array: float, shape (..., model.dof), all finite.
+    """Validate a joint-space array: real numbers (not bool or complex), shape
+    (..., model.dof), all finite and within +-:data:`~jointlock.bounds.MAX_JOINT_VALUE`.
 
     Raises
     ------
@@ -380,18 +393,33 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
     """
     from .errors import ConfigurationError
 
-    try:
-        arr = np.asarray(q, dtype=float)
-    except (TypeError, ValueError) as exc:
-        raise ConfigurationError(f"{name} must be numeric with shape (..., {model.dof}); {exc}") from None
+    raw = np.asarray(q)
+    if raw.dtype.kind not in "iuf":  # bool, complex, text, objects: no silent conversion
+        if raw.dtype.kind == "O":
+            try:
+                raw = np.asarray(q, dtype=float)
+            except (TypeError, ValueError, OverflowError):
+                pass
+        if raw.dtype.kind not in "iuf":
+            raise ConfigurationError(
+                f"{name} must be an array of real numbers with shape (..., {model.dof}); got dtype "
+                f"{raw.dtype} ({shown(q)})"
+            )
+    arr = np.asarray(raw, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != model.dof:
         raise ConfigurationError(
-            f"{name} must have shape (..., {model.dof}) for model {model.name!r} "
+            f"{name} must have shape (..., {model.dof}) for model {shown(model.name)} "
             f"(movable joints {list(model.joint_numbers)}); got shape {arr.shape}"
         )
     if not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
-        raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad} [rad]")
+        raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad}")
+    if arr.size and float(np.max(np.abs(arr))) > MAX_JOINT_VALUE:
+        bad = tuple(int(i) for i in np.argwhere(np.abs(arr) > MAX_JOINT_VALUE)[0])
+        raise ConfigurationError(
+            f"{name} must lie within +-{MAX_JOINT_VALUE:g} (rad, rad/s or rad/s^2: far beyond any arm); "
+            f"got {arr[bad]:g} at index {bad}"
+        )
     return arr
 
 

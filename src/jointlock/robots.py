@@ -15,8 +15,10 @@ from typing import Literal
 
 import numpy as np
 
+from .bounds import shown
 from .dh import from_dh
 from .errors import ModelError
+from .io.files import check_path_text
 from .model import ArmModel, Body, Joint
 from .spatial import rot_x, translation
 
@@ -299,6 +301,7 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         return _builtin(text, base)
     suffix = Path(text).suffix.lower()
     if suffix in (".urdf", ".toml"):
+        check_path_text(text, "model file", ModelError)
         try:
             stat = Path(text).stat()
         except OSError:  # the reader names the file and the reason
@@ -307,5 +310,5 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ModelError(
-        f"robot must be a built-in name ({', '.join(factories)}) or a .urdf/.toml file; got {text!r}{hint}"
+        f"robot must be a built-in name ({', '.join(factories)}) or a .urdf/.toml file; got {shown(text)}{hint}"
     )

@@ -21,6 +21,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._random import resolve_rng
+from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M, as_real
 from ..errors import ConfigurationError
 from ..kinematics import DEFAULT_CHUNK, ee_positions
 from ..locking import lock
@@ -252,6 +253,8 @@ def compare_workspaces(
         ``seed`` (:mod:`jointlock._random`); the full arm's samples come first, then the
         locked arm's.
     """
+    if voxel is not None:
+        voxel = as_real(voxel, "voxel", lo=MIN_LENGTH_M, hi=MAX_LENGTH_M, unit="m", error=ConfigurationError)
     gen, seed = resolve_rng(rng)
     locked_model = lock(model, joint, angle)
     full = ee_positions(model, sample_configurations(model, samples, gen))

@@ -16,7 +16,7 @@ from ..errors import CampaignError, ScenarioError
 from ..io.files import read_toml_file
 from ..scenario import DEPRECATED_FIELDS, JOB_ORDER
 from ..scenario._fields import _hint
-from ..scenario._read import _check
+from ..scenario._read import check_value as _check
 from ._spec import (
     _REPORT_KEYS,
     _SAMPLE_KEYS,

@@ -8,11 +8,13 @@ files never touches the user's plotting backend.
 
 from __future__ import annotations
 
+import codecs
 import errno
 import io
 import json
 import math
 import os
+import sys
 import tempfile
 from collections.abc import Mapping
 from pathlib import Path
@@ -48,22 +50,97 @@ def json_text(obj: Any) -> str:
     return json.dumps(to_plain(obj), indent=2, allow_nan=False) + "\n"
 
 
+#: Byte-order marks of the Unicode encodings a text file may use besides UTF-8 (UTF-32's
+#: first: its little-endian mark starts with UTF-16's).
+_BOMS = (
+    (codecs.BOM_UTF8, "utf-8-sig"),
+    (codecs.BOM_UTF32_LE, "utf-32"),
+    (codecs.BOM_UTF32_BE, "utf-32"),
+    (codecs.BOM_UTF16_LE, "utf-16"),
+    (codecs.BOM_UTF16_BE, "utf-16"),
+)
+
+
+def decode_text(data: bytes, label: str, error: type[Exception]) -> str:
+    """The text of a file's bytes: UTF-8, or UTF-8/16/32 with a byte-order mark.  Anything
+    else (a binary file, Latin-1, UTF-16 without a mark) raises ``error`` with one line
+    naming ``label``, the first offending byte and its line."""
+    for bom, encoding in _BOMS:
+        if data.startswith(bom):
+            try:
+                return data.decode(encoding)
+            except UnicodeDecodeError:
+                raise error(f"{label}: not valid {encoding.removesuffix('-sig').upper()} text after its "
+                            "byte-order mark; save it as UTF-8") from None
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = data[: exc.start].count(b"\n") + 1
+        if b"\x00" in data[:4096]:
+            raise error(f"{label}: a binary file, not text (NUL byte on line {line}); give a UTF-8 text file") from None
+        raise error(
+            f"{label}: not UTF-8 text (byte 0x{data[exc.start]:02x} on line {line}; Latin-1?); save it as UTF-8"
+        ) from None
+
+
+def check_path_text(path: str | Path, what: str, error: type[Exception]) -> Path:
+    """``path`` as a Path, refusing what no file system accepts (an embedded NUL character)."""
+    if "\x00" in str(path):
+        raise error(f"{what} {shorten(str(path))!r}: a path cannot contain a NUL character")
+    return Path(path)
+
+
+def shorten(text: str, limit: int = 80) -> str:
+    """``text`` cut to ``limit`` characters (with "...")."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
+
+
+def read_text_file(path: str | Path, what: str, error: type[Exception]) -> str:
+    """The text of ``path`` (see :func:`decode_text`); a missing or unreadable file raises
+    ``error`` with one line naming ``what`` (e.g. "model file") and the path."""
+    path = check_path_text(path, what, error)
+    shown = repr(shorten(str(path)))
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        raise error(f"{what} {shown} does not exist") from None
+    except OSError as exc:  # a folder, no permission, ...
+        raise error(f"cannot read {what} {shown}: {exc.strerror or type(exc).__name__}") from None
+    return decode_text(data, f"{what} {shown}", error)
+
+
 def read_toml_file(path: str | Path, what: str, error: type[Exception]) -> dict[str, Any]:
-    """The TOML data of ``path``; a missing, unreadable or invalid file raises ``error`` with
-    one line naming ``what`` (e.g. "scenario file") and the path."""
+    """The TOML data of ``path``; a missing, unreadable or invalid file (not UTF-8, not TOML,
+    an integer too large for a float) raises ``error`` with one line naming ``what`` (e.g.
+    "scenario file") and the path."""
     import tomllib
 
-    path = Path(path)
+    text = read_text_file(path, what, error)
     try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise error(f"{what} {str(path)!r} does not exist") from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise error(f"cannot read {what} {str(path)!r}: {exc}") from None
-    try:
-        return tomllib.loads(text)
+        data = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise error(f"{path}: not valid TOML: {exc}") from None
+        raise error(f"{shorten(str(path))}: not valid TOML: {exc}") from None
+    check_toml_numbers(data, shorten(str(path)), error)
+    return data
+
+
+def check_toml_numbers(data: Any, label: str, error: type[Exception], where: str = "") -> None:
+    """Refuse an integer that no float holds (TOML integers have no size limit; every number
+    of jointlock's files ends up a float): ``error`` naming the key."""
+    if isinstance(data, dict):
+        for key, value in data.items():
+            check_toml_numbers(value, label, error, f"{where}.{key}" if where else str(key))
+    elif isinstance(data, list):
+        for i, value in enumerate(data):
+            check_toml_numbers(value, label, error, f"{where} #{i + 1}")
+    elif isinstance(data, int) and not isinstance(data, bool) and abs(data) > _FLOAT_MAX_INT:
+        raise error(
+            f"{label}: {where or 'value'} is an integer of {len(str(abs(data)))} digits, too large for a "
+            "number (at most ~1.8e308; the physical bounds of each field are far smaller)"
+        )
+
+
+_FLOAT_MAX_INT = int(sys.float_info.max)
 
 
 def toml_value(value: Any) -> str:
@@ -110,8 +187,17 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
 
     A symbolic link is written through (the file it points to is replaced, the link kept); a
     path under ``/dev`` or ``/proc`` (``/dev/stdout``) or that is not a regular file (a pipe)
-    is written directly; a folder is refused (:class:`IsADirectoryError` naming it)."""
-    given = Path(path)
+    is written directly; a folder is refused (:class:`IsADirectoryError` naming it).  Every
+    :class:`OSError` names the path (a full disk says which file it could not write)."""
+    try:
+        _atomic_write(Path(path), data)
+    except OSError as exc:
+        if exc.filename is None:
+            raise type(exc)(exc.errno, exc.strerror or str(exc), str(path)) from None
+        raise
+
+
+def _atomic_write(given: Path, data: bytes) -> None:
     if str(given).startswith(("/dev/", "/proc/")):  # a device, a pipe, a redirected stdout
         with open(given, "ab") as fh:  # appending: a redirected stdout keeps what came before
             fh.write(data)

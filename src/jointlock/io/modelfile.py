@@ -32,16 +32,17 @@ from __future__ import annotations
 
 import difflib
 import math
-import tomllib
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..bounds import as_real, shown
 from ..dh import from_dh
 from ..errors import ModelError
 from ..model import ArmModel, Body
 from ..spatial import pose, rpy_matrix
+from .files import read_toml_file, shorten
 
 _TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base"}
 _JOINT_KEYS = {
@@ -66,29 +67,26 @@ def _check_keys(table: dict[str, Any], allowed: set[str], where: str) -> None:
     for key in table:
         if key not in allowed:
             close = difflib.get_close_matches(key, sorted(allowed), n=1)
-            hint = f" (did you mean {close[0]!r}?)" if close else ""
-            raise ModelError(f"{where}: unknown field {key!r}{hint}; allowed: {', '.join(sorted(allowed))}")
+            hint = f" (did you mean {shown(close[0])}?)" if close else ""
+            raise ModelError(f"{where}: unknown field {shown(key)}{hint}; allowed: {', '.join(sorted(allowed))}")
 
 
 def _num(table: dict[str, Any], key: str, where: str, default: float | None = None) -> float:
     if key not in table:
         if default is None:
-            raise ModelError(f"{where}: missing field {key!r}")
+            raise ModelError(f"{where}: missing field {shown(key)}")
         return default
-    value = table[key]
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-        raise ModelError(f"{where}: field {key!r} must be a finite number; got {value!r}")
-    return float(value)
+    return as_real(table[key], f"{where}: field {shown(key)}", error=ModelError)
 
 
 def _array(table: dict[str, Any], key: str, where: str, default: Any) -> np.ndarray:
     value = table.get(key, default)
     try:
         arr = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ModelError(f"{where}: field {key!r} must be numbers; got {value!r}") from None
+    except (TypeError, ValueError, OverflowError):
+        raise ModelError(f"{where}: field {shown(key)} must be finite numbers; got {shown(value)}") from None
     if not np.all(np.isfinite(arr)):
-        raise ModelError(f"{where}: field {key!r} must be finite; got {value!r}")
+        raise ModelError(f"{where}: field {shown(key)} must be finite; got {shown(value)}")
     return arr
 
 
@@ -108,9 +106,9 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
     """Build a model from the parsed TOML structure (see the module docstring)."""
     _check_keys(data, _TOP_KEYS, where)
     convention = data.get("convention")
-    if convention not in _CONVENTIONS:
+    if not isinstance(convention, str) or convention not in _CONVENTIONS:
         raise ModelError(
-            f"{where}: field 'convention' must be one of {sorted(_CONVENTIONS)}; got {convention!r}"
+            f"{where}: field 'convention' must be one of {sorted(_CONVENTIONS)}; got {shown(convention)}"
         )
     rows = data.get("joint")
     if not isinstance(rows, list) or not rows:
@@ -161,7 +159,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
             )
     name = data.get("name", "toml-arm")
     if not isinstance(name, str):
-        raise ModelError(f"{where}: field 'name' must be a string; got {name!r}")
+        raise ModelError(f"{where}: field 'name' must be a string; got {shown(name)}")
     return from_dh(
         name,
         a=cols["a"],
@@ -181,12 +179,5 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
 
 def read_model_toml(path: str | Path) -> ArmModel:
     """Read a TOML model file (format in the module docstring)."""
-    path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except OSError as exc:
-        raise ModelError(f"cannot read model file {str(path)!r}: {exc.strerror}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ModelError(f"{path}: malformed TOML: {exc}") from None
-    return model_from_dict(data, str(path))
+    data = read_toml_file(path, "model file", ModelError)
+    return model_from_dict(data, shorten(str(path)))

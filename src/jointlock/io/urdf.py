@@ -10,6 +10,7 @@ naming the joint.
 from __future__ import annotations
 
 import math
+import re
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass
 from pathlib import Path
@@ -17,9 +18,11 @@ from typing import Literal
 
 import numpy as np
 
+from ..bounds import MAX_JOINT_VALUE, MAX_LENGTH_M, shown
 from ..errors import ModelError
 from ..model import ArmModel, Body, Joint
 from ..spatial import pose, rpy_matrix
+from .files import check_path_text, decode_text, shorten
 
 
 @dataclass
@@ -41,10 +44,26 @@ def _floats(text: str | None, count: int, where: str, default: list[float]) -> n
     try:
         values = [float(v) for v in text.split()]
     except ValueError:
-        raise ModelError(f"{where}: expected {count} numbers; got {text!r}") from None
+        raise ModelError(f"{where}: expected {count} numbers; got {shown(text)}") from None
     if len(values) != count or not all(math.isfinite(v) for v in values):
-        raise ModelError(f"{where}: expected {count} finite numbers; got {text!r}")
+        raise ModelError(f"{where}: expected {count} finite numbers; got {shown(text)}")
     return np.array(values)
+
+
+#: An XML declaration naming its encoding (``<?xml version="1.0" encoding="ISO-8859-1"?>``).
+_DECLARED_ENCODING = re.compile(rb"^\s*<\?xml[^>]*encoding\s*=", re.IGNORECASE)
+
+
+def _urdf_text(path: Path, label: str) -> str | bytes:
+    """The file's XML: its bytes when its declaration names an encoding (the XML parser
+    decodes them), else its text read as UTF-8 (see :func:`decode_text`)."""
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise ModelError(f"cannot read URDF file {shown(label)}: {exc.strerror or type(exc).__name__}") from None
+    if _DECLARED_ENCODING.match(data):
+        return data
+    return decode_text(data, f"URDF file {shown(label)}", ModelError)
 
 
 def _origin(elem: ET.Element | None, where: str) -> np.ndarray:
@@ -52,6 +71,10 @@ def _origin(elem: ET.Element | None, where: str) -> np.ndarray:
         return np.eye(4)
     xyz = _floats(elem.get("xyz"), 3, f"{where} <origin xyz>", [0, 0, 0])
     rpy = _floats(elem.get("rpy"), 3, f"{where} <origin rpy>", [0, 0, 0])
+    if np.any(np.abs(xyz) > MAX_LENGTH_M):
+        raise ModelError(f"{where} <origin xyz>: each coordinate must lie within +-{MAX_LENGTH_M:g} m; got {shown(elem.get('xyz'))}")
+    if np.any(np.abs(rpy) > MAX_JOINT_VALUE):
+        raise ModelError(f"{where} <origin rpy>: each angle must lie within +-{MAX_JOINT_VALUE:g} rad; got {shown(elem.get('rpy'))}")
     return pose(rpy_matrix(rpy), xyz)
 
 
@@ -59,20 +82,20 @@ def _number(elem: ET.Element, attr: str, where: str, default: float | None = Non
     text = elem.get(attr)
     if text is None:
         if default is None:
-            raise ModelError(f"{where}: missing attribute {attr!r}")
+            raise ModelError(f"{where}: missing attribute {shown(attr)}")
         return default
     try:
         value = float(text)
     except ValueError:
-        raise ModelError(f"{where}: attribute {attr!r} must be a number; got {text!r}") from None
+        raise ModelError(f"{where}: attribute {shown(attr)} must be a number; got {shown(text)}") from None
     if math.isnan(value):
-        raise ModelError(f"{where}: attribute {attr!r} must be a number; got {text!r}")
+        raise ModelError(f"{where}: attribute {shown(attr)} must be a number; got {shown(text)}")
     return value
 
 
-def _inertial(link: ET.Element) -> Body:
+def _inertial(link: ET.Element, label: str) -> Body:
     name = link.get("name", "?")
-    where = f"link {name!r} <inertial>"
+    where = f"{label}: link {shorten(name, 40)!r} <inertial>"
     inertial = link.find("inertial")
     if inertial is None:
         return Body(0.0, name=name)
@@ -124,23 +147,20 @@ def read_urdf(
     name
         Model name; default: the ``<robot name>``.
     """
-    text = str(source)
+    text: str | bytes = str(source)
     label = "URDF"
-    if not text.lstrip().startswith("<"):
-        path = Path(text)
-        label = str(path)
-        try:
-            text = path.read_text()
-        except OSError as exc:
-            raise ModelError(f"cannot read URDF file {label!r}: {exc.strerror}") from None
+    if not str(text).lstrip().startswith("<"):
+        path = check_path_text(text, "URDF file", ModelError)
+        label = shorten(str(path))
+        text = _urdf_text(path, label)
     try:
         root = ET.fromstring(text)
-    except ET.ParseError as exc:
+    except (ET.ParseError, LookupError, ValueError) as exc:  # LookupError: an unknown declared encoding
         raise ModelError(f"{label}: malformed XML: {exc}") from None
     if root.tag != "robot":
         raise ModelError(f"{label}: the root element must be <robot>; got <{root.tag}>")
     if base not in ("fixed", "floating"):
-        raise ModelError(f"base must be 'fixed' or 'floating'; got {base!r}")
+        raise ModelError(f"base must be 'fixed' or 'floating'; got {shown(base)}")
 
     links: dict[str, ET.Element] = {}
     for link in root.findall("link"):
@@ -148,26 +168,26 @@ def read_urdf(
         if not lname:
             raise ModelError(f"{label}: a <link> has no name")
         if lname in links:
-            raise ModelError(f"{label}: link {lname!r} is defined twice")
+            raise ModelError(f"{label}: link {shown(lname)} is defined twice")
         links[lname] = link
     joints: list[_UrdfJoint] = []
     for jel in root.findall("joint"):
         jname = jel.get("name") or "?"
-        where = f"{label}: joint {jname!r}"
+        where = f"{label}: joint {shown(jname)}"
         kind = jel.get("type")
         if kind in ("prismatic", "planar", "floating"):
             raise ModelError(
-                f"{where}: type {kind!r} is not supported (allowed: revolute, continuous, fixed)"
+                f"{where}: type {shown(kind)} is not supported (allowed: revolute, continuous, fixed)"
             )
         if kind not in ("revolute", "continuous", "fixed"):
-            raise ModelError(f"{where}: unknown type {kind!r} (allowed: revolute, continuous, fixed)")
+            raise ModelError(f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, fixed)")
         parent_el, child_el = jel.find("parent"), jel.find("child")
         if parent_el is None or child_el is None or not parent_el.get("link") or not child_el.get("link"):
             raise ModelError(f"{where}: needs <parent link=...> and <child link=...>")
         parent, child = parent_el.get("link"), child_el.get("link")
         for role, lname in (("parent", parent), ("child", child)):
             if lname not in links:
-                raise ModelError(f"{where}: {role} link {lname!r} is not defined")
+                raise ModelError(f"{where}: {role} link {shown(lname)} is not defined")
         axis = _floats(
             jel.find("axis").get("xyz") if jel.find("axis") is not None else None,
             3,
@@ -185,7 +205,7 @@ def read_urdf(
             velocity = _number(limit, "velocity", f"{where} <limit>")
             if velocity <= 0:
                 velocity = math.inf
-        if kind != "fixed" and np.linalg.norm(axis) < 1e-12:
+        if kind != "fixed" and np.max(np.abs(axis)) < 1e-12:  # (a norm would overflow at 1e154)
             raise ModelError(f"{where}: <axis xyz> must be non-zero")
         joints.append(
             _UrdfJoint(
@@ -197,12 +217,14 @@ def read_urdf(
     parent_of: dict[str, str] = {}
     for j in joints:
         if j.child in parent_of:
-            raise ModelError(f"{label}: link {j.child!r} has two parent joints")
+            raise ModelError(f"{label}: link {shown(j.child)} has two parent joints")
         parent_of[j.child] = j.name
         children[j.parent].append(j)
     roots = [k for k in links if k not in parent_of]
     if len(roots) != 1:
-        raise ModelError(f"{label}: expected exactly one root link; found {roots}")
+        names = ", ".join(repr(shorten(r, 40)) for r in roots[:5]) + (", ..." if len(roots) > 5 else "")
+        why = " (every link has a parent: the joints form a cycle)" if not roots else ""
+        raise ModelError(f"{label}: expected exactly one root link; found {len(roots)}: [{names}]{why}")
     root_link = roots[0]
 
     # Walk the tree: every link belongs to an owner body (root = -1 or a movable joint index).
@@ -221,20 +243,27 @@ def read_urdf(
                 owner[j.child] = len(movable) - 1
                 in_owner[j.child] = np.eye(4)
             stack.append(j.child)
+    unreached = [k for k in links if k not in owner]
+    if unreached:  # beside the tree from the root: links whose joints form a closed loop
+        names = ", ".join(repr(shorten(k, 40)) for k in unreached[:5]) + (", ..." if len(unreached) > 5 else "")
+        raise ModelError(
+            f"{label}: links {names} are not connected to the root link {shown(root_link)} (their joints "
+            "form a closed loop); a model is one tree from its root"
+        )
     if not movable:
         raise ModelError(f"{label}: no revolute or continuous joint found")
     for i, (j, _, parent_owner) in enumerate(movable):
         if parent_owner != i - 1:
-            prev = movable[parent_owner][0].name if parent_owner >= 0 else f"root link {root_link!r}"
+            prev = movable[parent_owner][0].name if parent_owner >= 0 else f"root link {shown(root_link)}"
             raise ModelError(
-                f"{label}: joint {j.name!r} branches from {prev}; only serial chains of movable "
+                f"{label}: joint {shown(j.name)} branches from {prev}; only serial chains of movable "
                 "joints are supported"
             )
 
     bodies = [Body(0.0, name=movable[i][0].child) for i in range(len(movable))]
     root_body = Body(0.0, name=root_link)
     for lname, link in links.items():
-        body = _inertial(link)
+        body = _inertial(link, label)
         if body.mass == 0 and not np.any(body.inertia):
             continue
         o = owner[lname]
@@ -249,10 +278,10 @@ def read_urdf(
         while len(children[ee_link]) == 1 and children[ee_link][0].kind == "fixed":
             ee_link = children[ee_link][0].child
     elif ee_link not in links:
-        raise ModelError(f"{label}: ee_link {ee_link!r} is not a link of the robot")
+        raise ModelError(f"{label}: ee_link {shown(ee_link)} is not a link of the robot")
     elif owner[ee_link] != last:
         raise ModelError(
-            f"{label}: ee_link {ee_link!r} must be rigidly attached to the last movable joint "
+            f"{label}: ee_link {shown(ee_link)} must be rigidly attached to the last movable joint "
             f"{movable[-1][0].name!r}"
         )
     tool = in_owner[ee_link]
@@ -264,7 +293,7 @@ def read_urdf(
     if base == "floating" and root_body.mass <= 0:
         raise ModelError(
             f"{label}: base='floating' needs an <inertial> with positive mass on the root link "
-            f"{root_link!r} (the spacecraft)"
+            f"{shown(root_link)} (the spacecraft)"
         )
     return ArmModel(
         name=name or root.get("name") or "urdf-arm",

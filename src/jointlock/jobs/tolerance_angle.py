@@ -37,9 +37,12 @@ LOCKED_FIGSIZE = (6.0, 4.0)
 
 def gamma_sample_count(gamma_limit_deg: float, step_deg: float) -> int:
     """Number of gamma samples of a sweep over ``[-gamma_limit_deg, gamma_limit_deg]`` in steps
-    of about ``step_deg`` [deg] (both ends included)."""
+    of about ``step_deg`` [deg] (both ends included); a step so small that the count overflows
+    counts as 10**15 (far above any allowed sweep)."""
     limit, step = math.radians(gamma_limit_deg), math.radians(step_deg)
-    return int(round(2 * limit / step)) + 1
+    with np.errstate(over="ignore", divide="ignore"):
+        ratio = float(np.float64(2 * limit) / np.float64(step)) if step > 0 else math.inf
+    return int(round(ratio)) + 1 if ratio < 1e15 else 10**15
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead

@@ -77,9 +77,9 @@ from ._fields import _pos as _pos
 from ._fields import _spellings as _spellings
 from ._jump import JUMP_SCENARIO_FIELDS, jump_fields
 from ._jump import _check_jump as _check_jump
-from ._read import _check as _check
 from ._read import _table as _table
-from ._read import apply_overrides, load_scenario, parse_set, scenario_from_dict
+from ._read import apply_overrides, check_value, load_scenario, parse_set, scenario_from_dict
+from ._read import check_value as _check  # noqa: F401  (former private name)
 from ._scenario import Scenario, job_lock_args
 
 __all__ = [
@@ -98,6 +98,7 @@ __all__ = [
     "Field",
     "Scenario",
     "apply_overrides",
+    "check_value",
     "job_lock_args",
     "jump_fields",
     "load_scenario",

@@ -6,7 +6,9 @@ import math
 from pathlib import Path
 from typing import Any
 
+from ..bounds import shown
 from ..errors import JointlockError, ScenarioError
+from ..io.files import check_path_text
 from ..robots import BUILTIN_ROBOTS
 from ._defaults import _defaults_000
 from ._fields import _BASE2, NEEDS_LOCK, _hint
@@ -30,17 +32,18 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
     name = out["robot"]
     if name in BUILTIN_ROBOTS:
         return
+    check_path_text(name, f"{source}: robot: model file", ScenarioError)
     suffix = Path(name).suffix.lower()
     if suffix not in (".toml", ".urdf"):
         raise ScenarioError(
             f"{source}: robot must be a built-in name ({', '.join(BUILTIN_ROBOTS)}) or a .toml/.urdf "
-            f"model file; got {name!r}{_hint(name, BUILTIN_ROBOTS)}"
+            f"model file; got {shown(name)}{_hint(name, BUILTIN_ROBOTS)}"
         )
     path = Path(name)
     if not path.is_absolute():
         path = (base_dir / path).resolve()
     if not path.is_file():
-        raise ScenarioError(f"{source}: robot: model file {name!r} not found (looked for {path})")
+        raise ScenarioError(f"{source}: robot: model file {shown(name)} not found (looked for {path})")
     out["robot"] = str(path)
 
 

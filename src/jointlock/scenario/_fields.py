@@ -7,6 +7,8 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from ..bounds import MAX_GAIN, MAX_KAPPA, MAX_LENGTH_M, MAX_TIME_S, MIN_LENGTH_M, MIN_STEP_S, MIN_TIME_S
+
 #: Jobs a scenario can run, in the order they run (a halt uses the halt configuration found
 #: before it).
 JOB_ORDER: tuple[str, ...] = (
@@ -32,6 +34,9 @@ JOB_PAPER: dict[str, str] = {
 
 #: Largest |angle| accepted in an ``*_deg`` field [deg] (one turn either way).
 MAX_ABS_DEG = 360.0
+
+#: Largest seed (numpy takes any integer >= 0; a seed is stored as a 64-bit integer).
+MAX_SEED = 2**63 - 1
 
 #: Fewest ``workspace.samples`` (:data:`jointlock.analysis.workspace.MIN_SAMPLES`).
 WORKSPACE_MIN_SAMPLES = 1000
@@ -72,10 +77,14 @@ class Field:
         if self.length is not None:
             what = f"a list of {self.length} finite numbers"
         rng = []
+
+        def num(v: float) -> str:
+            return str(int(v)) if self.kind == "int" else f"{v:g}"
+
         if self.lo is not None:
-            rng.append(f"{'>' if self.lo_open else '>='} {self.lo:g}")
+            rng.append(f"{'>' if self.lo_open else '>='} {num(self.lo)}")
         if self.hi is not None:
-            rng.append(f"<= {self.hi:g}")
+            rng.append(f"<= {num(self.hi)}")
         each = " each" if self.kind == "numbers" else ""
         return what + (f"{each} " + " and ".join(rng) if rng else "") + unit
 
@@ -84,8 +93,22 @@ def _deg(help_: str, *, unit: str = "deg", lo: float = -MAX_ABS_DEG, hi: float =
     return Field("numbers", lo=lo, hi=hi, unit=unit, help=help_)
 
 
-def _pos(unit: str, help_: str, default: Any = None) -> Field:
-    return Field("number", default, lo=0.0, lo_open=True, unit=unit, help=help_)
+def _pos(unit: str, help_: str, default: Any = None, *, hi: float | None = None) -> Field:
+    return Field("number", default, lo=0.0, lo_open=True, hi=hi, unit=unit, help=help_)
+
+
+def _time(help_: str, default: Any = None, *, lo: float = MIN_TIME_S) -> Field:
+    """A duration [s] within the physical bounds of :mod:`jointlock.bounds`."""
+    return Field("number", default, lo=lo, hi=MAX_TIME_S, unit="s", help=help_)
+
+
+def _length(help_: str, default: Any = None, *, lo: float = MIN_LENGTH_M) -> Field:
+    """A length [m] a computation divides by, within the bounds of :mod:`jointlock.bounds`."""
+    return Field("number", default, lo=lo, hi=MAX_LENGTH_M, unit="m", help=help_)
+
+
+#: Largest joint speed and acceleration limits [deg/s, deg/s^2] (MAX_JOINT_VALUE rad/s ~ 5.7e7).
+MAX_RATE_DEG = 1e6
 
 
 #: Top-level scalar fields.
@@ -94,8 +117,13 @@ TOP_FIELDS: dict[str, Field] = {
     "description": Field("str", "", help="free text shown in the report"),
     "robot": Field("str", None, help="built-in name or model file (.toml DH table, .urdf)"),
     "base": Field("choice", "fixed", choices=("fixed", "floating"), help="spacecraft held or free-floating"),
-    "seed": Field("int", 0, lo=0, help="seed of every stochastic job (Monte Carlo, GA)"),
-    "out": Field("str", None, help="output folder (default: <scenario name>-results); --out overrides"),
+    "seed": Field("int", 0, lo=0, hi=MAX_SEED, help="seed of every stochastic job (Monte Carlo, GA)"),
+    "out": Field(
+        "str",
+        None,
+        help="output folder, relative to the file's folder and inside it (default: <scenario name>-results "
+        "in the working folder); --out overrides, with any folder",
+    ),
     "jobs": Field("strings", None, choices=JOB_ORDER, help="jobs to run (default: every job table given)"),
 }
 
@@ -106,7 +134,9 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         "angle_deg": Field(
             "number", None, lo=-MAX_ABS_DEG, hi=MAX_ABS_DEG, unit="deg", help="angle it locks at"
         ),
-        "time_s": Field("number", None, lo=0.0, unit="s", help="time it locks during a task (jump)"),
+        "time_s": Field(
+            "number", None, lo=0.0, hi=MAX_TIME_S, unit="s", help="time it locks during a task (jump)"
+        ),
     },
     "state": {
         "q0_deg": _deg("angles at failure (healthy joints, or the full arm)"),
@@ -114,11 +144,13 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         "ddq0_deg": _deg("accelerations at failure", unit="deg/s^2", lo=-1e5, hi=1e5),
     },
     "limits": {
-        "vmax_deg_s": _pos("deg/s", "joint speed limit (halt, halt_config, jump); formerly vmax_deg"),
-        "amax_deg_s2": _pos(
-            "deg/s^2", "joint acceleration limit (halt, halt_config, jump); formerly amax_deg"
+        "vmax_deg_s": _pos(
+            "deg/s", "joint speed limit (halt, halt_config, jump); formerly vmax_deg", hi=MAX_RATE_DEG
         ),
-        "eps_m": _pos("m", "end-effector position-deviation threshold (jump)"),
+        "amax_deg_s2": _pos(
+            "deg/s^2", "joint acceleration limit (halt, halt_config, jump); formerly amax_deg", hi=MAX_RATE_DEG
+        ),
+        "eps_m": _pos("m", "end-effector position-deviation threshold (jump)", hi=MAX_LENGTH_M),
     },
 }
 
@@ -145,7 +177,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "renormalize": Field(
             "bool", False, help="divide the combined weights by their sum (000 eq. 18 does not)"
         ),
-        "length": _pos("m", "characteristic length dividing the linear rows"),
+        "length": _length("characteristic length dividing the linear rows"),
         "no_refine": Field("bool", False, help="plain Monte Carlo, as 000"),
         "reachable": Field(
             "bool",
@@ -154,11 +186,11 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             "within halt.T (or halt_time) under the limits; default: yes when the state and a halt "
             "time are given",
         ),
-        "halt_time": _pos("s", "halt time of the reachability bound (default: halt.T)"),
+        "halt_time": _time("halt time of the reachability bound (default: halt.T)"),
         "base": Field("choice", None, choices=_BASE2, help="base of this job (default: the top-level base)"),
     },
     "halt": {
-        "T": _pos("s", "halt time (000: 10)"),
+        "T": _time("halt time (000: 10)"),
         "qf_deg": _deg("halt configuration (default: from halt_config, or a Monte Carlo search)"),
         "paper_qf": Field("bool", False, help="000's printed q_best (halt7 only)"),
         "solver": Field(
@@ -187,9 +219,18 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         ),
     },
     "jump": {
-        "fail_at": Field("number", None, lo=0.0, unit="s", help="one failure time (default failure.time_s)"),
+        "fail_at": Field(
+            "number", None, lo=0.0, hi=MAX_TIME_S, unit="s", help="one failure time (default failure.time_s)"
+        ),
         "sweep": Field("int", None, lo=1, hi=10_000, help="sampled failure times (default 40)"),
-        "kappa": Field("number", None, unit="rad^2/(s m^3)", help="constant kappa instead of the search"),
+        "kappa": Field(
+            "number",
+            None,
+            lo=-MAX_KAPPA,
+            hi=MAX_KAPPA,
+            unit="rad^2/(s m^3)",
+            help="constant kappa instead of the search",
+        ),
         "order": Field("int", 5, lo=1, hi=9, help="polynomial order of kappa(t)"),
         "fix": Field(
             "choice",
@@ -202,13 +243,15 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "dx_m": Field(
             "numbers", None, lo=-1e3, hi=1e3, length=3, unit="m", help="straight-line displacement"
         ),
-        "duration_s": _pos("s", "task time"),
-        "blend_s": _pos("s", "parabolic blend time"),
-        "dt_s": _pos("s", "control step"),
-        "vmax_deg_s": _pos("deg/s", "joint speed limit (default limits.vmax_deg_s, else 10)"),
-        "amax_deg_s2": _pos("deg/s^2", "joint acceleration limit (default limits.amax_deg_s2, else 5)"),
-        "eps_m": _pos("m", "position-deviation threshold (default limits.eps_m, else 0.001)"),
-        "kp": Field("number", None, lo=0.0, unit="1/s", help="feedback gain"),
+        "duration_s": _time("task time"),
+        "blend_s": _pos("s", "parabolic blend time", hi=MAX_TIME_S),
+        "dt_s": _time("control step", lo=MIN_STEP_S),
+        "vmax_deg_s": _pos("deg/s", "joint speed limit (default limits.vmax_deg_s, else 10)", hi=MAX_RATE_DEG),
+        "amax_deg_s2": _pos(
+            "deg/s^2", "joint acceleration limit (default limits.amax_deg_s2, else 5)", hi=MAX_RATE_DEG
+        ),
+        "eps_m": _pos("m", "position-deviation threshold (default limits.eps_m, else 0.001)", hi=MAX_LENGTH_M),
+        "kp": Field("number", None, lo=0.0, hi=MAX_GAIN, unit="1/s", help="feedback gain"),
         "rest_transitions": Field(
             "bool", None, help="also check the start from rest and the stop at the end (default false)"
         ),
@@ -241,7 +284,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "from_deg": _deg("start joints, every joint of the arm"),
         "to_deg": _deg("goal joints, every joint of the arm"),
         "steps": Field("int", 40, lo=1, hi=100_000, help="interior points N of 002 eq. (19)"),
-        "cycle": _pos("s", "time between points (002: 0.25)", 0.25),
+        "cycle": _time("time between points (002: 0.25)", 0.25, lo=MIN_STEP_S),
         "tolerance_deg": Field("number", 0.0, lo=0.0, hi=180.0, unit="deg", help="largest |gamma|"),
     },
     "workspace": {
@@ -252,7 +295,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             hi=20_000_000,
             help="configurations per arm (fewer than 1000 say little about a volume)",
         ),
-        "voxel": _pos("m", "voxel side (default automatic)"),
+        "voxel": _length("voxel side (default automatic)"),
     },
     "singular": {
         "verify_conditions": Field("bool", False, help="check 004's Cond1-Cond5"),
@@ -272,8 +315,8 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             help="virtual link lengths: 004's formula (segment) or the exact Vafa-Dubowsky one",
         ),
         "q_deg": _deg("configuration analysed (default zeros)"),
-        "tol": _pos("", "rank tolerance on singular values", 1e-8),
-        "length": _pos("m", "characteristic length"),
+        "tol": _pos("", "rank tolerance on singular values", 1e-8, hi=1e3),
+        "length": _length("characteristic length"),
         "samples": Field("int", None, lo=1, hi=1_000_000, help="samples per condition / search starts"),
     },
 }

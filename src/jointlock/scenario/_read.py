@@ -11,8 +11,9 @@ from pathlib import Path
 from typing import Any
 
 from .._deprecate import warn_once
+from ..bounds import shown
 from ..errors import ScenarioError
-from ..io.files import read_toml_file
+from ..io.files import check_path_text, read_toml_file
 from ..robots import BUILTIN_ROBOTS
 from ._checks import _check_semantics, _inherit_singular_base, _resolve_robot
 from ._fields import (
@@ -36,9 +37,11 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     Parameters
     ----------
     path
-        The ``.toml`` scenario file; relative model paths in it are resolved against its folder.
+        The ``.toml`` scenario file; relative paths in it (``robot``, ``out``) are resolved
+        against its folder, and its ``out`` must lie inside that folder.
     overrides
-        ``{"table.field" or "field": value}`` applied before validation (command-line options).
+        ``{"table.field" or "field": value}`` applied before validation (command-line options);
+        an ``"out"`` override is any folder, relative to the working folder (``--out``).
 
     Raises
     ------
@@ -49,6 +52,8 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     path = Path(path)
     data = read_toml_file(path, "scenario file", ScenarioError)
     applied: dict[str, Any] = {}
+    overrides = dict(overrides or {})
+    out_given = overrides.pop("out", None)  # the command line's: any folder, from the working one
     if overrides:
         for key, value in overrides.items():
             table, _, name = key.rpartition(".")
@@ -58,8 +63,31 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
                 old = next((holder[k] for k in _spellings(table, name) if k in holder), None)
             applied[key] = {"file": old, "value": value}
         data = apply_overrides(data, overrides, source=str(path))
+    if out_given is not None:  # the file's out is not used: not checked either
+        data = {k: v for k, v in data.items() if k != "out"}
     sc = scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
+    if out_given is not None:
+        sc.data["out"] = check_value(out_given, TOP_FIELDS["out"], "--out")
+        applied["out"] = {"file": data.get("out"), "value": out_given}
     return dataclasses.replace(sc, overrides=applied) if applied else sc
+
+
+def _resolve_out(out: dict[str, Any], source: str, base_dir: Path) -> None:
+    """A file's ``out``: relative to the file's folder, and inside it -- a scenario someone
+    sends you cannot write over ``../..`` or an absolute path; the command line's ``--out``
+    can (it is not checked here)."""
+    given = out.get("out")
+    if not given:
+        return
+    check_path_text(given, f"{source}: out", ScenarioError)
+    folder = base_dir.resolve()
+    target = (folder / given).resolve()
+    if target != folder and folder not in target.parents:
+        raise ScenarioError(
+            f"{source}: out must be a folder inside the scenario file's folder ({shown(str(folder))}); got "
+            f"{shown(given)}: give --out on the command line to write elsewhere"
+        )
+    out["out"] = str(target)
 
 
 def parse_set(text: str) -> tuple[str, Any]:
@@ -112,17 +140,29 @@ def apply_overrides(data: Mapping[str, Any], overrides: Mapping[str, Any], *, so
     return out
 
 
-def _check(value: Any, spec: Field, where: str) -> Any:
-    """Validate one value against its schema; returns it as plain data."""
+def check_value(value: Any, spec: Field, where: str) -> Any:
+    """Validate one value against its schema field (``where`` names it in the error, e.g.
+    ``"run.toml: halt.T"`` or ``"--T"``); returns it as plain data.
+
+    Raises
+    ------
+    ScenarioError
+        One line: ``where``, what the field allows (bounds and unit) and the value received
+        (shortened to 80 characters; an integer too large for a float by its digit count).
+    """
 
     def bad(got: str = "") -> ScenarioError:
-        shown = repr(value) if len(repr(value)) <= 80 else repr(value)[:77] + "..."
-        return ScenarioError(f"{where} must be {spec.allowed()}; got {shown}{got}")
+        return ScenarioError(f"{where} must be {spec.allowed()}; got {shown(value)}{got}")
 
     def number(v: Any) -> float:
         if isinstance(v, bool) or not isinstance(v, (int, float)):
             raise bad(f" ({type(value).__name__})")
-        x = float(v)
+        try:
+            x = float(v)
+        except OverflowError:
+            raise ScenarioError(
+                f"{where} must be {spec.allowed()}; got an integer of {len(str(abs(v)))} digits"
+            ) from None
         if not math.isfinite(x):
             raise bad()
         if spec.lo is not None and (x <= spec.lo if spec.lo_open else x < spec.lo):
@@ -191,7 +231,7 @@ def _table(raw: Any, name: str, fields: dict[str, Field], source: str) -> dict[s
                     f"same quantity; keep {field!r}"
                 )
             _warn_former_name(name, key, field, fields[field], source)
-        out[stored.get(field, field)] = _check(value, fields[field], f"{source}: {name}.{key}")
+        out[stored.get(field, field)] = check_value(value, fields[field], f"{source}: {name}.{key}")
     for key, spec in fields.items():
         out.setdefault(stored.get(key, key), spec.default)
     return out
@@ -217,7 +257,7 @@ def scenario_from_dict(
     out: dict[str, Any] = {}
     for key, value in data.items():
         if key in TOP_FIELDS:
-            out[key] = _check(value, TOP_FIELDS[key], f"{source}: {key}")
+            out[key] = check_value(value, TOP_FIELDS[key], f"{source}: {key}")
         elif key in ALL_TABLES:
             out[key] = _table(value, key, ALL_TABLES[key], source)
         else:
@@ -245,5 +285,6 @@ def scenario_from_dict(
     out.pop("jobs", None)
     _inherit_singular_base(out, jobs, given_base="base" in data)
     _resolve_robot(out, source, base_dir)
+    _resolve_out(out, source, base_dir)
     _check_semantics(out, jobs, source)
     return Scenario(data=out, jobs=jobs, source=source, base_dir=base_dir)

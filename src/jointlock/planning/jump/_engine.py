@@ -10,8 +10,9 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...bounds import MAX_KAPPA
 from ...derivatives import cross3, generalized_jacobian_derivatives, linear_jacobian_derivatives
-from ...errors import ModelError, ScenarioError, SingularityWarning
+from ...errors import InfeasibleError, ModelError, ScenarioError, SingularityWarning
 from ...kinematics import base_jacobian, chain_state, generalized_jacobian, system_com
 from ...model import ArmModel, FloatArray
 from ...spatial import axis_angle_rotation
@@ -126,6 +127,22 @@ class _RunOut:
 
 
 # Long on purpose: one explicit-Euler loop over all batched runs, whose per-step state is shared.
+#: A joint rate [rad/s] no arm reaches (~57,000 deg/s): the resolved-rate motion has diverged.
+DIVERGED_RATE = 1e3
+
+
+def _diverged(qd: np.ndarray, kappa: np.ndarray, t: float) -> None:
+    """Raise :class:`InfeasibleError`: a run's joint rates left every physical range (a
+    compensation coefficient far too large makes the resolved-rate law diverge), said in one
+    line instead of overflowing into inf/NaN further on."""
+    run = int(np.argmax(np.abs(qd).max(-1)))
+    raise InfeasibleError(
+        f"the motion diverges at t = {t:.6g} s: a joint rate reaches {np.abs(qd[run]).max():.3g} rad/s "
+        f"(> {DIVERGED_RATE:g}) with kappa = {float(kappa[run]):.6g} rad^2/(s m^3); kappa is far too large "
+        "for this task (the search keeps it within +-2 vmax / |grad w|)"
+    )
+
+
 def _integrate(
     prob: _Problem,
     kappa: FloatArray,
@@ -212,6 +229,8 @@ def _integrate(
                 out.qd_plus[sl, k] = qd2
                 out.task_plus[sl, k] = np.einsum("...rc,...c->...r", jac, qd2 - qd)
                 out.task_noreplan[sl, k] = -jac[..., jump_col] * qd[:, jump_col, None]
+        if np.abs(qd).max(initial=0.0) > DIVERGED_RATE:
+            _diverged(qd, kappa[sl, k], k * dt)
         qd_prev[sl] = qd
         q[sl] = q[sl] + dt * qd
         if rb is not None:
@@ -245,8 +264,17 @@ def _integrate(
 
 
 def _kappa_rows(prob: _Problem, kappa: ArrayLike) -> FloatArray:
-    """Constant kappa (K,) or schedules (K, N) -> (K, N)."""
-    arr = np.asarray(kappa, dtype=float)
+    """Constant kappa (K,) or schedules (K, N) -> (K, N); each finite, within +-:data:`MAX_KAPPA`."""
+    raw = np.asarray(kappa)
+    if raw.dtype.kind not in "iuf":
+        raise ScenarioError(f"kappa must be real numbers [rad^2/(s m^3)]; got dtype {raw.dtype}")
+    arr = raw.astype(float)
+    if not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > MAX_KAPPA):
+        bad = arr[~(np.isfinite(arr) & (np.abs(arr) <= MAX_KAPPA))].ravel()[0]
+        raise ScenarioError(
+            f"kappa must be finite and within +-{MAX_KAPPA:g} rad^2/(s m^3) (the compensation diverges "
+            f"long before); got {bad:g}"
+        )
     if arr.ndim == 0:
         arr = arr[None]
     if arr.ndim == 1:

@@ -15,7 +15,19 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._deprecate import warn_once
+from ...bounds import (
+    MAX_GAIN,
+    MAX_JOINT_VALUE,
+    MAX_LENGTH_M,
+    MAX_TIME_S,
+    MAX_TIME_STEPS,
+    MIN_STEP_S,
+    MIN_TIME_S,
+    as_real,
+    shown,
+)
 from ...errors import ScenarioError
+from ...io.files import read_toml_file
 from ...model import FloatArray
 
 Base = Literal["fixed", "floating"]
@@ -77,18 +89,29 @@ class JumpScenario:
             raise ScenarioError(f"q0 must be finite angles [rad]; got {q0}")
         if len(dx) != 3 or not all(math.isfinite(v) for v in dx):
             raise ScenarioError(f"dx must be 3 finite numbers [m]; got {self.dx!r}")
-        for name in ("duration", "blend", "dt", "vmax", "amax", "eps"):
-            value = float(getattr(self, name))
-            if not (math.isfinite(value) and value > 0):
-                raise ScenarioError(f"{name} must be a finite number > 0; got {getattr(self, name)!r}")
+        if any(abs(v) > MAX_JOINT_VALUE for v in q0):
+            raise ScenarioError(f"q0 must lie within +-{MAX_JOINT_VALUE:g} rad; got {shown(q0)}")
+        if any(abs(v) > MAX_LENGTH_M for v in dx):
+            raise ScenarioError(f"dx must lie within +-{MAX_LENGTH_M:g} m; got {shown(dx)}")
+        for name, (lo, hi, unit) in _BOUNDS.items():
+            value = as_real(getattr(self, name), name, hi=hi, unit=unit, error=ScenarioError)
+            if not value >= lo or (lo == 0 and value == 0):
+                raise ScenarioError(
+                    f"{name} must be a finite number {'> 0' if lo == 0 else f'>= {lo:g}'} and <= {hi:g} "
+                    f"[{unit}]; got {shown(getattr(self, name))}"
+                )
             object.__setattr__(self, name, value)
-        if not (math.isfinite(float(self.kp)) and float(self.kp) >= 0):
-            raise ScenarioError(f"kp must be a finite number >= 0 [1/s]; got {self.kp!r}")
+        as_real(self.kp, "kp", lo=0.0, hi=MAX_GAIN, unit="1/s", error=ScenarioError)
         if 2.0 * self.blend > self.duration + 1e-12:
             raise ScenarioError(
                 f"blend must be at most duration/2 = {self.duration / 2:g} s; got {self.blend:g} s"
             )
         steps = self.duration / self.dt
+        if steps > MAX_TIME_STEPS:
+            raise ScenarioError(
+                f"duration / dt = {steps:.3g} control steps; at most {MAX_TIME_STEPS:g} (a longer step dt, "
+                "or a shorter task)"
+            )
         if abs(steps - round(steps)) > 1e-6 or round(steps) < 2:
             raise ScenarioError(
                 f"duration ({self.duration:g} s) must be a whole number (>= 2) of control steps "
@@ -143,6 +166,18 @@ class JumpScenario:
             "rest_transitions": self.rest_transitions,
             "feedforward": self.feedforward,
         }
+
+
+#: Bounds of the task's positive quantities: attribute -> (lowest, highest, unit); a lowest
+#: of 0 means "> 0" (see :mod:`jointlock.bounds`).
+_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "duration": (MIN_TIME_S, MAX_TIME_S, "s"),
+    "blend": (0.0, MAX_TIME_S, "s"),
+    "dt": (MIN_STEP_S, MAX_TIME_S, "s"),
+    "vmax": (0.0, MAX_JOINT_VALUE, "rad/s"),
+    "amax": (0.0, MAX_JOINT_VALUE, "rad/s^2"),
+    "eps": (0.0, MAX_LENGTH_M, "m"),
+}
 
 
 #: Scenario-file fields: name -> (JumpScenario attribute, kind, conversion to SI).
@@ -200,10 +235,16 @@ def scenario_from_mapping(data: Mapping[str, Any], *, source: str = "scenario") 
                 "list3": "a list of 3 numbers",
             }[kind]
             raise ScenarioError(
-                f"{source}: field {key!r} must be {want}; got {value!r} ({type(value).__name__})"
+                f"{source}: field {key!r} must be {want}; got {shown(value)} ({type(value).__name__})"
             )
-        kwargs[attr] = convert(value)
-    return JumpScenario(**kwargs)
+        try:
+            kwargs[attr] = convert(value)
+        except OverflowError:
+            raise ScenarioError(f"{source}: field {key!r} is too large for a number; got {shown(value)}") from None
+    try:
+        return JumpScenario(**kwargs)
+    except ScenarioError as exc:
+        raise ScenarioError(f"{source}: {exc}") from None
 
 
 def load_jump_task(path: str | Path) -> JumpScenario:
@@ -212,22 +253,7 @@ def load_jump_task(path: str | Path) -> JumpScenario:
     Not a ``jointlock run`` scenario file (tables such as ``[jump]``): those are read by
     :func:`jointlock.scenario.load_scenario`, and refused here with a message saying so.
     """
-    try:
-        import tomllib
-    except ModuleNotFoundError:  # pragma: no cover - Python < 3.11
-        import tomli as tomllib  # type: ignore[no-redef]
-    path = Path(path)
-    try:
-        data = tomllib.loads(path.read_text(encoding="utf-8"))
-    except FileNotFoundError:
-        raise ScenarioError(f"scenario file {str(path)!r} does not exist") from None
-    except UnicodeDecodeError as exc:
-        raise ScenarioError(f"scenario file {str(path)!r} is not UTF-8 text: {exc}") from None
-    except OSError as exc:  # a folder, no permission, ...
-        reason = exc.strerror or type(exc).__name__
-        raise ScenarioError(f"cannot read scenario file {str(path)!r}: {reason}") from None
-    except tomllib.TOMLDecodeError as exc:
-        raise ScenarioError(f"scenario file {str(path)!r} is not valid TOML: {exc}") from None
+    data = read_toml_file(path, "scenario file", ScenarioError)
     _refuse_run_scenario(data, str(path))
     return scenario_from_mapping(data, source=str(path))
 
