@@ -74,7 +74,7 @@ def test_kinematics_reads_a_urdf_file():
         (["kinematics", "halt7", "--lock", "9=0"], "one of the movable joints"),
         (["kinematics", "halt7", "--q-deg", "1", "2"], "--q-deg needs 7 values"),
         (["kinematics", "halt7", "--lock", "4=zero"], "--lock must look like J=DEG"),
-        (["kinematics", "puma6", "--q-deg", "nan", "0", "0", "0", "0", "0"], "must be finite"),
+        (["kinematics", "puma6", "--q-deg", "nan", "0", "0", "0", "0", "0"], "must be a finite number"),
         (["kinematics", "/nonexistent.urdf"], "cannot read URDF file"),
     ],
 )

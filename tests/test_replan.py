@@ -420,9 +420,11 @@ def test_cli_bad_lock_is_an_error(capsys):
 def test_cli_replan_refuses_zero_steps(capsys):
     argv = ["replan", "puma6", "--lock", "2=59.4", "--from-deg", "0", "60", "0", "0", "0", "0"]
     argv += ["--to-deg", "5", "60", "35", "10", "-120", "90", "--steps", "0"]
-    assert main(argv) == 2
+    with pytest.raises(SystemExit) as info:  # refused by the option's type, before anything runs
+        main(argv)
+    assert info.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "--steps must be >= 1" in err
+    assert len(err.splitlines()) == 1 and "argument --steps: must be an integer >= 1 and <= 100000; got 0" in err
 
 
 def test_default_jump_threshold_is_capped():

@@ -115,9 +115,11 @@ def test_half_sample_estimate_and_warnings(puma):
 
 
 def test_cli_workspace_refuses_degenerate_inputs(capsys):
-    assert main(["workspace", "puma6", "--lock", "2=60", "--samples", "1"]) == 2
+    with pytest.raises(SystemExit) as info:  # refused by the option's type, before anything runs
+        main(["workspace", "puma6", "--lock", "2=60", "--samples", "1"])
+    assert info.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "--samples must be >= 1000" in err
+    assert len(err.splitlines()) == 1 and "argument --samples: must be an integer >= 1000" in err
     assert main(["workspace", "puma6", "--lock", "2=60", "--samples", "2000", "--voxel", "0.001"]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "--voxel 0.001 m is too small for 2000 samples" in err

@@ -19,19 +19,8 @@ Quick start::
 
 from __future__ import annotations
 
-from . import io
 from ._lazy import lazy_attributes
 from ._version import __version__
-from .dh import from_dh
-from .dynamics import (
-    InverseDynamics,
-    base_wrench,
-    generalized_inertia,
-    joint_torques,
-    mass_matrix,
-    rnea,
-    system_mass_matrix,
-)
 from .errors import (
     ConfigurationError,
     InfeasibleError,
@@ -40,30 +29,49 @@ from .errors import (
     ScenarioError,
     SingularityWarning,
 )
-from .io import read_model_toml, read_urdf
-from .kinematics import (
-    ChainState,
-    VirtualManipulator,
-    base_jacobian,
-    chain_state,
-    com_jacobians,
-    com_positions,
-    ee_pose,
-    generalized_jacobian,
-    jacobian,
-    link_poses,
-    momentum,
-    momentum_matrix,
-    system_com,
-    virtual_link_vectors,
-    virtual_manipulator,
-)
-from .locking import lock, lock_joints
-from .model import ArmModel, Body, Joint, LockedJoint, as_joint_array
-from .robots import BUILTIN_ROBOTS, load_robot
+
+#: The core (models, kinematics, dynamics, readers), imported on first use like everything else:
+#: ``import jointlock`` stays light, so the command line can handle Ctrl-C from its first line.
+_CORE = {
+    "from_dh": "jointlock.dh",
+    "InverseDynamics": "jointlock.dynamics",
+    "base_wrench": "jointlock.dynamics",
+    "generalized_inertia": "jointlock.dynamics",
+    "joint_torques": "jointlock.dynamics",
+    "mass_matrix": "jointlock.dynamics",
+    "rnea": "jointlock.dynamics",
+    "system_mass_matrix": "jointlock.dynamics",
+    "read_model_toml": "jointlock.io",
+    "read_urdf": "jointlock.io",
+    "ChainState": "jointlock.kinematics",
+    "VirtualManipulator": "jointlock.kinematics",
+    "base_jacobian": "jointlock.kinematics",
+    "chain_state": "jointlock.kinematics",
+    "com_jacobians": "jointlock.kinematics",
+    "com_positions": "jointlock.kinematics",
+    "ee_pose": "jointlock.kinematics",
+    "generalized_jacobian": "jointlock.kinematics",
+    "jacobian": "jointlock.kinematics",
+    "link_poses": "jointlock.kinematics",
+    "momentum": "jointlock.kinematics",
+    "momentum_matrix": "jointlock.kinematics",
+    "system_com": "jointlock.kinematics",
+    "virtual_link_vectors": "jointlock.kinematics",
+    "virtual_manipulator": "jointlock.kinematics",
+    "lock": "jointlock.locking",
+    "lock_joints": "jointlock.locking",
+    "ArmModel": "jointlock.model",
+    "Body": "jointlock.model",
+    "Joint": "jointlock.model",
+    "LockedJoint": "jointlock.model",
+    "as_joint_array": "jointlock.model",
+    "BUILTIN_ROBOTS": "jointlock.robots",
+    "load_robot": "jointlock.robots",
+}
 
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).
 _LAZY = {
+    **_CORE,
     "kinematic_indices": "jointlock.analysis.ability",
     "ahp_weights": "jointlock.analysis.ability",
     "entropy_weights": "jointlock.analysis.ability",
@@ -110,7 +118,7 @@ _LAZY = {
 }
 
 #: Subpackages reachable as attributes (``jl.plots``, ``jl.jobs``, ``jl.papers``), imported on first use.
-_LAZY_MODULES = ("plots", "jobs", "papers", "run", "report", "scenario", "analysis", "planning")
+_LAZY_MODULES = ("io", "plots", "jobs", "papers", "run", "report", "scenario", "analysis", "planning")
 
 
 __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals())

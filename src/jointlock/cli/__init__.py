@@ -12,6 +12,7 @@ import importlib.util
 import logging
 import os
 import sys
+import warnings
 from collections.abc import Sequence
 from typing import NoReturn
 
@@ -105,7 +106,23 @@ def _headless_backend() -> None:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the CLI; returns the process exit code (0 ok, 2 usage or input error, including a
-    file or folder that cannot be read or written; tracebacks only with ``--debug``)."""
+    file or folder that cannot be read or written; 130 interrupted; tracebacks only with
+    ``--debug``).
+
+    Ctrl-C is handled from the first line: the subcommands (and numpy, scipy, matplotlib
+    behind them) are imported inside this function, so an interrupt during start-up says
+    "interrupted" like one during the run.  Warnings are collected while the command runs and
+    printed after its output, one line each -- never ahead of an error (an error prints only
+    its line).  A numpy floating-point warning is an error: a result is never printed from
+    inf/NaN."""
+    try:
+        return _main(argv)
+    except KeyboardInterrupt:
+        print("jointlock: interrupted", file=sys.stderr)
+        return 130
+
+
+def _main(argv: Sequence[str] | None) -> int:
     _headless_backend()
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
@@ -115,26 +132,65 @@ def main(argv: Sequence[str] | None = None) -> int:
     logging.basicConfig(
         level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s"
     )
-    try:
-        code = int(args.func(args) or 0)
-        sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's final flush
-        return code
-    except JointlockError as exc:
-        if args.debug:
-            raise
-        print(f"jointlock {args.command}: error: {exc}", file=sys.stderr)
-        return 2
-    except BrokenPipeError:  # e.g. `jointlock ... | head`: the reader left; exit quietly
-        _silence_stdout()
-        return 141 if os.name == "posix" else 1
-    except OSError as exc:  # a file or folder that cannot be read or written (e.g. --out)
-        if args.debug:
-            raise
-        print(f"jointlock {args.command}: error: {_os_error_text(exc)}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt:
-        print("jointlock: interrupted", file=sys.stderr)
-        return 130
+    prefix = f"jointlock {args.command}"
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("default")
+        warnings.simplefilter("error", RuntimeWarning)  # numpy overflow / invalid value: an error
+        try:
+            code = int(args.func(args) or 0)
+            _print_warnings(prefix, caught)
+            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's final flush
+            return code
+        except JointlockError as exc:
+            if args.debug:
+                raise
+            print(f"{prefix}: error: {exc}", file=sys.stderr)
+            return 2
+        except BrokenPipeError:  # e.g. `jointlock ... | head`: the reader left; exit quietly
+            _silence_stdout()
+            return 141 if os.name == "posix" else 1
+        except OSError as exc:  # a file or folder that cannot be read or written (e.g. --out)
+            if args.debug:
+                raise
+            print(f"{prefix}: error: {_os_error_text(exc)}", file=sys.stderr)
+            return 2
+        except MemoryError:
+            if args.debug:
+                raise
+            print(f"{prefix}: error: not enough memory for this run: ask for fewer samples or steps", file=sys.stderr)
+            return 2
+        except Exception as exc:
+            if args.debug or not _numerical_failure(exc):
+                raise
+            print(f"{prefix}: error: {_numerical_text(exc)}", file=sys.stderr)
+            return 2
+
+
+def _print_warnings(prefix: str, caught: list[warnings.WarningMessage]) -> None:
+    """The warnings a command raised, one line each (repeats once), after its output."""
+    seen: set[str] = set()
+    for w in caught:
+        text = " ".join(str(w.message).split())
+        if text not in seen:
+            seen.add(text)
+            print(f"{prefix}: warning: {text}", file=sys.stderr)
+
+
+def _numerical_failure(exc: BaseException) -> bool:
+    """Whether ``exc`` is floating-point arithmetic failing (overflow, division by zero, a
+    numpy warning turned error, a linear-algebra routine that did not converge)."""
+    if isinstance(exc, (ArithmeticError, RuntimeWarning)):
+        return True
+    linalg = sys.modules.get("numpy.linalg")
+    return linalg is not None and isinstance(exc, linalg.LinAlgError)
+
+
+def _numerical_text(exc: BaseException) -> str:
+    return (
+        f"numerical failure ({type(exc).__name__}: {' '.join(str(exc).split())}): an input is too large or "
+        "too small for float64 arithmetic; every input within the documented bounds (docs/validation.md) "
+        "should compute, so please report it with --debug's traceback"
+    )
 
 
 def _silence_stdout() -> None:

@@ -4,6 +4,7 @@ output folders, JSON output and atomic figure files."""
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import sys
 from collections.abc import Callable
@@ -11,12 +12,13 @@ from pathlib import Path
 from typing import Any
 
 from ..errors import ScenarioError
-from ..io.files import json_text, write_png  # noqa: F401  (write_png re-exported)
+from ..io.files import json_text, shorten, write_png  # noqa: F401  (write_png re-exported)
 from ..io.files import to_plain as _plain  # noqa: F401  (old name)
 from ..jobs._common import format_matrix, joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..robots import BUILTIN_ROBOTS, load_robot
+from ..scenario import ALL_TABLES, MAX_ABS_DEG, TOP_FIELDS, Field, check_value
 
 
 def parse_lock(text: str) -> tuple[int, float]:
@@ -52,17 +54,46 @@ def int_at_least(minimum: int) -> Callable[[str], int]:
 seed_arg = int_at_least(0)
 
 
-def require_finite(args: argparse.Namespace, *names: str) -> None:
-    """Raise :class:`ScenarioError` naming the option when one of ``args.<name>`` (if given)
-    is NaN or infinite; ``names`` are attribute names (``"length_scale"`` -> ``--length-scale``)."""
-    for name in names:
-        value = getattr(args, name, None)
-        if value is None:
-            continue
-        values = value if isinstance(value, (list, tuple)) else [value]
-        if not all(math.isfinite(float(v)) for v in values):
-            option = "--" + name.replace("_", "-")
-            raise ScenarioError(f"{option} must be a finite number; got {value}")
+def field_arg(table: str, name: str) -> Callable[[str], Any]:
+    """An argparse type checking an option against its scenario field ``[table] name``: the
+    same kind, bounds and unit as in a scenario file (so ``--samples``, ``--T``, ``--voxel``
+    ... refuse what ``jointlock run`` refuses).  A list field is checked value by value."""
+    spec = ALL_TABLES[table][name] if table else TOP_FIELDS[name]
+    if spec.kind == "numbers":
+        spec = dataclasses.replace(spec, kind="number", length=None)
+    return _spec_arg(spec)
+
+
+def number_arg(
+    lo: float | None = None,
+    hi: float | None = None,
+    *,
+    lo_open: bool = False,
+    unit: str = "",
+    integer: bool = False,
+) -> Callable[[str], Any]:
+    """An argparse type: a finite number (an integer with ``integer=True``) within the bounds."""
+    kind = "int" if integer else "number"
+    return _spec_arg(Field(kind, lo=lo, hi=hi, lo_open=lo_open, unit=unit))
+
+
+def _spec_arg(spec: Field) -> Callable[[str], Any]:
+    def parse(text: str) -> Any:
+        try:
+            value: Any = int(text) if spec.kind == "int" else float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"must be {spec.allowed()}; got {shorten(text)!r}") from None
+        try:
+            return check_value(value, spec, "value")
+        except ScenarioError as exc:
+            raise argparse.ArgumentTypeError(str(exc).removeprefix("value ")) from None
+
+    parse.__name__ = spec.kind  # argparse names the type in its own messages
+    return parse
+
+
+#: argparse type of every joint-space vector option in degrees (``--q-deg``, ``--from-deg`` ...).
+deg_arg = number_arg(-MAX_ABS_DEG, MAX_ABS_DEG, unit="deg")
 
 
 def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None:

@@ -30,7 +30,17 @@ from ..jobs.halt import (
 )
 from ..papers import p000
 from ..planning.ga import GASettings
-from ._common import add_robot_arguments, check_out_dir, joint_vector_deg, lock_map, print_json, seed_arg
+from ._common import (
+    add_robot_arguments,
+    check_out_dir,
+    deg_arg,
+    field_arg,
+    joint_vector_deg,
+    lock_map,
+    number_arg,
+    print_json,
+    seed_arg,
+)
 
 #: 000 §5.1-5.2 scenario on halt7 (healthy joints 1, 2, 3, 5, 6, 7) [deg, deg/s, deg/s^2, s].
 PAPER_SCENARIO: dict[str, Any] = {
@@ -68,18 +78,28 @@ def register(sub: argparse._SubParsersAction) -> None:
         ),
     )
     add_robot_arguments(p, base_help=BASE_HELP)
-    p.add_argument("--q0-deg", type=float, nargs="+", metavar="DEG", help="angles at failure [deg]")
-    p.add_argument("--dq0-deg", type=float, nargs="+", metavar="DEG", help="rates at failure [deg/s]")
+    p.add_argument("--q0-deg", type=deg_arg, nargs="+", metavar="DEG", help="angles at failure [deg]")
     p.add_argument(
-        "--ddq0-deg", type=float, nargs="+", metavar="DEG", help="accelerations at failure [deg/s^2]"
+        "--dq0-deg",
+        type=field_arg("state", "dq0_deg"),
+        nargs="+",
+        metavar="DEG",
+        help="rates at failure [deg/s]",
     )
-    p.add_argument("--T", type=float, help="halt time [s], > 0 (000: 10)")
+    p.add_argument(
+        "--ddq0-deg",
+        type=field_arg("state", "ddq0_deg"),
+        nargs="+",
+        metavar="DEG",
+        help="accelerations at failure [deg/s^2]",
+    )
+    p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], > 0 (000: 10)")
     qf = p.add_mutually_exclusive_group()
-    qf.add_argument("--qf-deg", type=float, nargs="+", metavar="DEG", help="halt configuration [deg]")
+    qf.add_argument("--qf-deg", type=deg_arg, nargs="+", metavar="DEG", help="halt configuration [deg]")
     qf.add_argument("--paper-qf", action="store_true", help="use 000's printed q_best (halt7 only)")
     p.add_argument(
         "--vmax-deg",
-        type=float,
+        type=field_arg("limits", "vmax_deg_s"),
         nargs="+",
         metavar="DEG",
         help="speed limit(s) [deg/s], one or one per healthy joint, capped by the model's own limit "
@@ -87,7 +107,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--amax-deg",
-        type=float,
+        type=field_arg("limits", "amax_deg_s2"),
         nargs="+",
         metavar="DEG",
         help=f"acceleration limit(s) [deg/s^2], one or one per healthy joint (default {DEFAULT_AMAX_DEG:g}, as 000)",
@@ -97,7 +117,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--seed", type=seed_arg, default=0, help="seed of the GA and the Monte Carlo search (default 0)"
     )
     p.add_argument(
-        "--samples", type=int, default=p000.SAMPLES, help="Monte Carlo samples for the halt configuration"
+        "--samples",
+        type=field_arg("halt", "samples"),
+        default=p000.SAMPLES,
+        help="Monte Carlo samples for the halt configuration",
     )
     p.add_argument(
         "--no-reachability",
@@ -108,7 +131,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--n-samples",
-        type=int,
+        type=field_arg("halt", "n_samples"),
         default=501,
         help=f"time samples of the objective (odd, >= {MIN_N_SAMPLES}; default 501)",
     )
@@ -118,8 +141,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="also find the smallest feasible halt time when the halt is feasible (an infeasible "
         "halt always reports it)",
     )
-    p.add_argument("--generations", type=int, default=100, help="GA generations, >= 0 (default 100)")
-    p.add_argument("--population", type=int, default=50, help="GA population, >= 2 (default 50)")
+    p.add_argument(
+        "--generations",
+        type=number_arg(0, 100_000, integer=True),
+        default=100,
+        help="GA generations, >= 0 (default 100)",
+    )
+    p.add_argument(
+        "--population",
+        type=field_arg("halt", "population"),
+        default=50,
+        help="GA population, >= 2 (default 50)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write plots (PNG), time series (CSV, NPZ) and result.json")
     p.add_argument("--quiet", action="store_true", help="no progress bars")

@@ -11,7 +11,15 @@ from ..errors import ScenarioError
 from ..jobs.halt import CLI_LIMIT_NAMES, DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
 from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, ReachabilitySettings, study_halt_configuration
 from ..papers import p000
-from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json, seed_arg
+from ._common import (
+    add_robot_arguments,
+    deg_arg,
+    field_arg,
+    joint_vector_deg,
+    model_from_args,
+    print_json,
+    seed_arg,
+)
 from .halt import LIMITS_HELP
 
 
@@ -29,7 +37,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_arguments(p)
     p.add_argument(
-        "--samples", type=int, default=p000.SAMPLES, help=f"Monte Carlo samples K (default {p000.SAMPLES}, as 000)"
+        "--samples",
+        type=field_arg("halt_config", "samples"),
+        default=p000.SAMPLES,
+        help=f"Monte Carlo samples K (default {p000.SAMPLES}, as 000)",
     )
     p.add_argument("--seed", type=seed_arg, default=None, help="random seed (default: fresh, printed)")
     p.add_argument(
@@ -53,7 +64,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--length",
-        type=float,
+        type=field_arg("halt_config", "length"),
         default=None,
         metavar="L",
         help="characteristic length [m]: divide the Jacobian's linear rows by L (default: raw, as 000)",
@@ -64,19 +75,27 @@ def register(sub: argparse._SubParsersAction) -> None:
         "require the halt configuration to be reachable from a state within a halt time: by default "
         "exactly, by 000's halt polynomial (eq. 27) under the limits for some k",
     )
-    reach.add_argument("--from-q-deg", type=float, nargs="+", metavar="DEG", help="start angles [deg]")
-    reach.add_argument("--from-dq-deg", type=float, nargs="+", metavar="DEG", help="start rates [deg/s]")
+    reach.add_argument("--from-q-deg", type=deg_arg, nargs="+", metavar="DEG", help="start angles [deg]")
+    reach.add_argument(
+        "--from-dq-deg",
+        type=field_arg("state", "dq0_deg"),
+        nargs="+",
+        metavar="DEG",
+        help="start rates [deg/s]",
+    )
     reach.add_argument(
         "--from-ddq-deg",
-        type=float,
+        type=field_arg("state", "ddq0_deg"),
         nargs="+",
         metavar="DEG",
         help="start accelerations [deg/s^2] (default 0)",
     )
-    reach.add_argument("--halt-time", type=float, metavar="S", help="halt time T [s]")
+    reach.add_argument(
+        "--halt-time", type=field_arg("halt_config", "halt_time"), metavar="S", help="halt time T [s]"
+    )
     reach.add_argument(
         "--vmax-deg",
-        type=float,
+        type=field_arg("limits", "vmax_deg_s"),
         nargs="+",
         metavar="DEG",
         help="speed limit(s) [deg/s], one or one per healthy joint, capped by the model's own limit "
@@ -84,7 +103,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     reach.add_argument(
         "--amax-deg",
-        type=float,
+        type=field_arg("limits", "amax_deg_s2"),
         nargs="+",
         metavar="DEG",
         help=f"acceleration limit(s) [deg/s^2] (default {DEFAULT_AMAX_DEG:g}, as 000)",
@@ -132,10 +151,6 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilitySettings | Non
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.samples < 2:
-        raise ScenarioError(f"--samples must be an integer >= 2; got {args.samples}")
-    if args.length is not None and not (math.isfinite(args.length) and args.length > 0):
-        raise ScenarioError(f"--length must be a finite length > 0 [m]; got {args.length}")
     model = model_from_args(args)
     if not model.locked:
         raise ScenarioError("halt-config needs a locked joint: add --lock J=DEG (e.g. --lock 4=0)")

@@ -7,10 +7,11 @@ import argparse
 
 import numpy as np
 
+from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M
 from ..errors import ScenarioError
 from ..ik import pose_from_zyx
 from ..jobs.ik import inverse_kinematics
-from ._common import add_robot_arguments, model_from_args, print_json, require_finite, seed_arg
+from ._common import add_robot_arguments, model_from_args, number_arg, print_json, seed_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -27,12 +28,18 @@ def register(sub: argparse._SubParsersAction) -> None:
     target = p.add_mutually_exclusive_group(required=True)
     target.add_argument(
         "--pose",
-        type=float,
+        type=number_arg(-MAX_LENGTH_M, MAX_LENGTH_M),
         nargs=6,
         metavar=("X", "Y", "Z", "YAW", "PITCH", "ROLL"),
         help="position [m] and ZYX Euler angles [deg] (R = Rz(yaw) Ry(pitch) Rx(roll), as 002 prints)",
     )
-    target.add_argument("--matrix", type=float, nargs=16, metavar="M", help="4x4 pose, row-major [m]")
+    target.add_argument(
+        "--matrix",
+        type=number_arg(-MAX_LENGTH_M, MAX_LENGTH_M),
+        nargs=16,
+        metavar="M",
+        help="4x4 pose, row-major [m]",
+    )
     p.add_argument(
         "--method",
         choices=("auto", "closed-form", "numeric"),
@@ -43,7 +50,11 @@ def register(sub: argparse._SubParsersAction) -> None:
         "family, numeric otherwise",
     )
     p.add_argument(
-        "--length-scale", type=float, default=1.0, metavar="M", help="L [m] of the nearest-pose metric (> 0)"
+        "--length-scale",
+        type=number_arg(MIN_LENGTH_M, MAX_LENGTH_M, unit="m"),
+        default=1.0,
+        metavar="M",
+        help="L [m] of the nearest-pose metric (> 0)",
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="seed of the numerical starts (integer >= 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -73,9 +84,6 @@ def _target(args: argparse.Namespace) -> np.ndarray:
 
 
 def run(args: argparse.Namespace) -> int:
-    require_finite(args, "length_scale")
-    if not args.length_scale > 0:
-        raise ScenarioError(f"--length-scale must be > 0 [m]; got {args.length_scale}")
     model = model_from_args(args)
     report = inverse_kinematics(
         model, _target(args), method=args.method, rng=args.seed, length_scale=args.length_scale

@@ -13,11 +13,11 @@ stderr as ignored.
 from __future__ import annotations
 
 import argparse
-import sys
-from pathlib import Path
+import warnings
 from typing import Any
 
 from ..errors import ScenarioError
+from ..io.files import read_toml_file
 from ..jobs.jump import (  # noqa: F401  (KAPPA_UNIT, MAX_ORDER and the text helpers re-exported)
     DEFAULT_ORDER,
     DEFAULT_SWEEP,
@@ -32,7 +32,7 @@ from ..papers import p001
 from ..planning.jump import JumpScenario, scenario_from_mapping
 from ..planning.jump import load_jump_task as load_scenario
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, print_json, require_finite
+from ._common import add_robot_arguments, check_out_dir, field_arg, number_arg, print_json
 
 #: A start of the example task shown when a robot needs its own q0_deg (NOTES-001's start,
 #: cut or padded with zeros to the robot's joints).
@@ -66,14 +66,23 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="task file, a flat TOML table: q0_deg (one angle per joint [deg]), dx_m, duration_s, ... "
         "(needed for any robot but canadarm7; a `jointlock run` scenario file is run with `jointlock run`)",
     )
-    p.add_argument("--lock-joint", type=int, metavar="J", help="joint that locks (from 1; default 2)")
+    p.add_argument(
+        "--lock-joint",
+        type=number_arg(1, 10_000, integer=True),
+        metavar="J",
+        help="joint that locks (from 1; default 2)",
+    )
     when = p.add_mutually_exclusive_group()
-    when.add_argument("--fail-at", type=float, metavar="S", help="one failure time [s]")
-    when.add_argument("--sweep", type=int, metavar="N", help="N sampled failure times (default 40)")
+    when.add_argument(
+        "--fail-at", type=field_arg("jump", "fail_at"), metavar="S", help="one failure time [s]"
+    )
+    when.add_argument(
+        "--sweep", type=field_arg("jump", "sweep"), metavar="N", help="N sampled failure times (default 40)"
+    )
     how = p.add_mutually_exclusive_group()
     how.add_argument(
         "--kappa",
-        type=float,
+        type=field_arg("jump", "kappa"),
         metavar="K",
         help=f"use this constant kappa [{KAPPA_UNIT}] (no search)",
     )
@@ -84,7 +93,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--order",
-        type=int,
+        type=field_arg("jump", "order"),
         default=None,
         help=f"polynomial order of kappa(t), 1..{MAX_ORDER} (default 5; sweep with the search only)",
     )
@@ -144,11 +153,9 @@ def _check_q0(args: argparse.Namespace, sc: JumpScenario, model: Any) -> None:
 
 
 def _file_fields(path: str) -> set[str]:
-    import tomllib
-
     try:
-        return set(tomllib.loads(Path(path).read_text(encoding="utf-8")))
-    except (OSError, UnicodeDecodeError, tomllib.TOMLDecodeError):  # read before, by load_scenario
+        return set(read_toml_file(path, "scenario file", ScenarioError))
+    except ScenarioError:  # read before, by load_jump_task
         return set()
 
 
@@ -172,18 +179,10 @@ def _warn_ignored(args: argparse.Namespace) -> None:
                 if mode == "--fail-at"
                 else "a constant kappa verified at every step, no sampling or fit"
             )
-            print(
-                f"jointlock jump: warning: {', '.join(ignored)} ignored with {mode} ({what})",
-                file=sys.stderr,
-            )
+            warnings.warn(f"{', '.join(ignored)} ignored with {mode} ({what})", UserWarning, stacklevel=2)
 
 
 def run(args: argparse.Namespace) -> int:
-    require_finite(args, "kappa", "fail_at")
-    if args.sweep is not None and args.sweep < 1:
-        raise ScenarioError(f"--sweep must be >= 1; got {args.sweep}")
-    if args.order is not None and not 1 <= args.order <= MAX_ORDER:
-        raise ScenarioError(f"--order must be 1..{MAX_ORDER}; got {args.order}")
     out_dir = check_out_dir(args.out)
     sc = _scenario(args)
     model = load_robot(args.robot, base=sc.base)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import argparse
 
 from ..jobs.kinematics import describe_configuration
-from ._common import add_robot_arguments, joint_vector_deg, model_from_args, print_json
+from ._common import add_robot_arguments, deg_arg, joint_vector_deg, model_from_args, print_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,7 +21,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_arguments(p)
     p.add_argument(
-        "--q-deg", type=float, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)"
+        "--q-deg", type=deg_arg, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)"
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)

@@ -8,11 +8,21 @@ from pathlib import Path
 
 import numpy as np
 
+from ..bounds import MAX_LENGTH_M
 from ..errors import ScenarioError
 from ..jobs.replan import plan_replan
 from ..planning.replan import DEFAULT_STEP_WEIGHT
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, single_lock
+from ..scenario import MAX_ABS_DEG
+from ._common import (
+    add_robot_arguments,
+    check_out_dir,
+    deg_arg,
+    field_arg,
+    number_arg,
+    print_json,
+    single_lock,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -35,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_robot_arguments(p)
     p.add_argument(
         "--from-deg",
-        type=float,
+        type=deg_arg,
         nargs="+",
         required=True,
         metavar="DEG",
@@ -43,16 +53,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--to-deg",
-        type=float,
+        type=deg_arg,
         nargs="+",
         required=True,
         metavar="DEG",
         help="goal configuration, every joint of the arm [deg]",
     )
-    p.add_argument("--steps", type=int, default=40, help="interior points N of eq. (19), >= 1 (default 40)")
-    p.add_argument("--cycle", type=float, default=0.25, help="time between points [s] (002: 0.25)")
     p.add_argument(
-        "--tolerance-deg", type=float, default=0.0, help="largest |gamma| accepted [deg] (default 0)"
+        "--steps",
+        type=field_arg("replan", "steps"),
+        default=40,
+        help="interior points N of eq. (19), >= 1 (default 40)",
+    )
+    p.add_argument(
+        "--cycle", type=field_arg("replan", "cycle"), default=0.25, help="time between points [s] (002: 0.25)"
+    )
+    p.add_argument(
+        "--tolerance-deg",
+        type=field_arg("replan", "tolerance_deg"),
+        default=0.0,
+        help="largest |gamma| accepted [deg] (default 0)",
     )
     p.add_argument(
         "--method",
@@ -62,14 +82,14 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--step-weight",
-        type=float,
+        type=number_arg(0.0, MAX_LENGTH_M, unit="m/rad^2"),
         default=DEFAULT_STEP_WEIGHT,
         metavar="M_PER_RAD2",
         help=f"continuous: tracking error [m] traded per rad^2 of joint step (default {DEFAULT_STEP_WEIGHT:g})",
     )
     p.add_argument(
         "--jump-deg",
-        type=float,
+        type=number_arg(0.0, MAX_ABS_DEG, lo_open=True, unit="deg"),
         default=None,
         metavar="DEG",
         help="flag joint steps above this [deg] (default: 5x the median step, between 2 and 30 deg)",
@@ -80,17 +100,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    require_finite(args, "cycle", "tolerance_deg", "step_weight", "jump_deg")
     check_out_dir(args.out)
     joint, angle = single_lock(args)
     full = load_robot(args.robot, base=args.base)
     for opt, vals in (("--from-deg", args.from_deg), ("--to-deg", args.to_deg)):
         if len(vals) != full.dof or not np.all(np.isfinite(vals)):
             raise ScenarioError(f"{opt} needs {full.dof} finite values (all joints) [deg]; got {vals}")
-    if args.steps < 1:
-        raise ScenarioError(
-            f"--steps must be >= 1 (interior points between start and goal); got {args.steps}"
-        )
     if not (args.cycle > 0):
         raise ScenarioError(f"--cycle must be > 0 [s]; got {args.cycle}")
     if not (0 <= args.tolerance_deg <= 180):

@@ -28,10 +28,11 @@ from ..model import ArmModel
 from ._common import (
     add_robot_arguments,
     check_out_dir,
+    deg_arg,
+    field_arg,
     joint_vector_deg,
     lock_map,
     print_json,
-    require_finite,
     seed_arg,
 )
 
@@ -61,17 +62,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="virtual link lengths: 004's formula (segment, default) or the exact Vafa-Dubowsky one",
     )
     p.add_argument(
-        "--q-deg", type=float, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)"
+        "--q-deg", type=deg_arg, nargs="+", metavar="DEG", help="joint angles [deg] (default: zeros)"
     )
     p.add_argument(
         "--tol",
-        type=float,
+        type=field_arg("singular", "tol"),
         default=sg.RANK_TOL,
         help=f"rank tolerance on singular values (default {sg.RANK_TOL:g})",
     )
     p.add_argument(
         "--length",
-        type=float,
+        type=field_arg("singular", "length"),
         default=None,
         metavar="L",
         help="characteristic length [m] dividing the linear rows",
@@ -84,7 +85,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--search", action="store_true", help="search for singular configurations and cluster them"
     )
     p.add_argument(
-        "--samples", type=int, default=None, help="samples per condition (2000) or search starts (512)"
+        "--samples",
+        type=field_arg("singular", "samples"),
+        default=None,
+        help="samples per condition (2000) or search starts (512)",
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0)")
     p.add_argument(
@@ -106,11 +110,6 @@ def _progress(args: argparse.Namespace) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.samples is not None and args.samples < 1:
-        raise ScenarioError(f"--samples must be >= 1; got {args.samples}")
-    require_finite(args, "tol", "length")
-    if args.length is not None and not args.length > 0:
-        raise ScenarioError(f"--length must be a positive number of metres; got {args.length}")
     check_out_dir(args.out)
     if args.verify_conditions:
         base = args.base or "virtual"

@@ -8,7 +8,7 @@ from pathlib import Path
 from ..errors import ScenarioError
 from ..jobs.tolerance_angle import MAX_GAMMA_SAMPLES, find_tolerance_angle, gamma_sample_count
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, print_json, single_lock
+from ._common import add_robot_arguments, check_out_dir, deg_arg, field_arg, print_json, single_lock
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -26,7 +26,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_robot_arguments(p)
     p.add_argument(
         "--q-target-deg",
-        type=float,
+        type=deg_arg,
         nargs="+",
         required=True,
         metavar="DEG",
@@ -34,20 +34,24 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--gamma-limit-deg",
-        type=float,
+        type=field_arg("tolerance_angle", "gamma_limit_deg"),
         default=180.0,
         metavar="DEG",
         help="sweep |gamma| <= this [deg], in (0, 180] (default 180)",
     )
     p.add_argument(
         "--zoom-deg",
-        type=float,
+        type=field_arg("tolerance_angle", "zoom_deg"),
         default=2.0,
         metavar="DEG",
         help="half-width of the second, narrow gamma range [deg] (002 Fig. 6: 2)",
     )
     p.add_argument(
-        "--step-deg", type=float, default=0.1, metavar="DEG", help="gamma sweep step [deg] (default 0.1)"
+        "--step-deg",
+        type=field_arg("tolerance_angle", "step_deg"),
+        default=0.1,
+        metavar="DEG",
+        help="gamma sweep step [deg] (default 0.1)",
     )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", type=Path, metavar="DIR", help="write plots and sweep.json here")

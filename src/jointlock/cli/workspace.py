@@ -10,7 +10,7 @@ from ..analysis.workspace import MIN_SAMPLES
 from ..errors import ScenarioError
 from ..jobs.workspace import VoxelTooSmallError, study_workspace
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, print_json, require_finite, seed_arg
+from ._common import add_robot_arguments, check_out_dir, field_arg, print_json, seed_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,12 +30,16 @@ def register(sub: argparse._SubParsersAction) -> None:
     add_robot_arguments(p)
     p.add_argument(
         "--samples",
-        type=int,
+        type=field_arg("workspace", "samples"),
         default=200_000,
         help=f"configurations per arm, >= {MIN_SAMPLES} (default 200000)",
     )
     p.add_argument(
-        "--voxel", type=float, default=None, metavar="M", help="voxel side [m] (default: automatic)"
+        "--voxel",
+        type=field_arg("workspace", "voxel"),
+        default=None,
+        metavar="M",
+        help="voxel side [m] (default: automatic)",
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
@@ -44,15 +48,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    if args.samples < MIN_SAMPLES:
-        raise ScenarioError(
-            f"--samples must be >= {MIN_SAMPLES} (a voxel-occupancy volume from fewer samples says "
-            f"little); got {args.samples}"
-        )
-    require_finite(args, "voxel")
     check_out_dir(args.out)
-    if args.voxel is not None and not (args.voxel > 0):
-        raise ScenarioError(f"--voxel must be > 0 [m]; got {args.voxel}")
     if len(args.lock) > 1:
         raise ScenarioError(f"--lock may be given at most once; got {len(args.lock)}")
     model = load_robot(args.robot, base=args.base)
