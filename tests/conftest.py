@@ -2,10 +2,21 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pytest
+from hypothesis import HealthCheck, settings
 
 import jointlock as jl
+
+# Property-based fuzzing (tests/test_fuzz_*.py): the default profile is a fixed, derandomized
+# example budget (the same inputs every run, a couple of minutes in all); HYPOTHESIS_PROFILE=long
+# draws fresh inputs, 20x as many, and keeps failures in the example database.
+_FUZZ = dict(deadline=None, suppress_health_check=[HealthCheck.too_slow, HealthCheck.function_scoped_fixture])
+settings.register_profile("default", derandomize=True, database=None, **_FUZZ)
+settings.register_profile("long", max_examples=2000, **_FUZZ)
+settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE", "default"))
 
 #: Central finite-difference step [rad]; truncation error ~ h^2 * |f'''| ~ 1e-10 for these arms.
 FD_STEP = 1e-6
