@@ -8,11 +8,11 @@ naming what was wrong; every library case a :class:`JointlockError` whose messag
 from __future__ import annotations
 
 import errno
+import json
 import os
-import signal
 import subprocess
 import sys
-import time
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -196,10 +196,21 @@ def cli_usage(capsys, argv: list[str]) -> tuple[int, str]:
     return code, capsys.readouterr().err
 
 
-def test_a_kappa_that_makes_the_motion_diverge_is_said(capsys):
-    """kappa within its bound but far too large for the task: the divergence is one line,
-    naming kappa and the time -- not an error about an internal ``q``."""
-    assert_one_error_line(*cli(capsys, "jump", "canadarm7", "--kappa", "1000", "--fail-at", "3")[::2], "diverges", "kappa = 1000")
+def test_a_fast_arm_keeps_its_kappa_search(tmp_path, capsys):
+    """A speed limit of 20,000 deg/s (within its bound): the search's candidates run fast
+    without counting as diverged, and one candidate that diverges does not stop the search."""
+    path = _write(tmp_path / "fast.toml", JUMP_TASK + "vmax_deg_s = 20000.0\namax_deg_s2 = 20000.0\n")
+    code, out, err = cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "5", "--json", "--quiet")
+    assert code == 0, err
+
+
+def test_a_kappa_that_makes_the_motion_diverge_is_reported_finite(capsys):
+    """kappa within its bound but far too large for the task: the diverging run is stopped
+    (its rates frozen once past 100x the speed limit) and reported as breaking the limits
+    with finite numbers -- no error about an internal ``q``, no inf/NaN."""
+    code, out, err = cli(capsys, "jump", "canadarm7", "--kappa", "1e6", "--fail-at", "3", "--json", "--quiet")
+    assert code == 0 and "NaN" not in out and "Infinity" not in out, err
+    assert json.loads(out)["limits_ok"] is False
 
 
 # --- odd files ------------------------------------------------------------------------------
@@ -229,24 +240,36 @@ def test_a_null_character_in_a_robot_path(capsys, tmp_path):
 # --- timing ---------------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize("delay", [0.05, 0.15, 0.3, 0.6])
-def test_an_interrupt_during_start_up_is_one_line(delay):
-    """SIGINT at several moments of start-up (interpreter, imports, parsing, the start of the
-    run): never a KeyboardInterrupt traceback."""
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "jointlock.cli", "workspace", "halt7", "--samples", "2000000"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.PIPE,
+#: A child process that sends itself SIGINT the moment ``module`` starts being imported: the
+#: same moment on every run, however loaded the machine is.
+INTERRUPT_AT_IMPORT = """
+import os, signal, sys
+class Interrupt:
+    def find_spec(self, name, path=None, target=None):
+        if name == {module!r}:
+            sys.meta_path.remove(self)
+            os.kill(os.getpid(), signal.SIGINT)
+        return None
+sys.meta_path.insert(0, Interrupt())
+from jointlock.cli import main
+sys.exit(main(["workspace", "halt7", "--samples", "1000", "--json"]))
+"""
+
+
+@pytest.mark.parametrize("module", ["numpy", "jointlock.cli.halt", "jointlock.kinematics", "scipy"])
+def test_an_interrupt_during_start_up_imports_is_one_line(module):
+    """SIGINT while the command imports its modules (numpy, the subcommands, the core): one
+    line and exit 130, never a KeyboardInterrupt traceback.  (The interpreter's own start-up,
+    before ``main`` runs -- ~20 ms, a few light modules -- is Python's to handle.)"""
+    proc = subprocess.run(
+        [sys.executable, "-c", INTERRUPT_AT_IMPORT.format(module=module)],
+        capture_output=True,
         text=True,
+        timeout=120,
         env={**os.environ, "MPLBACKEND": "Agg"},
     )
-    time.sleep(delay)
-    proc.send_signal(signal.SIGINT)
-    _, err = proc.communicate(timeout=120)
-    assert "Traceback" not in err and "KeyboardInterrupt" not in err, err
-    assert proc.returncode in (130, -signal.SIGINT), (proc.returncode, err)
-    if proc.returncode == 130:
-        assert err.strip().splitlines()[-1] == "jointlock: interrupted", err
+    assert proc.returncode == 130, (proc.returncode, proc.stderr[-2000:])
+    assert proc.stderr == "jointlock: interrupted\n", proc.stderr[-2000:]
 
 
 def test_import_jointlock_is_light():
@@ -355,7 +378,7 @@ def test_compare_workspaces_with_a_voxel_out_of_bounds():
 
 def test_rnea_with_absurd_rates_is_refused_not_inf():
     arm = jl.load_robot("halt7")
-    with pytest.raises(JointlockError, match=r"dq must lie within \+-1e\+06"):
+    with pytest.raises(JointlockError, match=r"rnea: the result overflows float64 .*\|dq\| up to 1e\+300"):
         jl.rnea(arm, np.zeros(7), np.full(7, 1e300), np.zeros(7))
     result = jl.rnea(arm, np.zeros(7), np.full(7, MAX_JOINT_VALUE), np.zeros(7))  # the bound itself: finite
     for values in (result.torques, result.base_force, result.base_moment):
@@ -377,12 +400,16 @@ def test_a_scenarios_out_resolves_against_its_folder_and_stays_inside(tmp_path, 
     body = 'robot = "puma6"\nout = "{}"\n[workspace]\nsamples = 1000\n'
     monkeypatch.chdir(tmp_path)
     sc = jl.load_scenario(_write(folder / "a.toml", body.format("results/a")))
-    assert Path(sc.data["out"]) == (folder / "results" / "a").resolve()
+    assert sc.data["out"] == os.path.join(os.path.abspath(folder), "results", "a")
+    (folder / "scratch").symlink_to(tmp_path)  # a link inside the folder to elsewhere: as written, fine
+    assert jl.load_scenario(_write(folder / "l.toml", body.format("scratch/r"))).data["out"].endswith("scratch/r")
     for outside in ("../..", str(tmp_path / "elsewhere"), "../x"):
         with pytest.raises(ScenarioError, match="inside the scenario file's folder.*--out"):
             jl.load_scenario(_write(folder / "b.toml", body.format(outside)))
     sc = jl.load_scenario(_write(folder / "c.toml", body.format("../..")), {"out": "../anywhere"})
     assert sc.data["out"] == "../anywhere"  # the command line's --out: the working folder's
+    data = tomllib.loads(body.format(tmp_path / "py"))  # Python's scenario_from_dict: its own choice
+    assert jl.scenario_from_dict(data).data["out"] == str(tmp_path / "py")
 
 
 def _write(path: Path, text: str) -> Path:

@@ -424,7 +424,7 @@ def test_cli_replan_refuses_zero_steps(capsys):
         main(argv)
     assert info.value.code == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "argument --steps: must be an integer >= 1 and <= 100000; got 0" in err
+    assert len(err.splitlines()) == 1 and "argument --steps: must be an integer >= 1 and <= 100000; got '0'" in err
 
 
 def test_default_jump_threshold_is_capped():

@@ -52,6 +52,14 @@ MAX_KAPPA = 1e6
 #: Largest feedback gain [1/s] (a gain above 1/dt is unstable anyway).
 MAX_GAIN = 1e6
 
+#: Largest joint speed and acceleration limits [deg/s, deg/s^2]: far above any arm (the ISS arm
+#: moves at a few deg/s), low enough that rates and accelerations derived from them stay finite.
+MAX_RATE_DEG = 1e6
+#: Largest |angle| of a command-line angle option [deg] (a scenario's *_deg fields keep +-360).
+MAX_OPTION_DEG = 1e6
+#: Largest seed (numpy takes any integer >= 0; seeds are stored as 64-bit integers).
+MAX_SEED = 2**63 - 1
+
 #: Longest text of a value echoed in an error message [characters].
 SHOWN_CHARS = 80
 
@@ -59,10 +67,12 @@ SHOWN_CHARS = 80
 def shown(value: Any, limit: int = SHOWN_CHARS) -> str:
     """``repr(value)`` on one line, shortened to ``limit`` characters (a 5000-character name
     is not echoed back whole; an array's repr loses its line breaks)."""
-    text = " ".join(repr(value).split())
-    if len(text) <= limit:
-        return text
-    return text[: limit - 3] + "..."
+    return shorten(" ".join(repr(value).split()), limit)
+
+
+def shorten(text: str, limit: int = SHOWN_CHARS) -> str:
+    """``text`` cut to ``limit`` characters (with "..."); see :func:`shown` for a repr."""
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def as_real(
@@ -102,6 +112,33 @@ def _is_numpy_real(value: Any) -> bool:
     import numpy as np
 
     return isinstance(value, (np.integer, np.floating)) and not isinstance(value, np.bool_)
+
+
+def check_overflow(results: Any, what: str, **inputs: Any) -> None:
+    """Raise :class:`~jointlock.errors.ConfigurationError` when a computation from finite
+    inputs returned inf or NaN (its products overflowed float64): one line naming ``what``
+    and the largest magnitude of each input (``dq=...``), instead of returning the overflow.
+
+    ``results``: arrays, possibly nested in lists or tuples (``None`` entries skipped); call it after computing under
+    ``np.errstate(over="ignore", invalid="ignore")``."""
+    import numpy as np
+
+    from .errors import ConfigurationError
+
+    def finite(obj: Any) -> bool:
+        if obj is None:
+            return True
+        if isinstance(obj, (list, tuple)):
+            return all(finite(x) for x in obj)
+        return bool(np.all(np.isfinite(obj)))
+
+    if finite(results):
+        return
+    sizes = ", ".join(f"|{k}| up to {float(np.max(np.abs(v), initial=0.0)):.3g}" for k, v in inputs.items())
+    raise ConfigurationError(
+        f"{what}: the result overflows float64 for these inputs ({sizes}): rates and accelerations "
+        f"this large are far beyond any arm (|x| <= {MAX_JOINT_VALUE:g} computes)"
+    )
 
 
 def physical_memory_bytes() -> int | None:

@@ -17,6 +17,7 @@ from numpy.typing import ArrayLike
 
 from ._chain import SYM, composite, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
+from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
 from .kinematics import ChainState, _world_inertias, com_jacobians, com_positions, state_at
 from .model import ArmModel, FloatArray, as_joint_array
@@ -365,7 +366,10 @@ def rnea(
 
     qf, dqf, ddqf = flat(q), flat(dq), flat(ddq)
     n_samples = qf.shape[1]
-    tau, force, moment, acc_base, nu0 = _rnea_rows(model, qf, dqf, ddqf, base, g, point)
+    with np.errstate(over="ignore", invalid="ignore"):  # finite inputs whose products overflow: said below
+        rows = _rnea_rows(model, qf, dqf, ddqf, base, g, point)
+    check_overflow(rows, "rnea", dq=dqf, ddq=ddqf)
+    tau, force, moment, acc_base, nu0 = rows
     return InverseDynamics(
         *(_rows_out(rows, n_samples, batch) for rows in (tau, force, moment, acc_base, nu0)), point
     )

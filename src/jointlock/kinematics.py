@@ -27,6 +27,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._chain import momentum_matrix_soa
+from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
 from .forward import DEFAULT_CHUNK, ChainState, chain_state, ee_pose, ee_positions, link_poses, state_at
 from .model import ArmModel, FloatArray, as_joint_array
@@ -236,7 +237,10 @@ def momentum(model: ArmModel, q: ArrayLike, dq: ArrayLike, base_twist: ArrayLike
     h = momentum_matrix(model, q)
     nu = np.zeros(dq.shape[:-1] + (6,)) if base_twist is None else np.asarray(base_twist, dtype=float)
     full = np.concatenate([np.broadcast_to(nu, dq.shape[:-1] + (6,)), dq], axis=-1)
-    return np.einsum("...ij,...j->...i", h, full)
+    with np.errstate(over="ignore", invalid="ignore"):
+        out = np.einsum("...ij,...j->...i", h, full)
+    check_overflow([out], "momentum", dq=dq, base_twist=nu)
+    return out
 
 
 def system_com(model: ArmModel, q: ArrayLike | None, state: ChainState | None = None) -> FloatArray:

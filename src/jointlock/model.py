@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .bounds import MAX_INERTIA_KGM2, MAX_JOINT_VALUE, MAX_LENGTH_M, MAX_MASS_KG, shown
+from .bounds import MAX_INERTIA_KGM2, MAX_LENGTH_M, MAX_MASS_KG, shown
 from .errors import ConfigurationError, ModelError
 
 FloatArray = NDArray[np.float64]
@@ -383,7 +383,8 @@ class ArmModel:
 
 def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray:
     """Validate a joint-space array: real numbers (not bool or complex), shape
-    (..., model.dof), all finite and within +-:data:`~jointlock.bounds.MAX_JOINT_VALUE`.
+    (..., model.dof), all finite.  (No magnitude bound here: the maths calls this on its own
+    intermediate arrays too; a computation whose result overflows says so, e.g. :func:`rnea`.)
 
     Raises
     ------
@@ -414,12 +415,6 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
     if not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
         raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad}")
-    if arr.size and float(np.max(np.abs(arr))) > MAX_JOINT_VALUE:
-        bad = tuple(int(i) for i in np.argwhere(np.abs(arr) > MAX_JOINT_VALUE)[0])
-        raise ConfigurationError(
-            f"{name} must lie within +-{MAX_JOINT_VALUE:g} (rad, rad/s or rad/s^2: far beyond any arm); "
-            f"got {arr[bad]:g} at index {bad}"
-        )
     return arr
 
 

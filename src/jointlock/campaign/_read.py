@@ -12,8 +12,9 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
+from ..bounds import shown
 from ..errors import CampaignError, ScenarioError
-from ..io.files import read_toml_file
+from ..io.files import check_path_text, read_toml_file
 from ..scenario import DEPRECATED_FIELDS, JOB_ORDER
 from ..scenario._fields import _hint
 from ..scenario._read import check_value as _check
@@ -71,7 +72,7 @@ def campaign_from_dict(
     scenario, scenario_source, scenario_dir = _base_scenario(data.get("scenario"), source, base_dir)
     seed = data.get("seed", 0)
     if isinstance(seed, bool) or not isinstance(seed, int) or not 0 <= seed < 2**63:
-        raise CampaignError(f"{source}: seed must be an integer >= 0; got {seed!r}")
+        raise CampaignError(f"{source}: seed must be an integer >= 0; got {shown(seed)}")
     title = _string(data, "title", source) or Path(source).stem
     out = _string(data, "out", source)
     _string(data, "description", source)
@@ -124,7 +125,7 @@ def campaign_from_dict(
 def _string(data: Mapping[str, Any], key: str, source: str) -> str | None:
     value = data.get(key)
     if value is not None and not isinstance(value, str):
-        raise CampaignError(f"{source}: {key} must be a string; got {value!r} ({type(value).__name__})")
+        raise CampaignError(f"{source}: {key} must be a string; got {shown(value)} ({type(value).__name__})")
     return value
 
 
@@ -143,7 +144,7 @@ def _base_scenario(value: Any, source: str, base_dir: Path) -> tuple[dict[str, A
             f"{source}: scenario must be a scenario file's path or a [scenario] table; got "
             f"{type(value).__name__}"
         )
-    path = Path(value)
+    path = check_path_text(value, f"{source}: scenario", CampaignError)
     path = path if path.is_absolute() else (base_dir / path).resolve()
     return read_toml_file(path, f"{source}: base scenario file", CampaignError), str(path), path.parent
 
@@ -181,7 +182,7 @@ def _named_table(data: Mapping[str, Any], key: str, source: str) -> dict[str, An
     for name, value in _flatten(raw).items():
         current, _ = scenario_field(name, f"{source}: [{key}]")
         if current in out:
-            raise CampaignError(f"{source}: [{key}] gives {current!r} twice (under two names)")
+            raise CampaignError(f"{source}: [{key}] gives {shown(current)} twice (under two names)")
         out[current] = value
     return out
 
@@ -198,6 +199,8 @@ def _value(value: Any, name: str, where: str, base_dir: Path) -> Any:
         in_set = isinstance(value, list) and ": set." in where and spec.kind not in ("numbers", "strings")
         vary = " -- to vary it, list its values in [grid] or [zip]" if in_set else ""
         raise CampaignError(f"{exc}{vary}") from None
+    if name == "robot":
+        check_path_text(checked, where, CampaignError)
     if name == "robot" and Path(checked).suffix.lower() in (".toml", ".urdf") and not Path(checked).is_absolute():
         checked = str((base_dir / checked).resolve())
     return checked
@@ -206,7 +209,7 @@ def _value(value: Any, name: str, where: str, base_dir: Path) -> Any:
 def _sweep(values: Any, name: str, where: str, base_dir: Path) -> tuple[Any, ...]:
     if not isinstance(values, list):
         raise CampaignError(
-            f"{where} must be a list of the values to run (e.g. [1, 2, 3]); got {values!r} "
+            f"{where} must be a list of the values to run (e.g. [1, 2, 3]); got {shown(values)} "
             f"({type(values).__name__})"
         )
     if not values:
@@ -215,7 +218,7 @@ def _sweep(values: Any, name: str, where: str, base_dir: Path) -> tuple[Any, ...
     seen: list[Any] = []
     for i, v in enumerate(checked):
         if v in seen:
-            raise CampaignError(f"{where}[{i}] repeats the value {v!r}: each case would run twice")
+            raise CampaignError(f"{where}[{i}] repeats the value {shown(v)}: each case would run twice")
         seen.append(v)
     return checked
 
@@ -232,10 +235,10 @@ def _sample(raw: Any, source: str) -> SampleSpec | None:
     method = raw.get("method", "random")
     if method not in SAMPLE_METHODS:
         hint = _hint(method, SAMPLE_METHODS) if isinstance(method, str) else ""
-        raise CampaignError(f"{where}: method must be one of {', '.join(SAMPLE_METHODS)}; got {method!r}{hint}")
+        raise CampaignError(f"{where}: method must be one of {', '.join(SAMPLE_METHODS)}; got {shown(method)}{hint}")
     n = raw.get("n")
     if isinstance(n, bool) or not isinstance(n, int) or not 1 <= n <= MAX_CASES:
-        raise CampaignError(f"{where}: n must be an integer 1..{MAX_CASES:,} (points drawn); got {n!r}")
+        raise CampaignError(f"{where}: n must be an integer 1..{MAX_CASES:,} (points drawn); got {shown(n)}")
     if method == "sobol" and n & (n - 1):
         lo = 1 << (n.bit_length() - 1)
         raise CampaignError(
@@ -246,7 +249,7 @@ def _sample(raw: Any, source: str) -> SampleSpec | None:
     if not isinstance(ranges_raw, dict) or not ranges_raw:
         raise CampaignError(
             f'{where}: ranges must be a table of fields with [lo, hi] (e.g. ranges = {{ "halt.T" = [8, 14] }}); '
-            f"got {ranges_raw!r}"
+            f"got {shown(ranges_raw)}"
         )
     ranges: dict[str, tuple[float, float]] = {}
     for name, bounds in _flatten(ranges_raw).items():
@@ -255,12 +258,12 @@ def _sample(raw: Any, source: str) -> SampleSpec | None:
         if spec.kind not in ("number", "int"):
             raise CampaignError(f"{at}: only number and integer fields can be sampled; {current} is {spec.allowed()}")
         if not isinstance(bounds, list) or len(bounds) != 2:
-            raise CampaignError(f"{at} must be [lo, hi]; got {bounds!r}")
+            raise CampaignError(f"{at} must be [lo, hi]; got {shown(bounds)}")
         lo, hi = (_value(b, current, f"{at}[{i}]", Path.cwd()) for i, b in enumerate(bounds))
         if lo > hi:
             raise CampaignError(f"{at}: lo must be <= hi; got [{bounds[0]!r}, {bounds[1]!r}]")
         if current in ranges:
-            raise CampaignError(f"{where}: ranges give {current!r} twice (under two names)")
+            raise CampaignError(f"{where}: ranges give {shown(current)} twice (under two names)")
         ranges[current] = (lo, hi)
     return SampleSpec(method, n, ranges)
 
@@ -345,7 +348,7 @@ def _report(raw: Any, source: str) -> ReportSpec:
                 f"{source}: [report] unknown key {key!r}{_hint(key, _REPORT_KEYS)}; allowed: {', '.join(_REPORT_KEYS)}"
             )
         if not isinstance(value, str):
-            raise CampaignError(f"{source}: report.{key} must be a string; got {value!r}")
+            raise CampaignError(f"{source}: report.{key} must be a string; got {shown(value)}")
     if raw.get("worse") not in (None, "higher", "lower"):
         raise CampaignError(f"{source}: report.worse must be 'higher' or 'lower'; got {raw['worse']!r}")
     names = {k: scenario_field(raw[k], f"{source}: report.{k}")[0] for k in ("x", "y") if k in raw}

@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import importlib
 import importlib.util
-import logging
 import os
 import sys
 import warnings
@@ -113,8 +112,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     behind them) are imported inside this function, so an interrupt during start-up says
     "interrupted" like one during the run.  Warnings are collected while the command runs and
     printed after its output, one line each -- never ahead of an error (an error prints only
-    its line).  A numpy floating-point warning is an error: a result is never printed from
-    inf/NaN."""
+    its line).  numpy floating-point overflow, invalid values and division by zero raise (one
+    error line): a result is never printed from inf/NaN."""
     try:
         return _main(argv)
     except KeyboardInterrupt:
@@ -129,13 +128,17 @@ def _main(argv: Sequence[str] | None) -> int:
     commands = vars(args).pop("_commands", {})
     if extra:  # named by the subcommand, so that the hint points to its --help
         commands.get(args.command, parser).error(f"unrecognized arguments: {' '.join(extra)}")
+    import logging
+
     logging.basicConfig(
         level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s"
     )
     prefix = f"jointlock {args.command}"
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("default")
-        warnings.simplefilter("error", RuntimeWarning)  # numpy overflow / invalid value: an error
+    import numpy as np  # imported by every subcommand already (build_parser)
+
+    # numpy's floating-point overflow, invalid value and division by zero raise (an error line)
+    # instead of warning and returning inf/NaN; Python's own warning filters are kept.
+    with warnings.catch_warnings(record=True) as caught, np.errstate(over="raise", invalid="raise", divide="raise"):
         try:
             code = int(args.func(args) or 0)
             _print_warnings(prefix, caught)
@@ -177,9 +180,9 @@ def _print_warnings(prefix: str, caught: list[warnings.WarningMessage]) -> None:
 
 
 def _numerical_failure(exc: BaseException) -> bool:
-    """Whether ``exc`` is floating-point arithmetic failing (overflow, division by zero, a
-    numpy warning turned error, a linear-algebra routine that did not converge)."""
-    if isinstance(exc, (ArithmeticError, RuntimeWarning)):
+    """Whether ``exc`` is floating-point arithmetic failing (overflow, invalid value, division
+    by zero under the CLI's ``np.errstate``, a linear-algebra routine that did not converge)."""
+    if isinstance(exc, ArithmeticError):  # numpy's FloatingPointError, OverflowError, ZeroDivisionError
         return True
     linalg = sys.modules.get("numpy.linalg")
     return linalg is not None and isinstance(exc, linalg.LinAlgError)

@@ -11,6 +11,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
+from ..bounds import MAX_OPTION_DEG
 from ..errors import ScenarioError
 from ..io.files import json_text, shorten, write_png  # noqa: F401  (write_png re-exported)
 from ..io.files import to_plain as _plain  # noqa: F401  (old name)
@@ -18,7 +19,7 @@ from ..jobs._common import format_matrix, joint_vector_deg, locked_deg, locked_t
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..robots import BUILTIN_ROBOTS, load_robot
-from ..scenario import ALL_TABLES, MAX_ABS_DEG, TOP_FIELDS, Field, check_value
+from ..scenario import ALL_TABLES, TOP_FIELDS, Field, check_value
 
 
 def parse_lock(text: str) -> tuple[int, float]:
@@ -50,8 +51,6 @@ def int_at_least(minimum: int) -> Callable[[str], int]:
     return parse
 
 
-#: argparse type of every ``--seed``: an integer >= 0 (numpy refuses negative seeds).
-seed_arg = int_at_least(0)
 
 
 def field_arg(table: str, name: str) -> Callable[[str], Any]:
@@ -85,15 +84,18 @@ def _spec_arg(spec: Field) -> Callable[[str], Any]:
             raise argparse.ArgumentTypeError(f"must be {spec.allowed()}; got {shorten(text)!r}") from None
         try:
             return check_value(value, spec, "value")
-        except ScenarioError as exc:
-            raise argparse.ArgumentTypeError(str(exc).removeprefix("value ")) from None
+        except ScenarioError:  # said with the text as typed (not as converted: 1e400 -> inf)
+            raise argparse.ArgumentTypeError(f"must be {spec.allowed()}; got {shorten(text)!r}") from None
 
     parse.__name__ = spec.kind  # argparse names the type in its own messages
     return parse
 
 
-#: argparse type of every joint-space vector option in degrees (``--q-deg``, ``--from-deg`` ...).
-deg_arg = number_arg(-MAX_ABS_DEG, MAX_ABS_DEG, unit="deg")
+#: argparse type of every joint-space vector option in degrees (``--q-deg``, ``--from-deg`` ...):
+#: multi-turn joints of a URDF allowed (a scenario's ``*_deg`` fields keep one turn).
+deg_arg = number_arg(-MAX_OPTION_DEG, MAX_OPTION_DEG, unit="deg")
+#: argparse type of every ``--seed``: the scenario's seed field (an integer 0 .. 2**63 - 1).
+seed_arg = field_arg("", "seed")
 
 
 def check_out_dir(path: str | Path | None, option: str = "--out") -> Path | None:

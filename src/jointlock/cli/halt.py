@@ -37,7 +37,6 @@ from ._common import (
     field_arg,
     joint_vector_deg,
     lock_map,
-    number_arg,
     print_json,
     seed_arg,
 )
@@ -93,7 +92,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="DEG",
         help="accelerations at failure [deg/s^2]",
     )
-    p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], > 0 (000: 10)")
+    p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], 0.001 .. 1e6 (000: 10)")
     qf = p.add_mutually_exclusive_group()
     qf.add_argument("--qf-deg", type=deg_arg, nargs="+", metavar="DEG", help="halt configuration [deg]")
     qf.add_argument("--paper-qf", action="store_true", help="use 000's printed q_best (halt7 only)")
@@ -143,7 +142,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--generations",
-        type=number_arg(0, 100_000, integer=True),
+        type=field_arg("halt", "generations"),
         default=100,
         help="GA generations, >= 0 (default 100)",
     )

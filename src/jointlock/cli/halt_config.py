@@ -4,7 +4,6 @@
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
 
 from ..errors import ScenarioError
@@ -139,8 +138,6 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilitySettings | Non
         )
     q0 = joint_vector_deg(model, args.from_q_deg, "--from-q-deg")
     dq0 = joint_vector_deg(model, args.from_dq_deg or None, "--from-dq-deg", rates=True)
-    if not (math.isfinite(args.halt_time) and args.halt_time > 0):
-        raise ScenarioError(f"--halt-time must be a finite number > 0 [s]; got {args.halt_time}")
     ddq0 = joint_vector_deg(model, getattr(args, "from_ddq_deg", None) or None, "--from-ddq-deg", rates=True)
     return ReachabilitySettings(
         FailureState(q0, dq0, ddq0),

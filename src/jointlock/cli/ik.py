@@ -64,8 +64,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 def _target(args: argparse.Namespace) -> np.ndarray:
     if args.pose is not None:
         vals = np.asarray(args.pose, dtype=float)
-        if not np.all(np.isfinite(vals)):
-            raise ScenarioError(f"--pose must be 6 finite numbers; got {args.pose}")
         return pose_from_zyx(vals[:3], np.radians(vals[3:]))
     mat = np.asarray(args.matrix, dtype=float).reshape(4, 4)
     rot = mat[:3, :3]

@@ -22,6 +22,8 @@ from typing import Any
 
 import numpy as np
 
+from ..bounds import shorten  # noqa: F401  (used here, and by the readers)
+
 #: Resolution of every PNG written [dots per inch].
 PNG_DPI = 110
 
@@ -88,11 +90,6 @@ def check_path_text(path: str | Path, what: str, error: type[Exception]) -> Path
     if "\x00" in str(path):
         raise error(f"{what} {shorten(str(path))!r}: a path cannot contain a NUL character")
     return Path(path)
-
-
-def shorten(text: str, limit: int = 80) -> str:
-    """``text`` cut to ``limit`` characters (with "...")."""
-    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def read_text_file(path: str | Path, what: str, error: type[Exception]) -> str:

@@ -66,6 +66,11 @@ def _urdf_text(path: Path, label: str) -> str | bytes:
     return decode_text(data, f"URDF file {shown(label)}", ModelError)
 
 
+def _some_names(names: list[str]) -> str:
+    """The first five link names, each shortened, for an error line."""
+    return ", ".join(repr(shorten(k, 40)) for k in names[:5]) + (", ..." if len(names) > 5 else "")
+
+
 def _origin(elem: ET.Element | None, where: str) -> np.ndarray:
     if elem is None:
         return np.eye(4)
@@ -222,7 +227,7 @@ def read_urdf(
         children[j.parent].append(j)
     roots = [k for k in links if k not in parent_of]
     if len(roots) != 1:
-        names = ", ".join(repr(shorten(r, 40)) for r in roots[:5]) + (", ..." if len(roots) > 5 else "")
+        names = _some_names(roots)
         why = " (every link has a parent: the joints form a cycle)" if not roots else ""
         raise ModelError(f"{label}: expected exactly one root link; found {len(roots)}: [{names}]{why}")
     root_link = roots[0]
@@ -245,7 +250,7 @@ def read_urdf(
             stack.append(j.child)
     unreached = [k for k in links if k not in owner]
     if unreached:  # beside the tree from the root: links whose joints form a closed loop
-        names = ", ".join(repr(shorten(k, 40)) for k in unreached[:5]) + (", ..." if len(unreached) > 5 else "")
+        names = _some_names(unreached)
         raise ModelError(
             f"{label}: links {names} are not connected to the root link {shown(root_link)} (their joints "
             "form a closed loop); a model is one tree from its root"

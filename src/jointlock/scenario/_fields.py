@@ -7,7 +7,17 @@ from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
-from ..bounds import MAX_GAIN, MAX_KAPPA, MAX_LENGTH_M, MAX_TIME_S, MIN_LENGTH_M, MIN_STEP_S, MIN_TIME_S
+from ..bounds import (
+    MAX_GAIN,
+    MAX_KAPPA,
+    MAX_LENGTH_M,
+    MAX_RATE_DEG,
+    MAX_SEED,
+    MAX_TIME_S,
+    MIN_LENGTH_M,
+    MIN_STEP_S,
+    MIN_TIME_S,
+)
 
 #: Jobs a scenario can run, in the order they run (a halt uses the halt configuration found
 #: before it).
@@ -34,9 +44,6 @@ JOB_PAPER: dict[str, str] = {
 
 #: Largest |angle| accepted in an ``*_deg`` field [deg] (one turn either way).
 MAX_ABS_DEG = 360.0
-
-#: Largest seed (numpy takes any integer >= 0; a seed is stored as a 64-bit integer).
-MAX_SEED = 2**63 - 1
 
 #: Fewest ``workspace.samples`` (:data:`jointlock.analysis.workspace.MIN_SAMPLES`).
 WORKSPACE_MIN_SAMPLES = 1000
@@ -106,9 +113,6 @@ def _length(help_: str, default: Any = None, *, lo: float = MIN_LENGTH_M) -> Fie
     """A length [m] a computation divides by, within the bounds of :mod:`jointlock.bounds`."""
     return Field("number", default, lo=lo, hi=MAX_LENGTH_M, unit="m", help=help_)
 
-
-#: Largest joint speed and acceleration limits [deg/s, deg/s^2] (MAX_JOINT_VALUE rad/s ~ 5.7e7).
-MAX_RATE_DEG = 1e6
 
 
 #: Top-level scalar fields.
@@ -202,7 +206,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         ),
         "samples": Field("int", 36000, lo=2, hi=5_000_000, help="Monte Carlo samples when no halt_config"),
         "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
-        "generations": Field("int", 100, lo=1, hi=100_000, help="GA generations"),
+        "generations": Field("int", 100, lo=0, hi=100_000, help="GA generations (0: the first population only)"),
         "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
         "minimum_T": Field(
             "bool",

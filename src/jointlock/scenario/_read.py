@@ -5,6 +5,7 @@ from __future__ import annotations
 import copy
 import dataclasses
 import math
+import os
 import tomllib
 from collections.abc import Mapping
 from pathlib import Path
@@ -66,28 +67,30 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     if out_given is not None:  # the file's out is not used: not checked either
         data = {k: v for k, v in data.items() if k != "out"}
     sc = scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
+    _resolve_out(sc.data, str(path), path.parent)
     if out_given is not None:
         sc.data["out"] = check_value(out_given, TOP_FIELDS["out"], "--out")
         applied["out"] = {"file": data.get("out"), "value": out_given}
     return dataclasses.replace(sc, overrides=applied) if applied else sc
 
 
-def _resolve_out(out: dict[str, Any], source: str, base_dir: Path) -> None:
+def _resolve_out(out: dict[str, Any], source: str, folder: Path) -> None:
     """A file's ``out``: relative to the file's folder, and inside it -- a scenario someone
     sends you cannot write over ``../..`` or an absolute path; the command line's ``--out``
-    can (it is not checked here)."""
+    can (it is not checked here), and so can Python (:func:`scenario_from_dict`).  The paths
+    are compared as written (no links followed: a link to a scratch disk is fine)."""
     given = out.get("out")
     if not given:
         return
     check_path_text(given, f"{source}: out", ScenarioError)
-    folder = base_dir.resolve()
-    target = (folder / given).resolve()
-    if target != folder and folder not in target.parents:
+    folder_text = os.path.normpath(os.path.abspath(folder))
+    target = os.path.normpath(os.path.join(folder_text, given))
+    if target != folder_text and not target.startswith(folder_text.rstrip(os.sep) + os.sep):
         raise ScenarioError(
-            f"{source}: out must be a folder inside the scenario file's folder ({shown(str(folder))}); got "
+            f"{source}: out must be a folder inside the scenario file's folder ({shown(folder_text)}); got "
             f"{shown(given)}: give --out on the command line to write elsewhere"
         )
-    out["out"] = str(target)
+    out["out"] = target
 
 
 def parse_set(text: str) -> tuple[str, Any]:
@@ -285,6 +288,5 @@ def scenario_from_dict(
     out.pop("jobs", None)
     _inherit_singular_base(out, jobs, given_base="base" in data)
     _resolve_robot(out, source, base_dir)
-    _resolve_out(out, source, base_dir)
     _check_semantics(out, jobs, source)
     return Scenario(data=out, jobs=jobs, source=source, base_dir=base_dir)

@@ -126,23 +126,34 @@ class _RunOut:
     task_noreplan: FloatArray | None = None  # (B, N, 3) -J_j qd_j
 
 
+#: A run has diverged when a joint rate exceeds this many times the speed limit (and at least
+#: :data:`DIVERGED_RATE_MIN`): the resolved-rate law has left every physical range.
+DIVERGED_FACTOR = 100.0
+#: Smallest divergence threshold [rad/s] (~57,000 deg/s).
+DIVERGED_RATE_MIN = 1e3
+
+
+def _stop_diverged(qd: np.ndarray, kappa: np.ndarray, t: float, limit: float) -> np.ndarray:
+    """(m,) runs of a step whose joint rates passed ``limit`` [rad/s] (a compensation
+    coefficient far too large makes the resolved-rate law diverge).  They break the speed limit
+    already, so they are infeasible; their rates are zeroed from here on (``qd`` in place) so
+    that nothing overflows into inf/NaN.  When every run of the batch diverged -- a kappa
+    given by the user, not one among a search's candidates -- raise :class:`InfeasibleError`
+    saying so in one line."""
+    peak = np.abs(qd).max(-1)
+    diverged = peak > limit
+    if diverged.all():
+        run = int(np.argmax(peak))
+        raise InfeasibleError(
+            f"the motion diverges at t = {t:.6g} s: a joint rate reaches {peak[run]:.3g} rad/s "
+            f"(> {limit:g}) with kappa = {float(kappa[run]):.6g} rad^2/(s m^3); kappa is far too large "
+            "for this task (the search keeps it within +-2 vmax / |grad w|)"
+        )
+    qd[diverged] = 0.0
+    return diverged
+
+
 # Long on purpose: one explicit-Euler loop over all batched runs, whose per-step state is shared.
-#: A joint rate [rad/s] no arm reaches (~57,000 deg/s): the resolved-rate motion has diverged.
-DIVERGED_RATE = 1e3
-
-
-def _diverged(qd: np.ndarray, kappa: np.ndarray, t: float) -> None:
-    """Raise :class:`InfeasibleError`: a run's joint rates left every physical range (a
-    compensation coefficient far too large makes the resolved-rate law diverge), said in one
-    line instead of overflowing into inf/NaN further on."""
-    run = int(np.argmax(np.abs(qd).max(-1)))
-    raise InfeasibleError(
-        f"the motion diverges at t = {t:.6g} s: a joint rate reaches {np.abs(qd[run]).max():.3g} rad/s "
-        f"(> {DIVERGED_RATE:g}) with kappa = {float(kappa[run]):.6g} rad^2/(s m^3); kappa is far too large "
-        "for this task (the search keeps it within +-2 vmax / |grad w|)"
-    )
-
-
 def _integrate(
     prob: _Problem,
     kappa: FloatArray,
@@ -173,6 +184,7 @@ def _integrate(
     )
     qd_prev = np.zeros((B, n))
     max_vel = np.zeros(B)
+    diverged_rate = max(DIVERGED_RATE_MIN, DIVERGED_FACTOR * sc.vmax)
     max_acc = np.zeros(B)
     max_dev = np.zeros(B)
     min_w = np.full(B, np.inf)
@@ -229,8 +241,8 @@ def _integrate(
                 out.qd_plus[sl, k] = qd2
                 out.task_plus[sl, k] = np.einsum("...rc,...c->...r", jac, qd2 - qd)
                 out.task_noreplan[sl, k] = -jac[..., jump_col] * qd[:, jump_col, None]
-        if np.abs(qd).max(initial=0.0) > DIVERGED_RATE:
-            _diverged(qd, kappa[sl, k], k * dt)
+        if m and np.abs(qd).max() > diverged_rate:
+            _stop_diverged(qd, kappa[sl, k], k * dt, diverged_rate)
         qd_prev[sl] = qd
         q[sl] = q[sl] + dt * qd
         if rb is not None:
