@@ -69,10 +69,18 @@ def assert_one_error_line(code: int, err: str, *words: str) -> None:
     ("name", "data", "words"),
     [
         ("bin.urdf", bytes(range(256)) * 4, ["a binary file, not text"]),
-        ("latin1.urdf", ARM5.read_text().replace("arm5", "arm5\u00e9").encode("latin-1"), ["not UTF-8 text", "line 4"]),
+        (
+            "latin1.urdf",
+            ARM5.read_text().replace("arm5", "arm5\u00e9").encode("latin-1"),
+            ["not UTF-8 text", "line 4"],
+        ),
         ("latin1.toml", MODEL_TOML.replace("t3", "t3\u00e9").encode("latin-1"), ["not UTF-8 text", "line 1"]),
         ("bin.toml", b"\x00\x01\x02name = 1\n\xff", ["a binary file"]),
-        ("bom_garbage.toml", b"\xef\xbb\xbfname = '\xff'", ["not valid UTF-8 text after its byte-order mark"]),
+        (
+            "bom_garbage.toml",
+            b"\xef\xbb\xbfname = '\xff'",
+            ["not valid UTF-8 text after its byte-order mark"],
+        ),
     ],
 )
 def test_model_files_in_another_encoding_give_one_line(capsys, tmp_path, name, data, words):
@@ -91,7 +99,9 @@ def test_unicode_with_a_byte_order_mark_is_read(tmp_path, encoding):
     toml.write_bytes(MODEL_TOML.encode(encoding))
     q = np.linspace(-1, 1, ref_urdf.dof)
     np.testing.assert_array_equal(jl.ee_pose(jl.load_robot(urdf), q), jl.ee_pose(ref_urdf, q))
-    np.testing.assert_array_equal(jl.ee_pose(jl.load_robot(toml), [0.1, 0.2, 0.3]), jl.ee_pose(ref_toml, [0.1, 0.2, 0.3]))
+    np.testing.assert_array_equal(
+        jl.ee_pose(jl.load_robot(toml), [0.1, 0.2, 0.3]), jl.ee_pose(ref_toml, [0.1, 0.2, 0.3])
+    )
 
 
 def test_a_urdf_declaring_latin1_is_decoded_by_its_declaration(tmp_path):
@@ -103,11 +113,15 @@ def test_a_urdf_declaring_latin1_is_decoded_by_its_declaration(tmp_path):
 
 def test_scenario_and_task_files_in_another_encoding(capsys, tmp_path):
     scen = tmp_path / "s.toml"
-    scen.write_bytes((ROOT / "examples" / "replan_002.toml").read_text().replace("002:", "002\u00e9:").encode("latin-1"))
+    scen.write_bytes(
+        (ROOT / "examples" / "replan_002.toml").read_text().replace("002:", "002\u00e9:").encode("latin-1")
+    )
     assert_one_error_line(*cli(capsys, "run", scen)[::2], "not UTF-8 text")
     task = tmp_path / "task.toml"
     task.write_bytes(JUMP_TASK.encode("latin-1") + b"# \xe9\n")
-    assert_one_error_line(*cli(capsys, "jump", "canadarm7", "--scenario", task, "--fail-at", "3")[::2], "not UTF-8")
+    assert_one_error_line(
+        *cli(capsys, "jump", "canadarm7", "--scenario", task, "--fail-at", "3")[::2], "not UTF-8"
+    )
 
 
 # --- numbers TOML allows but floats do not ------------------------------------------------------
@@ -118,7 +132,10 @@ def test_a_400_digit_integer_in_a_model_file(capsys, tmp_path):
     assert_one_error_line(*cli(capsys, "kinematics", path)[::2], "joint #1.d_m", "400 digits")
 
 
-@pytest.mark.parametrize(("old", "new", "field"), [("seed = 0", f"seed = {BIG}", "seed"), ("steps = 40", f"steps = {BIG}", "replan.steps")])
+@pytest.mark.parametrize(
+    ("old", "new", "field"),
+    [("seed = 0", f"seed = {BIG}", "seed"), ("steps = 40", f"steps = {BIG}", "replan.steps")],
+)
 def test_a_400_digit_integer_in_a_scenario(capsys, tmp_path, old, new, field):
     path = _write(tmp_path / "s.toml", (ROOT / "examples" / "replan_002.toml").read_text().replace(old, new))
     assert_one_error_line(*cli(capsys, "run", path)[::2], field, "400 digits")
@@ -126,7 +143,9 @@ def test_a_400_digit_integer_in_a_scenario(capsys, tmp_path, old, new, field):
 
 def test_a_400_digit_integer_in_a_jump_task(capsys, tmp_path):
     path = _write(tmp_path / "t.toml", JUMP_TASK + f"duration_s = {BIG}\n")
-    assert_one_error_line(*cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "3")[::2], "duration_s")
+    assert_one_error_line(
+        *cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "3")[::2], "duration_s"
+    )
 
 
 @pytest.mark.parametrize(
@@ -148,7 +167,9 @@ def test_extreme_jump_fields_in_a_scenario(capsys, tmp_path, field, value, words
 def test_a_jump_task_too_many_steps(capsys, tmp_path):
     """1e-6 s steps over 1e6 s: each value within its bounds, the step count (1e12) is not."""
     path = _write(tmp_path / "t.toml", JUMP_TASK + "duration_s = 1000000.0\ndt_s = 1e-6\nblend_s = 1.0\n")
-    assert_one_error_line(*cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "3")[::2], "control steps")
+    assert_one_error_line(
+        *cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "3")[::2], "control steps"
+    )
 
 
 @pytest.mark.parametrize(
@@ -156,15 +177,59 @@ def test_a_jump_task_too_many_steps(capsys, tmp_path):
     [
         (["workspace", "puma6", "--voxel", "1e-300", "--samples", "1000"], ["--voxel", ">= 1e-06"]),
         (["workspace", "puma6", "--voxel", "1e308", "--samples", "1000"], ["--voxel", "<= 1e+06"]),
-        (["tolerance-angle", "puma6", "--lock", "2=59.4", "--q-target-deg", "5", "60", "35", "10", "-120", "90", "--step-deg", "1e-320"], ["--step-deg"]),
+        (
+            [
+                "tolerance-angle",
+                "puma6",
+                "--lock",
+                "2=59.4",
+                "--q-target-deg",
+                "5",
+                "60",
+                "35",
+                "10",
+                "-120",
+                "90",
+                "--step-deg",
+                "1e-320",
+            ],
+            ["--step-deg"],
+        ),
         (["halt-config", "halt7", "--lock", "4=0", "--length", "1e-320", "--samples", "100"], ["--length"]),
         (["singular", "canadarm7", "--length", "1e-320"], ["--length"]),
         (["halt", "halt7", "--lock", "4=0", "--T", "1e308"], ["--T", "[s]"]),
         (["halt", "halt7", "--lock", "4=0", "--T", "1e-300"], ["--T"]),
-        (["replan", "puma6", "--lock", "2=59.4", "--from-deg", "0", "60", "0", "0", "0", "0", "--to-deg", "5", "60", "35", "10", "-120", "90", "--cycle", "1e-320"], ["--cycle"]),
+        (
+            [
+                "replan",
+                "puma6",
+                "--lock",
+                "2=59.4",
+                "--from-deg",
+                "0",
+                "60",
+                "0",
+                "0",
+                "0",
+                "0",
+                "--to-deg",
+                "5",
+                "60",
+                "35",
+                "10",
+                "-120",
+                "90",
+                "--cycle",
+                "1e-320",
+            ],
+            ["--cycle"],
+        ),
         (["jump", "canadarm7", "--kappa", "1e308", "--fail-at", "3"], ["--kappa"]),
         (["ik", "puma6", "--pose", "1e308", "0", "0", "0", "0", "0"], ["--pose"]),
-        (["ik", "puma6", "--pose", "0.5", "0.2", "0.3", "0", "0", "0", "--length-scale", "1e-320"], ["--length-scale"]),
+        (
+            ["ik", "puma6", "--pose", "0.5", "0.2", "0.3", "0", "0", "0", "--length-scale", "1e-320"],
+            ["--length-scale"],
+        ),
         (["kinematics", "halt7", "--q-deg", "1e308", "0", "0", "0", "0", "0", "0"], ["--q-deg"]),
     ],
 )
@@ -177,7 +242,28 @@ def test_extreme_option_values_name_the_option(capsys, argv, words):
     [
         ["halt-config", "halt7", "--lock", "4=0", "--samples", "4294967297"],
         ["workspace", "puma6", "--samples", "4294967297"],
-        ["replan", "puma6", "--lock", "2=59.4", "--from-deg", "0", "60", "0", "0", "0", "0", "--to-deg", "5", "60", "35", "10", "-120", "90", "--steps", "4294967297"],
+        [
+            "replan",
+            "puma6",
+            "--lock",
+            "2=59.4",
+            "--from-deg",
+            "0",
+            "60",
+            "0",
+            "0",
+            "0",
+            "0",
+            "--to-deg",
+            "5",
+            "60",
+            "35",
+            "10",
+            "-120",
+            "90",
+            "--steps",
+            "4294967297",
+        ],
         ["singular", "canadarm7", "--search", "--samples", "4294967297"],
         ["jump", "canadarm7", "--sweep", "4294967297"],
         ["halt", "halt7", "--lock", "4=0", "--samples", "4294967297"],
@@ -200,7 +286,9 @@ def test_a_fast_arm_keeps_its_kappa_search(tmp_path, capsys):
     """A speed limit of 20,000 deg/s (within its bound): the search's candidates run fast
     without counting as diverged, and one candidate that diverges does not stop the search."""
     path = _write(tmp_path / "fast.toml", JUMP_TASK + "vmax_deg_s = 20000.0\namax_deg_s2 = 20000.0\n")
-    code, out, err = cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "5", "--json", "--quiet")
+    code, out, err = cli(
+        capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "5", "--json", "--quiet"
+    )
     assert code == 0, err
 
 
@@ -231,7 +319,11 @@ def test_a_urdf_origin_beyond_physical_lengths(capsys, tmp_path):
 
 
 def test_a_null_character_in_a_robot_path(capsys, tmp_path):
-    text = (ROOT / "examples" / "replan_002.toml").read_text().replace('robot = "puma6"', 'robot = "\\u0000.urdf"')
+    text = (
+        (ROOT / "examples" / "replan_002.toml")
+        .read_text()
+        .replace('robot = "puma6"', 'robot = "\\u0000.urdf"')
+    )
     path = _write(tmp_path / "s.toml", text)
     assert_one_error_line(*cli(capsys, "run", path)[::2], "NUL character")
     assert_one_error_line(*cli(capsys, "kinematics", "a\x00b.urdf")[::2], "NUL character")
@@ -294,7 +386,10 @@ def test_no_warning_is_printed_ahead_of_an_error(capsys):
 def test_warnings_come_after_the_output_one_line_each(capsys):
     code, out, err = cli(capsys, "jump", "canadarm7", "--fail-at", "3", "--single", "--quiet")
     assert code == 0 and out
-    assert err == "jointlock jump: warning: --single ignored with --fail-at (one failure time, no kappa(t) fit)\n"
+    assert (
+        err
+        == "jointlock jump: warning: --single ignored with --fail-at (one failure time, no kappa(t) fit)\n"
+    )
 
 
 def test_a_numpy_warning_is_an_error_not_a_result(capsys, monkeypatch):
@@ -402,7 +497,11 @@ def test_a_scenarios_out_resolves_against_its_folder_and_stays_inside(tmp_path, 
     sc = jl.load_scenario(_write(folder / "a.toml", body.format("results/a")))
     assert sc.data["out"] == os.path.join(os.path.abspath(folder), "results", "a")
     (folder / "scratch").symlink_to(tmp_path)  # a link inside the folder to elsewhere: as written, fine
-    assert jl.load_scenario(_write(folder / "l.toml", body.format("scratch/r"))).data["out"].endswith("scratch/r")
+    assert (
+        jl.load_scenario(_write(folder / "l.toml", body.format("scratch/r")))
+        .data["out"]
+        .endswith("scratch/r")
+    )
     for outside in ("../..", str(tmp_path / "elsewhere"), "../x"):
         with pytest.raises(ScenarioError, match="inside the scenario file's folder.*--out"):
             jl.load_scenario(_write(folder / "b.toml", body.format(outside)))
@@ -415,3 +514,133 @@ def test_a_scenarios_out_resolves_against_its_folder_and_stays_inside(tmp_path, 
 def _write(path: Path, text: str) -> Path:
     path.write_text(text, encoding="utf-8")
     return path
+
+
+# --- found by a first-user walkthrough of the above -----------------------------------------
+
+
+def _jointlock(args: str, **env: str) -> subprocess.CompletedProcess:
+    """``jointlock ARGS`` through a shell (for redirections such as ``>&-``)."""
+    return subprocess.run(
+        f"{sys.executable} -m jointlock.cli {args}", shell=True, capture_output=True, text=True, timeout=120,
+        env={**os.environ, "MPLBACKEND": "Agg", **env},
+    )  # fmt: skip
+
+
+def test_odd_standard_streams():
+    closed = _jointlock("robots >&-")
+    assert closed.returncode == 0 and "Traceback" not in closed.stderr, closed.stderr
+    ascii_only = _jointlock("robots", PYTHONIOENCODING="ascii")
+    assert ascii_only.returncode == 0 and "\\xa75" in ascii_only.stdout, ascii_only.stderr  # "§5" escaped
+    if Path("/dev/full").exists():
+        full = _jointlock("robots > /dev/full")
+        assert (
+            full.returncode == 2
+            and full.stderr == "jointlock robots: error: '<standard output>': No space left on device\n"
+        )
+
+
+def test_inputs_that_are_not_regular_files(capsys, tmp_path):
+    (tmp_path / "zero.toml").symlink_to("/dev/zero")
+    assert_one_error_line(*cli(capsys, "kinematics", tmp_path / "zero.toml")[::2], "not a regular file")
+    assert_one_error_line(*cli(capsys, "run", tmp_path / "zero.toml")[::2], "not a regular file")
+    (tmp_path / "dir.urdf").mkdir()
+    assert_one_error_line(*cli(capsys, "kinematics", tmp_path / "dir.urdf")[::2], "is a folder")
+    (tmp_path / "a.urdf").symlink_to(tmp_path / "b.urdf")
+    (tmp_path / "b.urdf").symlink_to(tmp_path / "a.urdf")
+    scenario = _write(tmp_path / "s.toml", 'robot = "a.urdf"\n[workspace]\nsamples = 1000\n')
+    assert_one_error_line(*cli(capsys, "run", scenario)[::2], "robot: cannot use model file")
+
+
+def test_the_largest_seed_is_accepted(capsys):
+    top = str(2**63 - 1)
+    assert cli(capsys, "workspace", "puma6", "--samples", "1000", "--seed", top, "--json")[0] == 0
+    assert_one_error_line(
+        *cli_usage(capsys, ["workspace", "puma6", "--seed", str(2**63)]), "<= 9223372036854775807"
+    )
+
+
+def test_a_large_arm_can_be_locked(tmp_path):
+    """Each model-file length within 1e6 m: locking composes two of them, still accepted."""
+    big = ARM5.read_text().replace(
+        '<origin xyz="1.0 0 0" rpy="0 0 0"/>', '<origin xyz="900000 0 0" rpy="0 0 0"/>'
+    )
+    big = big.replace(
+        '<origin xyz="0.8 0 0" rpy="0 -1.5707963267948966 0"/>',
+        '<origin xyz="900000 0 0" rpy="0 -1.5707963267948966 0"/>',
+    )
+    arm = jl.read_urdf(_write(tmp_path / "big.urdf", big))
+    locked = jl.lock(arm, 4, 0.0)
+    assert np.all(np.isfinite(jl.ee_pose(locked, np.zeros(locked.dof))))
+
+
+def test_a_robot_given_on_the_command_line_is_relative_to_the_working_folder(tmp_path, monkeypatch):
+    folder = tmp_path / "scenarios"
+    folder.mkdir()
+    scenario = _write(folder / "s.toml", 'robot = "puma6"\n[workspace]\nsamples = 1000\n')
+    monkeypatch.chdir(tmp_path)
+    _write(tmp_path / "arm.urdf", ARM5.read_text())
+    assert jl.load_scenario(scenario, {"robot": "arm.urdf"}).data["robot"] == str(tmp_path / "arm.urdf")
+
+
+def test_a_campaign_files_out_stays_in_its_folder(tmp_path):
+    from jointlock.campaign import load_campaign
+
+    body = 'scenario = "{}"\nout = "../../evil"\n[grid]\n"workspace.samples" = [1000, 2000]\n'
+    scenario = _write(tmp_path / "s.toml", 'robot = "puma6"\n[workspace]\nsamples = 1000\n')
+    with pytest.raises(JointlockError, match="out must be a folder inside the campaign file's folder"):
+        load_campaign(_write(tmp_path / "c.toml", body.format(scenario)))
+
+
+def test_control_characters_in_a_model_name_are_refused(capsys, tmp_path):
+    path = _write(
+        tmp_path / "esc.toml", MODEL_TOML.replace('name = "t3"', 'name = "\\u001b[2J\\u001b[31mPWNED"')
+    )
+    assert_one_error_line(*cli(capsys, "kinematics", path)[::2], "control characters")
+
+
+def test_a_urdf_without_links(capsys, tmp_path):
+    path = _write(tmp_path / "empty.urdf", '<robot name="x"/>')
+    assert_one_error_line(*cli(capsys, "kinematics", path)[::2], "no <link> found")
+
+
+def test_a_task_too_fast_even_without_compensation(capsys, tmp_path):
+    path = _write(tmp_path / "fast.toml", JUMP_TASK.replace("[1.2, -1.5, 0.8]", "[1000.0, 1000.0, 1000.0]"))
+    code, _, err = cli(capsys, "jump", "canadarm7", "--scenario", path, "--fail-at", "3", "--quiet")
+    assert_one_error_line(code, err, "kappa = 0", "the task itself is too fast")
+
+
+def test_a_search_whose_candidates_are_large_kappas_runs(capsys, tmp_path):
+    """A floating base's search scales its candidates with vmax / |grad w|: far above the bound
+    on a user's kappa, and accepted (the bound is on what a user types)."""
+    path = _write(tmp_path / "t.toml", JUMP_TASK)
+    code, out, err = cli(
+        capsys,
+        "jump",
+        "canadarm7",
+        "--base",
+        "floating",
+        "--scenario",
+        path,
+        "--fail-at",
+        "3",
+        "--json",
+        "--quiet",
+    )
+    assert code in (0, 2) and "kappa must be finite" not in err, err
+
+
+@pytest.mark.parametrize(
+    ("text", "words"),
+    [
+        ("hi", "not a scheduler's JSON"),
+        ("{}", "no scheduler address"),
+        ('{"address": 5}', "no scheduler address"),
+    ],
+)
+def test_a_dask_scheduler_file_that_is_not_one(tmp_path, text, words):
+    pytest.importorskip("distributed")
+    from jointlock.campaign._engines import dask_cluster
+
+    with pytest.raises(JointlockError, match=words):
+        dask_cluster(scheduler_file=str(_write(tmp_path / "scheduler.json", text)))

@@ -75,7 +75,7 @@ def test_kinematics_reads_a_urdf_file():
         (["kinematics", "halt7", "--q-deg", "1", "2"], "--q-deg needs 7 values"),
         (["kinematics", "halt7", "--lock", "4=zero"], "--lock must look like J=DEG"),
         (["kinematics", "puma6", "--q-deg", "nan", "0", "0", "0", "0", "0"], "must be a finite number"),
-        (["kinematics", "/nonexistent.urdf"], "cannot read URDF file"),
+        (["kinematics", "/nonexistent.urdf"], "URDF file '/nonexistent.urdf' does not exist"),
     ],
 )
 def test_errors_are_one_line_without_traceback(args, message):

@@ -365,7 +365,7 @@ def test_reduction_is_undefined_without_a_jump(arm):
 
 
 def test_load_jump_task_unreadable_files(tmp_path):
-    with pytest.raises(jl.ScenarioError, match="cannot read scenario file .*: Is a directory"):
+    with pytest.raises(jl.ScenarioError, match="scenario file .* is a folder, not a file"):
         load_jump_task(tmp_path)
     bad = tmp_path / "latin1.toml"
     bad.write_bytes("kp = 1.5 # \xe9\n".encode("latin-1"))

@@ -68,7 +68,7 @@ def test_toml_model_equals_the_builtin(tmp_path, rng):
         ('convention = "dh_standard"\n', r"at least one \[\[joint\]\]"),
         (
             'convention = "dh_standard"\n[[joint]]\nd_m = "long"\n',
-            "field 'd_m' must be a finite real number; got 'long'",
+            r"field 'd_m' must be a finite real number >= -1e\+06 and <= 1e\+06 \[m\]; got 'long'",
         ),
         (
             'convention = "dh_standard"\n[[joint]]\nmass_kg = -3\n',

@@ -473,3 +473,16 @@ def test_cli_replan_velocity_legend(tmp_path, monkeypatch):
     ]
     assert main(argv) == 0
     assert {"vx", "vy", "vz", "wx", "wy", "wz"} <= set(labels)
+
+
+@pytest.mark.parametrize("q5_deg", [30.0, 45.0])
+def test_a_target_already_at_the_lock_angle_is_absorbed_at_gamma_zero(q5_deg):
+    """theta_5(gamma) of puma6 at q = (0, 0, 0, 0, q5, 0) has its minimum, q5, at gamma = 0:
+    the root touches the lock angle without crossing it, which a sign-change search misses
+    (found by a first-user walkthrough: "no gamma within +-180 deg" for the target itself)."""
+    from jointlock.planning.replan import gammas_for_lock
+
+    arm = jl.load_robot("puma6")
+    q = np.radians([0.0, 0.0, 0.0, 0.0, q5_deg, 0.0])
+    roots = gammas_for_lock(arm, jl.ee_pose(arm, q), 5, math.radians(q5_deg), q_ref=q)
+    assert roots and abs(roots[0].gamma) < 1e-6

@@ -31,6 +31,9 @@ from .errors import JointlockError
 
 #: Largest |length| of a model dimension, a pose or a displacement [m].
 MAX_LENGTH_M = 1e6
+#: Largest |length| an ArmModel holds [m]: a safety net above MAX_LENGTH_M, as the placements
+#: of a locked arm compose several lengths of the model files (each within MAX_LENGTH_M).
+MAX_MODEL_LENGTH_M = 1e12
 #: Smallest length that a computation divides by (characteristic length, voxel side) [m].
 MIN_LENGTH_M = 1e-6
 #: Largest mass of a link or a spacecraft [kg].

@@ -57,8 +57,8 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
     if check_limits and not (jnt.lower - LOCK_LIMIT_SLACK <= angle <= jnt.upper + LOCK_LIMIT_SLACK):
         raise ModelError(
             f"lock angle of joint {joint} must lie within its limits "
-            f"[{math.degrees(jnt.lower):.6g}, {math.degrees(jnt.upper):.6g}] deg; "
-            f"got {math.degrees(angle):.6g} deg"
+            f"[{math.degrees(jnt.lower):.10g}, {math.degrees(jnt.upper):.10g}] deg; "
+            f"got {math.degrees(angle):.10g} deg"
         )
     if model.dof == 1:
         raise ModelError(f"cannot lock joint {joint}: it is the only movable joint of {model.name!r}")

@@ -26,7 +26,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .bounds import MAX_INERTIA_KGM2, MAX_LENGTH_M, MAX_MASS_KG, shown
+from .bounds import MAX_INERTIA_KGM2, MAX_MASS_KG, MAX_MODEL_LENGTH_M, shown
 from .errors import ConfigurationError, ModelError
 
 FloatArray = NDArray[np.float64]
@@ -48,8 +48,8 @@ def _vector3(value: ArrayLike, name: str) -> FloatArray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)):
         raise ModelError(f"{name} must be 3 finite numbers [m]; got {shown(np.asarray(value).tolist())}")
-    if np.any(np.abs(arr) > MAX_LENGTH_M):
-        raise ModelError(f"{name} must lie within +-{MAX_LENGTH_M:g} m; got {shown(arr.tolist())}")
+    if np.any(np.abs(arr) > MAX_MODEL_LENGTH_M):
+        raise ModelError(f"{name} must lie within +-{MAX_MODEL_LENGTH_M:g} m; got {shown(arr.tolist())}")
     return arr
 
 
@@ -57,9 +57,9 @@ def _transform(value: ArrayLike, name: str) -> FloatArray:
     arr = np.asarray(value, dtype=float)
     if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
         raise ModelError(f"{name} must be a finite 4x4 homogeneous transform; got shape {arr.shape}")
-    if np.any(np.abs(arr[:3, 3]) > MAX_LENGTH_M):
+    if np.any(np.abs(arr[:3, 3]) > MAX_MODEL_LENGTH_M):
         raise ModelError(
-            f"{name}: the translation must lie within +-{MAX_LENGTH_M:g} m; got {shown(arr[:3, 3].tolist())}"
+            f"{name}: the translation must lie within +-{MAX_MODEL_LENGTH_M:g} m; got {shown(arr[:3, 3].tolist())}"
         )
     rot = arr[:3, :3]
     if not np.allclose(rot @ rot.T, np.eye(3), atol=1e-9) or np.linalg.det(rot) < 0:
@@ -257,6 +257,14 @@ class ArmModel:
     def __post_init__(self) -> None:
         joints = tuple(self.joints)
         bodies = tuple(self.bodies)
+        for what, text in [("model name", self.name)] + [("joint name", j.name) for j in joints] + [
+            ("body name", b.name) for b in bodies
+        ]:
+            if not isinstance(text, str) or any(ord(c) < 32 or 127 <= ord(c) < 160 for c in text):
+                raise ModelError(
+                    f"{what} {shown(text)} must be text without control characters (they would "
+                    "reach the terminal and the reports)"
+                )
         if len(joints) != len(bodies):
             raise ModelError(
                 f"model {shown(self.name)}: {len(joints)} joints but {len(bodies)} bodies; "

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from ..bounds import shown
 from ..errors import CampaignError
 
 
@@ -184,11 +185,8 @@ def dask_cluster(
         raise CampaignError(
             "the Dask engine needs the optional 'dask' extra: pip install 'jointlock[dask]'"
         ) from None
-    if scheduler_file is not None and not Path(scheduler_file).is_file():
-        raise CampaignError(
-            f"Dask scheduler file {scheduler_file!r} does not exist: start the scheduler first "
-            f"(dask scheduler --scheduler-file {scheduler_file})"
-        )
+    if scheduler_file is not None:
+        _check_scheduler_file(scheduler_file)
     if address not in (None, "local") and "://" not in address and ":" not in address:
         hint = " (did you mean 'local'?)" if difflib.get_close_matches(address, ["local"], cutoff=0.6) else ""
         raise CampaignError(f"--dask must be 'local' or a scheduler's address tcp://HOST:PORT; got {address!r}{hint}")
@@ -217,7 +215,7 @@ def dask_cluster(
         else:
             client = Client(address, timeout=timeout_s)
             where = address
-    except (OSError, TimeoutError, ValueError) as exc:
+    except (OSError, TimeoutError, ValueError, TypeError, AssertionError) as exc:  # Dask's own checks
         if cluster is not None:
             cluster.close()
         raise CampaignError(
@@ -256,3 +254,27 @@ def dask_cluster(
         _close=close,
         _count=count,
     )
+
+
+def _check_scheduler_file(path: str) -> None:
+    """A Dask scheduler file: a JSON object with the scheduler's ``address`` (a string), as
+    ``dask scheduler --scheduler-file F`` writes it; anything else in one line."""
+    import json
+
+    file = Path(path)
+    if file.is_dir():
+        raise CampaignError(f"Dask scheduler file {shown(path)} is a folder, not a file")
+    if not file.is_file():
+        raise CampaignError(
+            f"Dask scheduler file {shown(path)} does not exist: start the scheduler first "
+            f"(dask scheduler --scheduler-file {path})"
+        )
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError, ValueError) as exc:
+        raise CampaignError(f"Dask scheduler file {shown(path)} is not a scheduler's JSON: {exc}") from None
+    if not isinstance(data, dict) or not isinstance(data.get("address"), str):
+        raise CampaignError(
+            f"Dask scheduler file {shown(path)} has no scheduler address (a JSON object with \"address\": "
+            f"\"tcp://HOST:PORT\", as `dask scheduler --scheduler-file` writes)"
+        )

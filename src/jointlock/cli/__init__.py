@@ -123,6 +123,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
 def _main(argv: Sequence[str] | None) -> int:
     _headless_backend()
+    _forgiving_streams()
     parser = build_parser()
     args, extra = parser.parse_known_args(argv)
     commands = vars(args).pop("_commands", {})
@@ -142,7 +143,8 @@ def _main(argv: Sequence[str] | None) -> int:
         try:
             code = int(args.func(args) or 0)
             _print_warnings(prefix, caught)
-            sys.stdout.flush()  # a closed pipe shows here, not in the interpreter's final flush
+            if sys.stdout is not None:  # a closed pipe or a full disk shows here, not at exit
+                sys.stdout.flush()
             return code
         except JointlockError as exc:
             if args.debug:
@@ -155,6 +157,9 @@ def _main(argv: Sequence[str] | None) -> int:
         except OSError as exc:  # a file or folder that cannot be read or written (e.g. --out)
             if args.debug:
                 raise
+            if exc.filename is None:  # no path: standard output (e.g. `> /dev/full`)
+                exc.filename = "<standard output>"
+                _silence_stdout()
             print(f"{prefix}: error: {_os_error_text(exc)}", file=sys.stderr)
             return 2
         except MemoryError:
@@ -167,6 +172,21 @@ def _main(argv: Sequence[str] | None) -> int:
                 raise
             print(f"{prefix}: error: {_numerical_text(exc)}", file=sys.stderr)
             return 2
+
+
+def _forgiving_streams() -> None:
+    """Standard output and error that never fail on a character their encoding lacks (an
+    ASCII locale printing "§" or a model's name) -- it is written escaped -- and a closed
+    stdout (``>&-``) that swallows output instead of raising."""
+    for name in ("stdout", "stderr"):
+        stream = getattr(sys, name)
+        if stream is None:
+            setattr(sys, name, open(os.devnull, "w"))  # lives as long as the process
+        elif hasattr(stream, "reconfigure"):
+            try:
+                stream.reconfigure(errors="backslashreplace")
+            except (ValueError, OSError, AttributeError):  # a replaced stream (tests) or detached
+                pass
 
 
 def _print_warnings(prefix: str, caught: list[warnings.WarningMessage]) -> None:

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import warnings
 from pathlib import Path
 
 from ..analysis import singularity as sg
@@ -111,6 +112,8 @@ def _progress(args: argparse.Namespace) -> bool:
 
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
+    if args.out is not None and not args.search:
+        warnings.warn("--out: nothing written (only --search writes files: search.json and plots)", UserWarning, stacklevel=1)
     if args.verify_conditions:
         base = args.base or "virtual"
         if base == "floating":

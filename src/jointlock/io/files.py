@@ -14,6 +14,7 @@ import io
 import json
 import math
 import os
+import stat
 import sys
 import tempfile
 from collections.abc import Mapping
@@ -92,18 +93,37 @@ def check_path_text(path: str | Path, what: str, error: type[Exception]) -> Path
     return Path(path)
 
 
-def read_text_file(path: str | Path, what: str, error: type[Exception]) -> str:
-    """The text of ``path`` (see :func:`decode_text`); a missing or unreadable file raises
-    ``error`` with one line naming ``what`` (e.g. "model file") and the path."""
+#: Largest input file read [bytes] (a model, scenario or campaign file is a few KB; a URDF with
+#: every mesh inlined a few MB).
+MAX_INPUT_BYTES = 64 * 1024 * 1024
+
+
+def read_input_bytes(path: str | Path, what: str, error: type[Exception]) -> bytes:
+    """The bytes of an input file: a regular file (not a device such as ``/dev/zero`` or a
+    named pipe, which could be read forever) of at most :data:`MAX_INPUT_BYTES`; anything else
+    raises ``error`` with one line naming ``what`` (e.g. "model file") and the path."""
     path = check_path_text(path, what, error)
     shown = repr(shorten(str(path)))
     try:
-        data = path.read_bytes()
+        info = path.stat()
+        if stat.S_ISDIR(info.st_mode):
+            raise error(f"{what} {shown} is a folder, not a file")
+        if not stat.S_ISREG(info.st_mode):
+            raise error(f"{what} {shown} is not a regular file (a device or a pipe)")
+        if info.st_size > MAX_INPUT_BYTES:
+            raise error(f"{what} {shown} is {info.st_size / 2**20:.0f} MB; at most {MAX_INPUT_BYTES // 2**20} MB are read")
+        return path.read_bytes()
     except FileNotFoundError:
         raise error(f"{what} {shown} does not exist") from None
-    except OSError as exc:  # a folder, no permission, ...
-        raise error(f"cannot read {what} {shown}: {exc.strerror or type(exc).__name__}") from None
-    return decode_text(data, f"{what} {shown}", error)
+    except (OSError, RuntimeError) as exc:  # no permission, a loop of links, ...
+        reason = exc.strerror if isinstance(exc, OSError) and exc.strerror else str(exc) or type(exc).__name__
+        raise error(f"cannot read {what} {shown}: {reason}") from None
+
+
+def read_text_file(path: str | Path, what: str, error: type[Exception]) -> str:
+    """The text of ``path`` (see :func:`read_input_bytes` and :func:`decode_text`)."""
+    data = read_input_bytes(path, what, error)
+    return decode_text(data, f"{what} {shorten(str(path))!r}", error)
 
 
 def read_toml_file(path: str | Path, what: str, error: type[Exception]) -> dict[str, Any]:

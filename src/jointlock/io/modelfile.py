@@ -37,7 +37,7 @@ from typing import Any
 
 import numpy as np
 
-from ..bounds import as_real, shown
+from ..bounds import MAX_LENGTH_M, MAX_OPTION_DEG, as_real, shown
 from ..dh import from_dh
 from ..errors import ModelError
 from ..model import ArmModel, Body
@@ -72,11 +72,20 @@ def _check_keys(table: dict[str, Any], allowed: set[str], where: str) -> None:
 
 
 def _num(table: dict[str, Any], key: str, where: str, default: float | None = None) -> float:
+    """A number field; a length (``_m``) within +-:data:`~jointlock.bounds.MAX_LENGTH_M`, an
+    angle (``_deg``) within +-1e6 deg."""
     if key not in table:
         if default is None:
             raise ModelError(f"{where}: missing field {shown(key)}")
         return default
-    return as_real(table[key], f"{where}: field {shown(key)}", error=ModelError)
+    bound = _BOUND.get(key.rsplit("_", 1)[-1])
+    unit = {"m": "m", "deg": "deg"}.get(key.rsplit("_", 1)[-1], "")
+    lo = None if bound is None else -bound
+    return as_real(table[key], f"{where}: field {shown(key)}", lo=lo, hi=bound, unit=unit, error=ModelError)
+
+
+#: Bounds of a model file's fields by unit suffix (lengths as the readers allow them).
+_BOUND = {"m": MAX_LENGTH_M, "deg": MAX_OPTION_DEG}
 
 
 def _array(table: dict[str, Any], key: str, where: str, default: Any) -> np.ndarray:
@@ -87,17 +96,18 @@ def _array(table: dict[str, Any], key: str, where: str, default: Any) -> np.ndar
         raise ModelError(f"{where}: field {shown(key)} must be finite numbers; got {shown(value)}") from None
     if not np.all(np.isfinite(arr)):
         raise ModelError(f"{where}: field {shown(key)} must be finite; got {shown(value)}")
+    bound = _BOUND.get(key.rsplit("_", 1)[-1])
+    if bound is not None and np.any(np.abs(arr) > bound):
+        raise ModelError(f"{where}: field {shown(key)} must lie within +-{bound:g}; got {shown(value)}")
     return arr
 
 
 def _body(table: dict[str, Any], where: str, name: str) -> Body:
+    mass = _num(table, "mass_kg", where, 0.0)
+    com = _array(table, "com_m", where, [0.0, 0.0, 0.0])
+    inertia = _array(table, "inertia_kgm2", where, [0.0, 0.0, 0.0])
     try:
-        return Body(
-            _num(table, "mass_kg", where, 0.0),
-            _array(table, "com_m", where, [0.0, 0.0, 0.0]),
-            _array(table, "inertia_kgm2", where, [0.0, 0.0, 0.0]),
-            name=name,
-        )
+        return Body(mass, com, inertia, name=name)
     except ModelError as exc:
         raise ModelError(f"{where}: {exc}") from None
 
@@ -160,13 +170,20 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
     name = data.get("name", "toml-arm")
     if not isinstance(name, str):
         raise ModelError(f"{where}: field 'name' must be a string; got {shown(name)}")
+    try:
+        return _model(name, cols, bodies, tool, spacecraft, data, where)
+    except ModelError as exc:  # e.g. a joint's limits: named with the file
+        raise ModelError(f"{where}: {exc}") from None
+
+
+def _model(name: str, cols: dict, bodies: list, tool: Any, spacecraft: Any, data: dict, where: str) -> ArmModel:
     return from_dh(
         name,
         a=cols["a"],
         alpha=cols["alpha"],
         d=cols["d"],
         theta=cols["theta"],
-        convention=_CONVENTIONS[convention],  # type: ignore[arg-type]
+        convention=_CONVENTIONS[data["convention"]],  # type: ignore[arg-type]
         bodies=bodies,
         tool=tool,
         lower=cols["lower"],

@@ -22,7 +22,7 @@ from ..bounds import MAX_JOINT_VALUE, MAX_LENGTH_M, shown
 from ..errors import ModelError
 from ..model import ArmModel, Body, Joint
 from ..spatial import pose, rpy_matrix
-from .files import check_path_text, decode_text, shorten
+from .files import check_path_text, decode_text, read_input_bytes, shorten
 
 
 @dataclass
@@ -57,10 +57,7 @@ _DECLARED_ENCODING = re.compile(rb"^\s*<\?xml[^>]*encoding\s*=", re.IGNORECASE)
 def _urdf_text(path: Path, label: str) -> str | bytes:
     """The file's XML: its bytes when its declaration names an encoding (the XML parser
     decodes them), else its text read as UTF-8 (see :func:`decode_text`)."""
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise ModelError(f"cannot read URDF file {shown(label)}: {exc.strerror or type(exc).__name__}") from None
+    data = read_input_bytes(path, "URDF file", ModelError)
     if _DECLARED_ENCODING.match(data):
         return data
     return decode_text(data, f"URDF file {shown(label)}", ModelError)
@@ -225,6 +222,8 @@ def read_urdf(
             raise ModelError(f"{label}: link {shown(j.child)} has two parent joints")
         parent_of[j.child] = j.name
         children[j.parent].append(j)
+    if not links:
+        raise ModelError(f"{label}: no <link> found (a robot is links joined by joints)")
     roots = [k for k in links if k not in parent_of]
     if len(roots) != 1:
         names = _some_names(roots)
@@ -291,10 +290,13 @@ def read_urdf(
         )
     tool = in_owner[ee_link]
 
-    model_joints = tuple(
-        Joint(placement, j.axis, j.lower, j.upper, j.velocity, number=i + 1, name=j.name)
-        for i, (j, placement, _) in enumerate(movable)
-    )
+    try:
+        model_joints = tuple(
+            Joint(placement, j.axis, j.lower, j.upper, j.velocity, number=i + 1, name=j.name)
+            for i, (j, placement, _) in enumerate(movable)
+        )
+    except ModelError as exc:  # e.g. lower > upper: named with the file
+        raise ModelError(f"{label}: {exc}") from None
     if base == "floating" and root_body.mass <= 0:
         raise ModelError(
             f"{label}: base='floating' needs an <inertial> with positive mass on the root link "

@@ -185,10 +185,8 @@ class HaltConfigurationStudy(JobResult):
                 f"{c.manipulability:11.5g}"
             )
         gain = r.refinement_gain
-        rel = gain / abs(r.best_sample.cp) if r.best_sample.cp else float("nan")
-        out.append(
-            f"refinement gain: {gain:+.5f} CP ({100 * rel:+.2f} %), {r.refine_evaluations} evaluations"
-        )
+        rel = f"{100 * gain / abs(r.best_sample.cp):+.2f} %" if r.best_sample.cp else "n/a: CP of the best sample is 0"
+        out.append(f"refinement gain: {gain:+.5f} CP ({rel}), {r.refine_evaluations} evaluations")
         w, ahp = r.weights, r.ability.ahp
         out += [
             "",

@@ -40,9 +40,15 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
             f"model file; got {shown(name)}{_hint(name, BUILTIN_ROBOTS)}"
         )
     path = Path(name)
-    if not path.is_absolute():
-        path = (base_dir / path).resolve()
-    if not path.is_file():
+    try:
+        if not path.is_absolute():
+            path = (base_dir / path).resolve()
+        found, folder = path.is_file(), path.is_dir()
+    except (OSError, RuntimeError) as exc:  # a loop of symbolic links, a name too long
+        raise ScenarioError(f"{source}: robot: cannot use model file {shown(name)}: {exc}") from None
+    if folder:
+        raise ScenarioError(f"{source}: robot: {shown(name)} is a folder, not a model file (looked at {path})")
+    if not found:
         raise ScenarioError(f"{source}: robot: model file {shown(name)} not found (looked for {path})")
     out["robot"] = str(path)
 

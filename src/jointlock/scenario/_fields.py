@@ -226,7 +226,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "fail_at": Field(
             "number", None, lo=0.0, hi=MAX_TIME_S, unit="s", help="one failure time (default failure.time_s)"
         ),
-        "sweep": Field("int", None, lo=1, hi=10_000, help="sampled failure times (default 40)"),
+        "sweep": Field("int", None, lo=2, hi=10_000, help="sampled failure times (default 40; kappa(t) is fitted to >= 2)"),
         "kappa": Field(
             "number",
             None,

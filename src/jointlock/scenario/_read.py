@@ -55,6 +55,9 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     applied: dict[str, Any] = {}
     overrides = dict(overrides or {})
     out_given = overrides.pop("out", None)  # the command line's: any folder, from the working one
+    robot = overrides.get("robot")
+    if isinstance(robot, str) and Path(robot).suffix.lower() in (".toml", ".urdf") and "\x00" not in robot:
+        overrides["robot"] = os.path.abspath(robot)  # the command line's: from the working folder
     if overrides:
         for key, value in overrides.items():
             table, _, name = key.rpartition(".")
@@ -190,7 +193,11 @@ def check_value(value: Any, spec: Field, where: str) -> Any:
     if kind == "int":
         if isinstance(value, bool) or not isinstance(value, int):
             raise bad(f" ({type(value).__name__})")
-        number(value)
+        # compared as integers: a float rounds 2**63 - 1 up (and a 400-digit integer overflows)
+        if (spec.lo is not None and (value <= spec.lo if spec.lo_open else value < spec.lo)) or (
+            spec.hi is not None and value > spec.hi
+        ):
+            raise bad(f" ({len(str(abs(value)))} digits)" if abs(value) > 10**20 else "")
         return int(value)
     if kind == "number":
         return number(value)

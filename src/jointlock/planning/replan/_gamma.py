@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -233,6 +234,39 @@ def _brackets(f: FloatArray) -> FloatArray:
     return ok & ((a == 0) | (np.sign(a) != np.sign(b)))
 
 
+#: A root where the locked joint's angle only touches the lock angle (no sign change: an
+#: extremum of theta_j(gamma)) is kept when the extremum is this close [rad].
+TANGENT_TOL = 1e-9
+
+
+def _tangent_roots(geom: Any, t: FloatArray, grid: FloatArray, f: FloatArray, b: int, joint: int, angle: float) -> FloatArray:
+    """Roots the sign-change brackets miss: ``theta_j(gamma)`` reaching the lock angle at an
+    extremum (e.g. a target whose joint already sits at the lock angle, gamma = 0, at the
+    bottom of the curve).  Each grid-local minimum of ``|f|`` without a sign change around it
+    is refined (bounded scalar minimisation) and kept when ``|f|`` < :data:`TANGENT_TOL`."""
+    from scipy.optimize import minimize_scalar
+
+    a = np.abs(f)
+    inner = np.arange(1, len(grid) - 1)
+    cand = inner[
+        np.isfinite(a[inner])
+        & (a[inner] <= a[inner - 1])
+        & (a[inner] <= a[inner + 1])
+        & (a[inner] < math.pi / 2)
+        & (np.sign(f[inner - 1]) == np.sign(f[inner + 1]))
+        & (np.sign(f[inner]) == np.sign(f[inner + 1]))
+    ]
+    out = []
+    for i in cand:  # few (one per extremum of the curve): a Python loop over candidates, not samples
+        def err(g: float) -> float:
+            return float(abs(wrap_angle(_locked_value(geom, t, np.array([g]), b, joint)[0] - angle)))
+
+        res = minimize_scalar(err, bounds=(grid[i - 1], grid[i + 1]), method="bounded", options={"xatol": 1e-12})
+        if res.fun < TANGENT_TOL:
+            out.append(float(res.x))
+    return np.array(out)
+
+
 def gammas_for_lock(
     model: ArmModel,
     target: ArrayLike,
@@ -276,10 +310,11 @@ def gammas_for_lock(
     grid = np.linspace(-gamma_limit, gamma_limit, count)
     f = wrap_angle(_locked_value(geom, t, grid, b, joint) - angle)
     br = np.flatnonzero(_brackets(f))
-    if br.size == 0:
-        return ()
-    gam = _bisect(geom, t, grid[br], grid[br + 1], f[br], b, joint, angle)
+    gam = _bisect(geom, t, grid[br], grid[br + 1], f[br], b, joint, angle) if br.size else np.zeros(0)
     gam = np.where(f[br] == 0, grid[br], gam)
+    gam = np.concatenate([gam, _tangent_roots(geom, t, grid, f, b, joint, angle)])
+    if gam.size == 0:
+        return ()
     q, _ = _full_branches(geom, tool_x_rotation(t, gam))
     roots = [GammaRoot(float(g), q[k, b].copy(), joint, float(angle), b) for k, g in enumerate(gam)]
     roots.sort(key=lambda r: abs(r.gamma))
