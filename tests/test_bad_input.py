@@ -503,7 +503,7 @@ def test_a_scenarios_out_resolves_against_its_folder_and_stays_inside(tmp_path, 
         .endswith("scratch/r")
     )
     for outside in ("../..", str(tmp_path / "elsewhere"), "../x"):
-        with pytest.raises(ScenarioError, match="inside the scenario file's folder.*--out"):
+        with pytest.raises(ScenarioError, match="inside the file's folder.*--out"):
             jl.load_scenario(_write(folder / "b.toml", body.format(outside)))
     sc = jl.load_scenario(_write(folder / "c.toml", body.format("../..")), {"out": "../anywhere"})
     assert sc.data["out"] == "../anywhere"  # the command line's --out: the working folder's
@@ -588,7 +588,7 @@ def test_a_campaign_files_out_stays_in_its_folder(tmp_path):
 
     body = 'scenario = "{}"\nout = "../../evil"\n[grid]\n"workspace.samples" = [1000, 2000]\n'
     scenario = _write(tmp_path / "s.toml", 'robot = "puma6"\n[workspace]\nsamples = 1000\n')
-    with pytest.raises(JointlockError, match="out must be a folder inside the campaign file's folder"):
+    with pytest.raises(JointlockError, match="out must be a folder inside the file's folder"):
         load_campaign(_write(tmp_path / "c.toml", body.format(scenario)))
 
 

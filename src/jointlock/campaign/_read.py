@@ -8,14 +8,13 @@ Nothing runs and nothing is written before the whole file is valid.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
 from ..bounds import shown
 from ..errors import CampaignError, ScenarioError
-from ..io.files import check_path_text, read_toml_file
+from ..io.files import check_path_text, path_inside, read_toml_file
 from ..scenario import DEPRECATED_FIELDS, JOB_ORDER
 from ..scenario._fields import _hint
 from ..scenario._read import check_value as _check
@@ -77,7 +76,7 @@ def campaign_from_dict(
     title = _string(data, "title", source) or Path(source).stem
     out = _string(data, "out", source)
     if out:
-        _check_inside(out, source, base_dir)
+        path_inside(base_dir, out, f"{source}: out", CampaignError)
     _string(data, "description", source)
     fixed = {
         name: _value(value, name, f"{source}: set.{name}", base_dir)
@@ -377,17 +376,3 @@ def _check_filters_and_report(spec: CampaignSpec) -> None:
             raise CampaignError(
                 f"{spec.source}: report.{axis} = {name!r} is not varied by this campaign; varied: {', '.join(varied)}"
             )
-
-
-def _check_inside(out: str, source: str, folder: Path) -> None:
-    """A campaign file's ``out`` lies inside the file's folder (a campaign someone sends you
-    cannot write to ``../..``); ``--out`` on the command line can name any folder.  Paths are
-    compared as written, as for a scenario's ``out``."""
-    check_path_text(out, f"{source}: out", CampaignError)
-    base = os.path.normpath(os.path.abspath(folder))
-    target = os.path.normpath(os.path.join(base, out))
-    if target != base and not target.startswith(base.rstrip(os.sep) + os.sep):
-        raise CampaignError(
-            f"{source}: out must be a folder inside the campaign file's folder ({shown(base)}); got "
-            f"{shown(out)}: give --out on the command line to write elsewhere"
-        )

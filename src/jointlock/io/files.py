@@ -98,6 +98,22 @@ def check_path_text(path: str | Path, what: str, error: type[Exception]) -> Path
 MAX_INPUT_BYTES = 64 * 1024 * 1024
 
 
+def path_inside(folder: str | Path, given: str, what: str, error: type[Exception]) -> str:
+    """``given`` (a file's ``out``) resolved against ``folder``, which it must lie inside: a
+    scenario or campaign file someone sends you cannot write to ``../..`` or an absolute path.
+    Paths are compared as written (a symbolic link inside the folder may point elsewhere);
+    ``what`` names the field in the error (e.g. ``"run.toml: out"``)."""
+    check_path_text(given, what, error)
+    base = os.path.normpath(os.path.abspath(folder))
+    target = os.path.normpath(os.path.join(base, given))
+    if target != base and not target.startswith(base.rstrip(os.sep) + os.sep):
+        raise error(
+            f"{what} must be a folder inside the file's folder ({shorten(base)!r}); got {shorten(given)!r}: "
+            "give --out on the command line to write elsewhere"
+        )
+    return target
+
+
 def read_input_bytes(path: str | Path, what: str, error: type[Exception]) -> bytes:
     """The bytes of an input file: a regular file (not a device such as ``/dev/zero`` or a
     named pipe, which could be read forever) of at most :data:`MAX_INPUT_BYTES`; anything else

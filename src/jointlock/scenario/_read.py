@@ -14,7 +14,7 @@ from typing import Any
 from .._deprecate import warn_once
 from ..bounds import shown
 from ..errors import ScenarioError
-from ..io.files import check_path_text, read_toml_file
+from ..io.files import path_inside, read_toml_file
 from ..robots import BUILTIN_ROBOTS
 from ._checks import _check_semantics, _inherit_singular_base, _resolve_robot
 from ._fields import (
@@ -70,30 +70,12 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
     if out_given is not None:  # the file's out is not used: not checked either
         data = {k: v for k, v in data.items() if k != "out"}
     sc = scenario_from_dict(data, source=str(path), base_dir=path.resolve().parent)
-    _resolve_out(sc.data, str(path), path.parent)
+    if sc.data.get("out"):  # the file's: relative to its folder, and inside it
+        sc.data["out"] = path_inside(path.parent, sc.data["out"], f"{path}: out", ScenarioError)
     if out_given is not None:
         sc.data["out"] = check_value(out_given, TOP_FIELDS["out"], "--out")
         applied["out"] = {"file": data.get("out"), "value": out_given}
     return dataclasses.replace(sc, overrides=applied) if applied else sc
-
-
-def _resolve_out(out: dict[str, Any], source: str, folder: Path) -> None:
-    """A file's ``out``: relative to the file's folder, and inside it -- a scenario someone
-    sends you cannot write over ``../..`` or an absolute path; the command line's ``--out``
-    can (it is not checked here), and so can Python (:func:`scenario_from_dict`).  The paths
-    are compared as written (no links followed: a link to a scratch disk is fine)."""
-    given = out.get("out")
-    if not given:
-        return
-    check_path_text(given, f"{source}: out", ScenarioError)
-    folder_text = os.path.normpath(os.path.abspath(folder))
-    target = os.path.normpath(os.path.join(folder_text, given))
-    if target != folder_text and not target.startswith(folder_text.rstrip(os.sep) + os.sep):
-        raise ScenarioError(
-            f"{source}: out must be a folder inside the scenario file's folder ({shown(folder_text)}); got "
-            f"{shown(given)}: give --out on the command line to write elsewhere"
-        )
-    out["out"] = target
 
 
 def parse_set(text: str) -> tuple[str, Any]:
