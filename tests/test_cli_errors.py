@@ -555,3 +555,43 @@ def exit_code(argv: list[str]) -> int:
         return main(argv)
     except SystemExit as exc:
         return int(exc.code)
+
+
+# -- halt: the state at failure is 000's only for 000's failure (issue 14, item 4) -----------------
+
+
+def test_halt_refuses_000s_state_for_another_lock(capsys):
+    assert exit_code(["halt", "halt7", "--lock", "3=0", "--quiet"]) == 2
+    err = err_line(capsys)
+    assert "halt7 with joint 3 at 0 deg needs --q0-deg, --dq0-deg, --ddq0-deg, --T" in err and "--from-rest" in err
+    assert exit_code(["halt", "halt7", "--lock", "3=0", "--paper-qf", "--q0-deg", *["0"] * 6, "--from-rest", "--T", "10"]) == 2
+    assert "--paper-qf is 000's q_best for halt7 with joint 4 locked at 0 deg only" in err_line(capsys)
+
+
+def test_halt_from_rest_says_it_is_a_reconfiguration(capsys):
+    argv = ["halt", "halt7", "--lock", "3=0", "--from-rest", "--q0-deg", "10", "20", "30", "40", "50", "60"]
+    argv += ["--T", "10", "--qf-deg", "0", "0", "0", "0", "0", "0", "--quiet"]
+    assert exit_code([*argv, "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["from_rest"] and data["state_source"] == "--q0-deg, from rest"
+    assert data["dq_initial_deg_s"] == [0.0] * 6 and data["ddq_initial_deg_s2"] == [0.0] * 6
+    assert np.allclose(data["q_initial_deg"], [10.0, 20.0, 30.0, 40.0, 50.0, 60.0], rtol=0, atol=1e-12)
+    assert exit_code(argv) == 0
+    out = capsys.readouterr().out
+    assert "state at failure (--q0-deg, from rest): q0 = [10, 20, 30, 40, 50, 60] deg" in out
+    assert "from rest: the halt is a reconfiguration from q0 to the halt configuration" in out
+    assert "-0 " not in out and "-0," not in out and "= -0" not in out
+    assert exit_code([*argv, "--dq0-deg", *["1"] * 6]) == 2
+    assert "--from-rest means zero rates" in err_line(capsys)
+
+
+def test_halt_prints_the_state_it_starts_from(capsys):
+    assert exit_code(["halt", "halt7", "--paper-qf", "--quiet"]) == 0
+    out = capsys.readouterr().out
+    assert "state at failure (000 §5.2): q0 = [-180, -180, -100, -10, 20, 20] deg; dq0 = [20, 30, 15, 25, 40, 35] deg/s" in out
+    scenario = jl.load_scenario(Path(__file__).resolve().parents[1] / "examples" / "halt_000.toml")
+    data = scenario.data
+    from jointlock.jobs.halt import halt_from_scenario
+
+    data = {**data, "halt": {**data["halt"], "paper_qf": True}}
+    assert halt_from_scenario(data, {}).state_source == "the scenario's [state]"

@@ -526,7 +526,7 @@ def test_paper_numbers_only_for_the_paper_scenario(capsys):
         argv = base + extra
         if extra[0] == "--lock":
             argv = ["halt", "halt7", "--lock", "3=0", "--qf-deg", *["0"] * 6, "--n-samples", "101", "--quiet"]
-            argv += ["--q0-deg", *["0"] * 6, "--dq0-deg", *["0"] * 6, "--ddq0-deg", *["0"] * 6]
+            argv += ["--q0-deg", *["0"] * 6, "--dq0-deg", *["0"] * 6, "--ddq0-deg", *["0"] * 6, "--T", "10"]
         assert main(argv) == 0
         assert "000 printed" not in capsys.readouterr().out
         assert main(argv + ["--json"]) == 0

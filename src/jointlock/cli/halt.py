@@ -37,6 +37,7 @@ from ._common import (
     field_arg,
     joint_vector_deg,
     lock_map,
+    locked_text,
     print_json,
     seed_arg,
 )
@@ -91,6 +92,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         nargs="+",
         metavar="DEG",
         help="accelerations at failure [deg/s^2]",
+    )
+    p.add_argument(
+        "--from-rest",
+        action="store_true",
+        help="the arm was at rest when the joint locked: zero rates and accelerations (the halt is "
+        "then a reconfiguration to the halt configuration)",
     )
     p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], 0.001 .. 1e6 (000: 10)")
     qf = p.add_mutually_exclusive_group()
@@ -162,7 +169,15 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     """The options as :func:`plan_halt`'s inputs (errors name the options), and its result."""
     ga = GASettings(n_pop=args.population, n_gen=args.generations)
     check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga, CLI_NAMES)
-    defaults = PAPER_SCENARIO if args.robot == "halt7" else {}
+    paper_lock = {j: math.radians(a) for j, a in PAPER_SCENARIO["lock"].items()}
+    locks = lock_map(args.lock) if args.lock else (paper_lock if args.robot == "halt7" else {})
+    # 000's state at failure belongs to 000's failure only: halt7 with joint 4 locked at 0
+    paper = args.robot == "halt7" and locks == paper_lock
+    defaults = PAPER_SCENARIO if paper else {}
+    if args.from_rest:
+        if args.dq0_deg is not None or args.ddq0_deg is not None:
+            raise ScenarioError("--from-rest means zero rates and accelerations: drop --dq0-deg / --ddq0-deg")
+        args.dq0_deg = args.ddq0_deg = [0.0]
     missing = [
         option
         for option, value, key in (
@@ -174,25 +189,31 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         if value is None and key not in defaults
     ]
     if missing:
-        raise ScenarioError(
-            f"this robot needs {', '.join(missing)} (the state at failure [deg, deg/s, deg/s^2] and "
-            "the halt time [s]; 000's scenario is the default for halt7 only)"
+        which = (
+            f"halt7 with {locked_text({j: math.degrees(a) for j, a in locks.items()})}"
+            if args.robot == "halt7"
+            else "this robot"
         )
-    locks = (
-        lock_map(args.lock)
-        if args.lock
-        else {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
-    )
+        raise ScenarioError(
+            f"{which} needs {', '.join(missing)} (the state at failure [deg, deg/s, deg/s^2] and the halt "
+            "time [s]; 000's scenario is the default only for halt7 with joint 4 locked at 0 deg; "
+            "--from-rest sets zero rates and accelerations)"
+        )
     model = halt_model(args.robot, locks, args.base)
+    given = [opt for opt, v in (("--q0-deg", args.q0_deg), ("--dq0-deg", args.dq0_deg), ("--ddq0-deg", args.ddq0_deg)) if v]
+    rest = [0.0] * model.dof
     state = FailureState.from_degrees(
         model,
         args.q0_deg or defaults["q0_deg"],
-        args.dq0_deg or defaults["dq0_deg"],
-        args.ddq0_deg or defaults["ddq0_deg"],
+        (rest if args.from_rest else args.dq0_deg) or defaults["dq0_deg"],
+        (rest if args.from_rest else args.ddq0_deg) or defaults["ddq0_deg"],
         names=("--q0-deg", "--dq0-deg", "--ddq0-deg"),
     )
-    if args.paper_qf and args.robot != "halt7":
-        raise ScenarioError("--paper-qf is 000's q_best for halt7 only; give --qf-deg")
+    source = "000 §5.2" if not given else "given" if len(given) == 3 else f"{', '.join(given)} given, the rest 000 §5.2's"
+    if args.from_rest:
+        source = "--q0-deg, from rest" if args.q0_deg else "000 §5.2's angles, from rest"
+    if args.paper_qf and not paper:
+        raise ScenarioError("--paper-qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give --qf-deg")
     return plan_halt(
         model,
         state,
@@ -210,6 +231,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         ga=ga,
         minimum_T=args.minimum_T,
         progress=progress,
+        state_source=source,
         _names=CLI_NAMES,
     )
 

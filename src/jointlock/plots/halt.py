@@ -24,7 +24,7 @@ def k_label(res: HaltMotion) -> str:
 
 def k_text(res: HaltMotion, digits: int = 6) -> str:
     """The reported k in deg/s^6, ``digits`` significant digits, with the unit."""
-    kd = np.atleast_1d(np.asarray(res.k, dtype=float) / _K_DEG)
+    kd = np.atleast_1d(np.asarray(res.k, dtype=float) / _K_DEG) + 0.0  # + 0.0: no "-0"
     body = ", ".join(f"{v:.{digits}g}" for v in kd)
     return (f"[{body}]" if res.per_joint else body) + " deg/s^6"
 

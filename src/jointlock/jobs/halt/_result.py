@@ -79,6 +79,7 @@ class HaltPlan(JobResult):
     samples: int = p000.SAMPLES
     reachability_requested: bool = True
     seed: int | None = 0
+    state_source: str = "given"
 
     @property
     def problem(self) -> HaltProblem:
@@ -136,6 +137,10 @@ class HaltPlan(JobResult):
             **({"joint_k_intervals_deg": res.joint_intervals / scale} if res.per_joint else {}),
             "minimum_T_s": res.minimum_T,
             "q_initial_deg": np.degrees(p.q0),
+            "dq_initial_deg_s": np.degrees(p.dq0),
+            "ddq_initial_deg_s2": np.degrees(p.ddq0),
+            "state_source": self.state_source,
+            "from_rest": self.from_rest,
             "q_final_deg": np.degrees(p.qf),
             "peak_velocity_deg_s": np.degrees(np.abs(dq).max(axis=0)),
             "peak_acceleration_deg_s2": np.degrees(np.abs(ddq).max(axis=0)),
@@ -147,6 +152,28 @@ class HaltPlan(JobResult):
             "paper": dict(p000.HALT_RESULTS) if self.paper_scenario else None,
             **self._notes(),
         }
+
+    @property
+    def from_rest(self) -> bool:
+        """The arm was at rest when the joint locked (no rate, no acceleration): the "halt" is
+        a reconfiguration to the halt configuration."""
+        p = self.problem
+        return not np.any(p.dq0) and not np.any(p.ddq0)
+
+    def state_lines(self) -> list[str]:
+        """The state at failure the halt starts from, and where it comes from."""
+        p = self.problem
+
+        def deg(values: np.ndarray) -> str:
+            return ", ".join(f"{v:.4g}" for v in np.degrees(values) + 0.0)  # + 0.0: no "-0"
+
+        lines = [
+            f"state at failure ({self.state_source}): q0 = [{deg(p.q0)}] deg; dq0 = [{deg(p.dq0)}] deg/s; "
+            f"ddq0 = [{deg(p.ddq0)}] deg/s^2"
+        ]
+        if self.from_rest:
+            lines.append("  from rest: the halt is a reconfiguration from q0 to the halt configuration")
+        return lines
 
     def summary(self) -> list[str]:
         """The lines ``jointlock halt`` prints."""
@@ -164,6 +191,7 @@ class HaltPlan(JobResult):
             )
         if self.reachability is not None:
             lines.append(f"reachability: {self.reachability}")
+        lines += self.state_lines()
         lim = self.limits
         lines += [
             f"halt time T = {p.T:g} s",

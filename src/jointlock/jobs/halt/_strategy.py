@@ -251,6 +251,7 @@ def plan_halt(
     ga: GASettings | None = None,
     minimum_T: bool = False,
     progress: bool = False,
+    state_source: str | None = None,
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -298,6 +299,9 @@ def plan_halt(
         configuration); an infeasible halt always reports it.
     progress
         Show progress bars on stderr.
+    state_source
+        Where ``state`` comes from, in words, recorded in the result and printed with it
+        (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
 
     Raises
     ------
@@ -309,17 +313,22 @@ def plan_halt(
     """
     ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
     check_halt_settings(T, n_samples, samples, solver, ga, _names)
+    state_given = state is not None
     model, state, T, base, paper = _arm_state_and_time(robot, state, locks, T, base, _state_names)
     if limits is None:
         limits = halt_limits(model, vmax_deg, amax_deg, names=_names["limits"])
     paper_scenario = _is_paper_state(model, state, T, limits)
+    if state_source is None:
+        state_source = "given" if state_given and not paper_scenario else "000 §5.2"
     rng = resolve_seed(rng)  # one seed for the search and the GA, recorded
     configuration, reach_note = None, None
     if qf is not None:
         qf_arr, qf_source = np.asarray(qf, dtype=float), _names["qf"]
     elif paper_qf:
-        if not paper:
-            raise ScenarioError("paper_qf is 000's q_best for halt7 only; give qf")
+        if not paper or {lj.number: math.degrees(lj.angle) for lj in model.locked} != dict(p000.SCENARIO["lock"]):
+            raise ScenarioError(
+                "paper_qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give qf"
+            )
         qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"), "000's printed q_best"
     else:
         _check_start(model, state, T, limits, _names["state"])
@@ -350,6 +359,7 @@ def plan_halt(
         samples=samples,
         reachability_requested=reachable,
         seed=None if isinstance(rng, np.random.Generator) else rng,
+        state_source=state_source,
     )
 
 
@@ -390,5 +400,6 @@ def halt_from_scenario(
         ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
         minimum_T=bool(t["minimum_T"]),
         progress=progress,
+        state_source="the scenario's [state]",
         _names=names,
     )
