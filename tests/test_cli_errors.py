@@ -595,3 +595,9 @@ def test_halt_prints_the_state_it_starts_from(capsys):
 
     data = {**data, "halt": {**data["halt"], "paper_qf": True}}
     assert halt_from_scenario(data, {}).state_source == "the scenario's [state]"
+
+
+def test_run_refuses_a_second_lock_instead_of_keeping_the_last(capsys):
+    scenario = str(Path(__file__).resolve().parents[1] / "examples" / "replan_002.toml")
+    assert exit_code(["run", scenario, "--lock", "2=59.4", "--lock", "3=0"]) == 2
+    assert "--lock given 2 times: a scenario has one failure" in err_line(capsys)

@@ -13,6 +13,7 @@ import math
 import sys
 from typing import Any
 
+from ..errors import ScenarioError
 from ..run import default_out_dir, run_scenario
 from ..run._summary import summary_lines
 from ..scenario import JOB_ORDER, load_scenario, parse_set
@@ -38,7 +39,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--base", choices=("fixed", "floating"), help="override base")
     p.add_argument("--seed", type=seed_arg, help="override seed (integer >= 0)")
     p.add_argument(
-        "--lock", metavar="J=DEG", type=parse_lock, help="override the failure: joint J locked at DEG degrees"
+        "--lock",
+        metavar="J=DEG",
+        type=parse_lock,
+        action="append",
+        help="override the failure: joint J locked at DEG degrees (once: a scenario has one failure)",
     )
     p.add_argument("--jobs", nargs="+", choices=JOB_ORDER, metavar="JOB", help="run only these jobs")
     p.add_argument(
@@ -63,8 +68,13 @@ def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
     if args.seed is not None:
         out["seed"] = args.seed
     if args.lock is not None:
-        out["failure.joint"] = args.lock[0]
-        out["failure.angle_deg"] = math.degrees(args.lock[1])
+        if len(args.lock) > 1:  # not the last one silently
+            raise ScenarioError(
+                f"--lock given {len(args.lock)} times: a scenario has one failure ([failure] joint, angle_deg); "
+                "lock several joints with `jointlock kinematics/halt/... --lock A --lock B` or lock_joints in Python"
+            )
+        out["failure.joint"] = args.lock[0][0]
+        out["failure.angle_deg"] = math.degrees(args.lock[0][1])
     if args.jobs:
         out["jobs"] = list(args.jobs)
     if args.out is not None:
