@@ -598,3 +598,36 @@ def test_impossible_start_skips_the_search(capsys, monkeypatch):
         main(["halt", "halt7", "--ddq0-deg", "8", "10", "30", "10", "-8", "6", "--paper-qf", "--quiet"]) == 0
     )
     assert "no halt time or k helps" in capsys.readouterr().out
+
+
+@pytest.mark.paper
+def test_moment_about_gives_both_readings_on_000s_scenario():
+    """000's scenario (q_best, T = 10 s, fixed base), k = 0: 2142.3 N m about the default
+    spacecraft's centre of mass, 2340.5 N m about joint 1's origin (the root frame's origin, the
+    reading of an independent reproduction of 000); recorded in the result."""
+    import jointlock as jl
+
+    about_com = jl.plan_halt("halt7", paper_qf=True, n_samples=501)
+    about_joint1 = jl.plan_halt("halt7", paper_qf=True, n_samples=501, moment_about="joint1")
+    assert about_com.motion.global_torque_k0 == pytest.approx(2142.3, abs=0.05)
+    assert about_joint1.motion.global_torque_k0 == pytest.approx(2340.5, abs=0.05)
+    assert about_com.to_dict()["moment_about"] == "spacecraft_com"
+    assert about_joint1.to_dict()["moment_about"] == "joint1"
+    assert "about joint 1's origin" in about_joint1.summary()[0]
+    # the moment about another point: n_P = n_O + (O - P) x f, checked on the histories
+    from jointlock.planning.halt_motion import base_torque_history
+
+    t = about_com.problem.times(21)
+    n_com = base_torque_history(about_com.problem, 0.0, t)
+    n_j1 = base_torque_history(about_joint1.problem, 0.0, t)
+    q, dq, ddq = about_com.problem.trajectory(0.0, t)
+    force = jl.rnea(about_com.problem.model, q, dq, ddq).base_force
+    com = about_com.problem.model.root_body.com
+    np.testing.assert_allclose(n_j1, n_com + np.cross(com - np.zeros(3), force), rtol=1e-10, atol=1e-9)
+
+
+def test_moment_about_is_checked():
+    import jointlock as jl
+
+    with pytest.raises(jl.ScenarioError, match="moment_about must be one of spacecraft_com, joint1"):
+        jl.plan_halt("halt7", paper_qf=True, moment_about="tip")

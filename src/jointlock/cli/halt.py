@@ -94,6 +94,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="accelerations at failure [deg/s^2]",
     )
     p.add_argument(
+        "--moment-about",
+        choices=("spacecraft_com", "joint1"),
+        default="spacecraft_com",
+        help="point of the base torque: the spacecraft's centre of mass (default, physical) or joint 1's "
+        "origin (an independent reproduction of 000's reading)",
+    )
+    p.add_argument(
         "--from-rest",
         action="store_true",
         help="the arm was at rest when the joint locked: zero rates and accelerations (the halt is "
@@ -232,6 +239,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         minimum_T=args.minimum_T,
         progress=progress,
         state_source=source,
+        moment_about=args.moment_about,
         _names=CLI_NAMES,
     )
 

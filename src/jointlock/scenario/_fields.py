@@ -208,6 +208,13 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
         "generations": Field("int", 100, lo=0, hi=100_000, help="GA generations (0: the first population only)"),
         "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
+        "moment_about": Field(
+            "choice",
+            "spacecraft_com",
+            choices=("spacecraft_com", "joint1"),
+            help="point of the base torque: the spacecraft's centre of mass (physical) or joint 1's "
+            "origin (an independent reproduction of 000's reading)",
+        ),
         "minimum_T": Field(
             "bool",
             False,

@@ -39,6 +39,9 @@ from ...plots.halt import (
 from .._common import JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
 
+#: How the summary names the base torque's point (:attr:`HaltProblem.moment_about`).
+MOMENT_TEXT = {"spacecraft_com": "the spacecraft's centre of mass", "joint1": "joint 1's origin"}
+
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
 class HaltPlan(JobResult):
@@ -140,6 +143,7 @@ class HaltPlan(JobResult):
             "dq_initial_deg_s": np.degrees(p.dq0),
             "ddq_initial_deg_s2": np.degrees(p.ddq0),
             "state_source": self.state_source,
+            "moment_about": p.moment_about,
             "from_rest": self.from_rest,
             "q_final_deg": np.degrees(p.qf),
             "peak_velocity_deg_s": np.degrees(np.abs(dq).max(axis=0)),
@@ -181,7 +185,7 @@ class HaltPlan(JobResult):
         nums = list(p.model.joint_numbers)
         lines = [
             f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
-            f"base torque with {p.base} base",
+            f"base torque with {p.base} base about {MOMENT_TEXT[p.moment_about]}",
             f"halt configuration ({self.qf_source}): " + ", ".join(f"{v:.2f}" for v in np.degrees(p.qf)) + " deg",
         ]
         hc = self.configuration

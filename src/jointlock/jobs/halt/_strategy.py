@@ -19,7 +19,7 @@ from ...model import ArmModel
 from ...papers import p000
 from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
-from ...planning.halt_motion import HaltProblem, optimal_halt_motion
+from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
 from ...progress import Progress
 from ...robots import load_robot
 from .._common import JobResult, joint_vector_deg, scenario_lock
@@ -252,6 +252,7 @@ def plan_halt(
     minimum_T: bool = False,
     progress: bool = False,
     state_source: str | None = None,
+    moment_about: MomentAbout = "spacecraft_com",
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -299,6 +300,10 @@ def plan_halt(
         configuration); an infeasible halt always reports it.
     progress
         Show progress bars on stderr.
+    moment_about
+        Point of the base torque: ``"spacecraft_com"`` (default: the spacecraft's centre of mass)
+        or ``"joint1"`` (joint 1's origin, the reading of an independent reproduction of 000);
+        see :class:`~jointlock.planning.halt_motion.HaltProblem`.
     state_source
         Where ``state`` comes from, in words, recorded in the result and printed with it
         (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
@@ -341,7 +346,7 @@ def plan_halt(
         qf_source = f"optimal halt configuration (Monte Carlo, {samples} samples, seed {seed_text})"
     problem = HaltProblem(
         model, state.q, state.dq, state.ddq, qf_arr, T, limits.velocity, limits.acceleration,
-        base=base, n_samples=n_samples,
+        base=base, n_samples=n_samples, moment_about=moment_about,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
     motion = optimal_halt_motion(
@@ -401,5 +406,6 @@ def halt_from_scenario(
         minimum_T=bool(t["minimum_T"]),
         progress=progress,
         state_source="the scenario's [state]",
+        moment_about=t["moment_about"],
         _names=names,
     )

@@ -71,7 +71,7 @@ from ._feasibility import (
 )
 from ._objective import _simpson_mean, base_torque_history, global_base_torque
 from ._polynomial import halt_coefficients, k_shape, polynomial_profile
-from ._problem import HaltProblem, _angle_limit, _k_array, _vec
+from ._problem import MOMENT_POINTS, HaltProblem, MomentAbout, _angle_limit, _k_array, _vec
 from ._report import infeasibility_message
 from ._solve import HaltMotion, _check_k_bounds, _scan, log, optimal_halt_motion
 
@@ -84,6 +84,8 @@ __all__ = [
     "AffineKBounds",
     "HaltMotion",
     "HaltProblem",
+    "MOMENT_POINTS",
+    "MomentAbout",
     "KIntervalBatch",
     "LimitKind",
     "Solver",

@@ -27,7 +27,7 @@ def base_torque_history(
 ) -> FloatArray:
     """Base disturbance torque ``tau_b(t; k)`` (000 eq. 31), (..., n_t, 3) [N m], root frame."""
     q, dq, ddq = problem.trajectory(k, t, per_joint=per_joint)
-    return rnea(problem.model, q, dq, ddq, base=problem.base).base_moment
+    return rnea(problem.model, q, dq, ddq, base=problem.base, moment_point=problem.moment_point).base_moment
 
 
 def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:

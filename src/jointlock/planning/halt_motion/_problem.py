@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
+from typing import Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -69,6 +70,12 @@ class HaltProblem:
         Time samples of the objective (odd; Simpson's rule).
     n_check
         Time samples of the constraint check.
+    moment_about
+        Point of the base disturbance torque (000 eqs. 30-31): ``"spacecraft_com"`` (default,
+        the physical choice: the spacecraft turns about its centre of mass; the root frame's
+        origin for a model without a spacecraft) or ``"joint1"``, joint 1's origin: the root
+        frame's origin, where joint 1 is mounted on the spacecraft (DH frame 0; 000 eq. 30's
+        ``bP_1`` ends there) -- the reading of an independent reproduction of 000.
     """
 
     model: ArmModel
@@ -84,6 +91,7 @@ class HaltProblem:
     base: BaseMode = "fixed"
     n_samples: int = 501
     n_check: int = 2001
+    moment_about: MomentAbout = "spacecraft_com"
 
     def __post_init__(self) -> None:
         n = self.model.dof
@@ -116,6 +124,14 @@ class HaltProblem:
             raise ScenarioError(f"n_samples must be odd and >= {MIN_SAMPLES}; got {self.n_samples}")
         if self.n_check < 3:
             raise ScenarioError(f"n_check must be >= 3; got {self.n_check}")
+        if self.moment_about not in MOMENT_POINTS:
+            raise ScenarioError(f"moment_about must be one of {', '.join(MOMENT_POINTS)}; got {self.moment_about!r}")
+
+    @property
+    def moment_point(self) -> FloatArray | None:
+        """(3,) point of the base torque in the root frame [m], or None for the spacecraft's
+        centre of mass (:func:`~jointlock.dynamics.rnea`'s default)."""
+        return np.zeros(3) if self.moment_about == "joint1" else None
 
     @property
     def dof(self) -> int:
@@ -162,6 +178,11 @@ class HaltProblem:
         shape = self.k_shape(t)
         kk = k[..., None, :]
         return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+
+
+#: Points about which the base torque can be taken (:attr:`HaltProblem.moment_about`).
+MOMENT_POINTS = ("spacecraft_com", "joint1")
+MomentAbout = Literal["spacecraft_com", "joint1"]
 
 
 def _k_array(k: ArrayLike, n: int, per_joint: bool) -> FloatArray:
