@@ -594,7 +594,25 @@ def test_halt_prints_the_state_it_starts_from(capsys):
     from jointlock.jobs.halt import halt_from_scenario
 
     data = {**data, "halt": {**data["halt"], "paper_qf": True}}
-    assert halt_from_scenario(data, {}).state_source == "the scenario's [state]"
+    assert halt_from_scenario(data, {}).state_source == "000 §5.2"  # the example's state is 000's
+
+
+def test_000s_defaults_belong_to_joint_4_at_0_only(tmp_path, capsys):
+    """A scenario (or the library) with joint 4 locked at 30 deg gets no 000 state or T; 000's lock
+    given explicitly does; giving part of the state on 000's failure warns."""
+    path = tmp_path / "j4at30.toml"
+    path.write_text('robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 30.0\n[halt]\nqf_deg = [0, 0, 0, 0, 0, 0]\n')
+    with pytest.raises(jl.ScenarioError, match=r"job \[halt\] needs state.q0_deg"):
+        jl.load_scenario(path)
+    model = jl.lock(jl.load_robot("halt7", base="floating"), 3, 0.0)
+    state = jl.FailureState.from_degrees(model, [0.0] * 6)
+    with pytest.raises(jl.ScenarioError, match="needs the halt time T"):
+        jl.plan_halt(model, state, qf=np.zeros(6))
+    assert exit_code(["halt", "halt7", "--lock", "4=0", "--paper-qf", "--quiet", "--n-samples", "101"]) == 0
+    assert "state at failure (000 §5.2)" in capsys.readouterr().out
+    assert exit_code(["halt", "halt7", "--paper-qf", "--quiet", "--n-samples", "101", "--q0-deg", *["0"] * 6]) == 0
+    err = capsys.readouterr().err
+    assert "warning: --q0-deg given, the rest of the state is 000 §5.2's" in err
 
 
 def test_run_refuses_a_second_lock_instead_of_keeping_the_last(capsys):

@@ -613,7 +613,7 @@ def test_moment_about_gives_both_readings_on_000s_scenario():
     assert about_joint1.motion.global_torque_k0 == pytest.approx(2340.5, abs=0.05)
     assert about_com.to_dict()["moment_about"] == "spacecraft_com"
     assert about_joint1.to_dict()["moment_about"] == "joint1"
-    assert "about joint 1's origin" in about_joint1.summary()[0]
+    assert "about joint 1's mount (the root frame's origin)" in about_joint1.summary()[0]
     # the moment about another point: n_P = n_O + (O - P) x f, checked on the histories
     from jointlock.planning.halt_motion import base_torque_history
 
@@ -631,3 +631,29 @@ def test_moment_about_is_checked():
 
     with pytest.raises(jl.ScenarioError, match="moment_about must be one of spacecraft_com, joint1"):
         jl.plan_halt("halt7", paper_qf=True, moment_about="tip")
+
+
+def test_moment_about_reaches_the_scenario_run_and_its_equivalent_command():
+    """[halt] moment_about = "joint1": the run's result and the command it records agree."""
+    import shlex
+    from pathlib import Path
+
+    import jointlock as jl
+    from jointlock.cli import main
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    overrides = {"halt.moment_about": "joint1", "halt.paper_qf": True, "halt.n_samples": 101, "jobs": ["halt"]}
+    run = jl.run_scenario(jl.load_scenario(examples / "halt_000.toml", overrides))
+    halt = run.to_dict()["jobs"]["halt"]
+    assert run["halt"].to_dict()["moment_about"] == "joint1" and "--moment-about joint1" in halt["command"]
+    argv = [a for a in shlex.split(halt["command"])[1:] if a != "--quiet"]
+    out_at = argv.index("--out")
+    del argv[out_at : out_at + 2]
+    import contextlib
+    import io
+    import json
+
+    buf = io.StringIO()
+    with contextlib.redirect_stdout(buf):
+        assert main(argv) == 0
+    assert json.loads(buf.getvalue())["global_torque_k0_Nm"] == pytest.approx(run["halt"].motion.global_torque_k0, rel=1e-12)

@@ -173,7 +173,8 @@ def test_000_note_only_for_000s_scenario(tmp_path):
 
     for angle, expected in ((0.0, True), (10.0, False)):
         path = tmp_path / f"s{angle:g}.toml"
-        path.write_text(f'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = {angle}\n[halt]\n')
+        own = "" if expected else "T = 10.0\n[state]\nq0_deg = [0, 0, 0, 0, 0, 0]\ndq0_deg = [0, 0, 0, 0, 0, 0]\nddq0_deg = [0, 0, 0, 0, 0, 0]\n"
+        path.write_text(f'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = {angle}\n[halt]\n{own}')
         sc = load_scenario(path)
         full, _ = _model(sc)
         assert is_000_case(sc, full) is expected

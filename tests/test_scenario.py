@@ -132,7 +132,7 @@ def test_jobs_list_selects_and_orders(tmp_path):
 
 
 def test_full_arm_rates_need_a_zero_locked_entry(tmp_path):
-    head = 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 30\n[halt]\n[state]\n'
+    head = 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 30\n[halt]\nT = 10.0\n[state]\n'  # not 000's failure: T given
     q0 = "q0_deg = [-180, -180, -100, 30, -10, 20, 20]\n"
     ok = write(
         tmp_path, head + q0 + "dq0_deg = [20, 30, 15, 0, 25, 40, 35]\nddq0_deg = [8, 10, 12, 0, 10, -8, 6]\n"

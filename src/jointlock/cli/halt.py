@@ -11,6 +11,7 @@ from __future__ import annotations
 import argparse
 import math
 import sys
+import warnings
 from pathlib import Path
 from typing import Any
 
@@ -24,6 +25,7 @@ from ..jobs.halt import (
     HaltPlan,
     check_halt_settings,
     halt_model,
+    is_000_failure,
     limits_text,  # noqa: F401  (re-exported)
     plan_halt,
     resolve_limits,  # noqa: F401  (re-exported)
@@ -98,7 +100,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=("spacecraft_com", "joint1"),
         default="spacecraft_com",
         help="point of the base torque: the spacecraft's centre of mass (default, physical) or joint 1's "
-        "origin (an independent reproduction of 000's reading)",
+        "mount, the root frame's origin (an independent reproduction's reading of 000)",
     )
     p.add_argument(
         "--from-rest",
@@ -109,7 +111,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], 0.001 .. 1e6 (000: 10)")
     qf = p.add_mutually_exclusive_group()
     qf.add_argument("--qf-deg", type=deg_arg, nargs="+", metavar="DEG", help="halt configuration [deg]")
-    qf.add_argument("--paper-qf", action="store_true", help="use 000's printed q_best (halt7 only)")
+    qf.add_argument("--paper-qf", action="store_true", help="use 000's printed q_best (000's failure only: halt7, joint 4 locked at 0)")
     p.add_argument(
         "--vmax-deg",
         type=field_arg("limits", "vmax_deg_s"),
@@ -178,8 +180,8 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga, CLI_NAMES)
     paper_lock = {j: math.radians(a) for j, a in PAPER_SCENARIO["lock"].items()}
     locks = lock_map(args.lock) if args.lock else (paper_lock if args.robot == "halt7" else {})
-    # 000's state at failure belongs to 000's failure only: halt7 with joint 4 locked at 0
-    paper = args.robot == "halt7" and locks == paper_lock
+    model = halt_model(args.robot, locks, args.base)
+    paper = is_000_failure(model)  # 000's state at failure belongs to 000's failure only
     defaults = PAPER_SCENARIO if paper else {}
     if args.from_rest:
         if args.dq0_deg is not None or args.ddq0_deg is not None:
@@ -206,7 +208,6 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
             "time [s]; 000's scenario is the default only for halt7 with joint 4 locked at 0 deg; "
             "--from-rest sets zero rates and accelerations)"
         )
-    model = halt_model(args.robot, locks, args.base)
     given = [opt for opt, v in (("--q0-deg", args.q0_deg), ("--dq0-deg", args.dq0_deg), ("--ddq0-deg", args.ddq0_deg)) if v]
     rest = [0.0] * model.dof
     state = FailureState.from_degrees(
@@ -219,6 +220,13 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     source = "000 §5.2" if not given else "given" if len(given) == 3 else f"{', '.join(given)} given, the rest 000 §5.2's"
     if args.from_rest:
         source = "--q0-deg, from rest" if args.q0_deg else "000 §5.2's angles, from rest"
+    elif 0 < len(given) < 3:
+        warnings.warn(
+            f"{', '.join(given)} given, the rest of the state is 000 §5.2's: give all three (or --from-rest) "
+            "for a state of your own",
+            UserWarning,
+            stacklevel=1,
+        )
     if args.paper_qf and not paper:
         raise ScenarioError("--paper-qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give --qf-deg")
     return plan_halt(

@@ -90,7 +90,7 @@ def locked_deg(model: ArmModel) -> dict[str, float]:
 
 def locked_text(locked: dict[str, float]) -> str:
     """``"joint J at DEG deg, ..."`` (or ``"none"``) from :func:`locked_deg`'s mapping."""
-    return ", ".join(f"joint {k} at {v:g} deg" for k, v in locked.items()) or "none"
+    return ", ".join(f"joint {k} at {v + 0.0:g} deg" for k, v in locked.items()) or "none"  # + 0.0: no "-0"
 
 
 def joint_vector_deg(

@@ -88,6 +88,7 @@ def job_argv(
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
         argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])
+        argv += ["--moment-about", t["moment_about"]] if t["moment_about"] != "spacecraft_com" else []
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "jump":
         fields = jump_fields(d)

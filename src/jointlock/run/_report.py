@@ -13,6 +13,7 @@ from typing import Any
 import numpy as np
 
 from ..io.files import save_figure
+from ..jobs.halt._result import MOMENT_TEXT
 from ..locking import lock
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
@@ -362,8 +363,8 @@ def assumptions(scenario: Scenario, model: Any) -> list[str]:
     if "halt" in jobs:
         notes.append(
             "Halt motion: 000 eq. (27) with one shared k, k read in deg/s^6 (000's reading); objective = "
-            "time average of the base torque about the spacecraft's centre of mass (Simpson's rule); limits "
-            "checked on a 2001-point grid (docs/halt-motion.md)."
+            f"time average of the base torque about {MOMENT_TEXT[d['halt']['moment_about']]} (Simpson's rule); "
+            "limits checked on a 2001-point grid (docs/halt-motion.md)."
             + (" 000's headline numbers are not reproduced." if is_000_case(scenario, model) else "")
         )
     if "jump" in jobs:

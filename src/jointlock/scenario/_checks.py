@@ -10,7 +10,7 @@ from ..bounds import shown
 from ..errors import JointlockError, ScenarioError
 from ..io.files import check_path_text
 from ..robots import BUILTIN_ROBOTS
-from ._defaults import _defaults_000
+from ._defaults import _defaults_000, _is_000_failure
 from ._fields import _BASE2, NEEDS_LOCK, _hint
 from ._jump import _check_jump
 
@@ -148,8 +148,10 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
         vector("halt.qf_deg", h["qf_deg"])
         if h["paper_qf"] and h["qf_deg"] is not None:
             raise ScenarioError(f"{source}: halt.paper_qf and halt.qf_deg exclude each other; give one")
-        if h["paper_qf"] and model.name != "halt7":
-            raise ScenarioError(f"{source}: halt.paper_qf is 000's q_best for halt7 only; give halt.qf_deg")
+        if h["paper_qf"] and not _is_000_failure(model.name, fail):
+            raise ScenarioError(
+                f"{source}: halt.paper_qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give halt.qf_deg"
+            )
         if h["n_samples"] % 2 == 0:
             raise ScenarioError(
                 f"{source}: halt.n_samples must be odd (Simpson's rule); got {h['n_samples']}"

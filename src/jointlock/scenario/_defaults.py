@@ -1,14 +1,21 @@
-"""000's defaults: halt7 with joint 4 locked gets 000 §5.2's state, limits and halt time."""
+"""000's defaults: halt7 with joint 4 locked at 0 deg gets 000 §5.2's state, limits and halt time."""
 
 from __future__ import annotations
 
+import math
 from typing import Any
+
+
+def _is_000_failure(robot: str, fail: dict[str, Any]) -> bool:
+    """halt7 with joint 4 locked at 0 deg: the failure 000's state, limits and T belong to."""
+    angle = fail.get("angle_deg")
+    return robot == "halt7" and fail.get("joint") == 4 and angle is not None and math.isclose(angle, 0.0, abs_tol=1e-9)
 
 
 def _defaults_000(out: dict[str, Any], jobs: tuple[str, ...], model: Any) -> None:
     """halt7 with joint 4 locked: 000 §5's state and limits where the file gives none."""
     fail = out["failure"]
-    if model.name != "halt7" or fail["joint"] != 4 or not ({"halt", "halt_config"} & set(jobs)):
+    if not _is_000_failure(model.name, fail) or not ({"halt", "halt_config"} & set(jobs)):
         return
     from ..papers.p000 import SCENARIO as PAPER_SCENARIO
 

@@ -36,6 +36,7 @@ from ._inputs import (
     FailureState,
     JointLimits,
     halt_limits,
+    is_000_failure,
     limits_text,
     resolve_limits,
 )
@@ -69,6 +70,7 @@ __all__ = [
     "halt_from_scenario",
     "halt_limits",
     "halt_model",
+    "is_000_failure",
     "limits_text",
     "plan_halt",
     "resolve_limits",

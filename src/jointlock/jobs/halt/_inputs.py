@@ -23,6 +23,17 @@ DEFAULT_VMAX_DEG = p000.VELOCITY_LIMIT_DEG_S
 DEFAULT_AMAX_DEG = p000.ACCELERATION_LIMIT_DEG_S2
 
 
+def is_000_failure(model: ArmModel) -> bool:
+    """halt7 with joint 4 locked at 0 deg and no other lock: 000 §5's failure, the only one 000's
+    state at failure, halt time and q_best belong to."""
+    locked = {lj.number: math.degrees(lj.angle) for lj in model.locked}
+    return (
+        model.name == "halt7"
+        and set(locked) == set(p000.SCENARIO["lock"])
+        and all(math.isclose(locked[j], a, abs_tol=1e-9) for j, a in p000.SCENARIO["lock"].items())
+    )
+
+
 @dataclass(frozen=True)
 class FailureState:
     """State of the healthy joints when the failure is detected.

@@ -40,7 +40,10 @@ from .._common import JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
 
 #: How the summary names the base torque's point (:attr:`HaltProblem.moment_about`).
-MOMENT_TEXT = {"spacecraft_com": "the spacecraft's centre of mass", "joint1": "joint 1's origin"}
+MOMENT_TEXT = {
+    "spacecraft_com": "the spacecraft's centre of mass",
+    "joint1": "joint 1's mount (the root frame's origin)",
+}
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead

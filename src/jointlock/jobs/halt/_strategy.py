@@ -22,13 +22,14 @@ from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal
 from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
 from ...progress import Progress
 from ...robots import load_robot
-from .._common import JobResult, joint_vector_deg, scenario_lock
+from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_lock
 from ._inputs import (
     CLI_LIMIT_NAMES,
     SCENARIO_LIMIT_NAMES,
     FailureState,
     JointLimits,
     halt_limits,
+    is_000_failure,
     limits_text,
 )
 from ._result import HaltPlan
@@ -63,7 +64,7 @@ def halt_model(robot: str, locks: Mapping[int, float] | None, base: str = "fixed
 def _is_paper_state(model: ArmModel, state: FailureState, T: float, limits: JointLimits) -> bool:
     """True for 000 §5's scenario on halt7: joint 4 locked at 0, §5.2's state, T and limits."""
     ps = p000.SCENARIO
-    if model.name != "halt7" or {lj.number: lj.angle for lj in model.locked} != ps["lock"]:
+    if not is_000_failure(model):
         return False
     same = all(
         np.allclose(np.degrees(v), ps[key], atol=1e-9)
@@ -192,32 +193,24 @@ def _arm_state_and_time(
     time and base, with 000 §5's as defaults on halt7; and whether the arm is halt7."""
     named = isinstance(robot, str)
     if named:
-        paper = robot == "halt7"
-        defaults = p000.SCENARIO if paper else {}
-        if locks is None:
-            locks = {j: math.radians(a) for j, a in defaults.get("lock", {}).items()}
+        if locks is None and robot == "halt7":
+            locks = {j: math.radians(a) for j, a in p000.SCENARIO["lock"].items()}
         base = base or "fixed"  # 000 computes the torque with the spacecraft held
         model = halt_model(robot, locks, base)  # a name that is no robot is refused here
     else:
         model = robot
         base = base or ("floating" if model.floating else "fixed")  # the model's own base
-        paper = model.name == "halt7"
-        defaults = p000.SCENARIO if paper else {}
+    paper = is_000_failure(model)  # 000's state and T belong to 000's failure only
+    defaults = p000.SCENARIO if paper else {}
     if state is None and not paper:
         raise ScenarioError(
-            f"plan_halt needs the state at failure of {model.name!r} (state=FailureState(...)); "
-            "000's scenario is the default for halt7 only"
+            f"plan_halt needs the state at failure of {model.name!r} with {locked_text(locked_deg(model))} "
+            "(state=FailureState(...)); 000's is the default only for halt7 with joint 4 locked at 0 deg"
         )
     if T is None and "T" not in defaults:
         raise ScenarioError(f"plan_halt needs the halt time T [s] for {model.name!r}")
     T = float(T if T is not None else defaults["T"])
     if state is None:
-        lock_now = {lj.number: lj.angle for lj in model.locked}
-        if lock_now != dict(defaults["lock"]):
-            raise ScenarioError(
-                f"plan_halt: 000's state at failure is for halt7 with joint 4 locked at 0; this model has "
-                f"locked {sorted(lock_now) or 'no joint'}: give state=FailureState(...)"
-            )
         state = FailureState.from_degrees(
             model, defaults["q0_deg"], defaults["dq0_deg"], defaults["ddq0_deg"],
             names=state_names,
@@ -265,15 +258,17 @@ def plan_halt(
         locked :class:`ArmModel` (used as given: the base torque is taken about its
         spacecraft's centre of mass when it has one, else about its root frame's origin).
     state
-        State at failure; None on halt7 = 000 §5.2's (:data:`jointlock.papers.p000.SCENARIO`).
+        State at failure; None on 000's failure (halt7, joint 4 locked at 0 deg: see
+        :func:`is_000_failure`) = 000 §5.2's (:data:`jointlock.papers.p000.SCENARIO`); needed for
+        any other failure.
     locks
         ``{joint number: angle [rad]}`` when ``robot`` is a name; None on halt7 = 000's
         (joint 4 at 0).
     T
-        Halt time [s]; None on halt7 = 000's 10 s.
+        Halt time [s]; None on 000's failure = 000's 10 s; needed for any other.
     qf
         (n,) halt configuration [rad]; None = search it (HCOM), unless ``paper_qf`` (000's
-        printed q_best, halt7 only).
+        printed q_best, on 000's failure only).
     vmax_deg, amax_deg, limits
         The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s] and ``amax_deg``
         [deg/s^2], or ``limits`` as they are.
@@ -330,7 +325,7 @@ def plan_halt(
     if qf is not None:
         qf_arr, qf_source = np.asarray(qf, dtype=float), _names["qf"]
     elif paper_qf:
-        if not paper or {lj.number: math.degrees(lj.angle) for lj in model.locked} != dict(p000.SCENARIO["lock"]):
+        if not paper:
             raise ScenarioError(
                 "paper_qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give qf"
             )
@@ -405,7 +400,6 @@ def halt_from_scenario(
         ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
         minimum_T=bool(t["minimum_T"]),
         progress=progress,
-        state_source="the scenario's [state]",
         moment_about=t["moment_about"],
         _names=names,
     )
