@@ -1,5 +1,5 @@
 """Figures of a halt motion (000 §4-§5.2): global base torque vs k (Fig. 8), joint profiles
-(Fig. 9) and the base torque over the halt."""
+(Fig. 9), the base torque over the halt, and what a free spacecraft does during it."""
 
 from __future__ import annotations
 
@@ -146,3 +146,24 @@ def plot_base_torque_vs_time(res: HaltMotion, *, ax: Any | None = None) -> Any:
         ax.set_title("INFEASIBLE halt: every k breaks a limit", color="r")
     ax.legend(fontsize=8)
     return ax
+
+
+def plot_spacecraft_response(response: Any, *, fig: Any | None = None) -> Any:
+    """The spacecraft during a free-floating motion
+    (:class:`~jointlock.analysis.spacecraft.SpacecraftResponse`): attitude change [deg] and
+    angular rate [deg/s] over time (left axis, right axis).  Returns the figure."""
+    fig = new_figure(fig, (7, 4))
+    ax = fig.add_subplot()
+    t = response.t
+    ax.plot(t, response.attitude_change_deg, label="attitude change [deg]")
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("attitude change from t = 0 [deg]")
+    rate = ax.twinx()
+    rate.plot(t, np.degrees(np.linalg.norm(response.angular_velocity, axis=-1)), color="C1", label="rate [deg/s]")
+    rate.set_ylabel("angular rate [deg/s]", color="C1")
+    ax.set_title(
+        f"spacecraft: {response.final_attitude_change_deg:.3g} deg turned, peak {response.peak_rate_deg_s:.3g} deg/s, "
+        f"drift {response.com_drift_m:.3g} m",
+        fontsize=9,
+    )
+    return fig

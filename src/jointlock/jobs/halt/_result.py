@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...io.files import (
     atomic_write_bytes,
     atomic_write_json,
@@ -35,6 +36,7 @@ from ...plots.halt import (
     plot_base_torque_vs_time,
     plot_global_torque_vs_k,
     plot_joint_profiles,
+    plot_spacecraft_response,
 )
 from .._common import JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
@@ -145,6 +147,7 @@ class HaltPlan(JobResult):
             "q_initial_deg": np.degrees(p.q0),
             "dq_initial_deg_s": np.degrees(p.dq0),
             "ddq_initial_deg_s2": np.degrees(p.ddq0),
+            "spacecraft": None if (sc := self.spacecraft_response()) is None else sc.to_dict(),
             "state_source": self.state_source,
             "moment_about": p.moment_about,
             "from_rest": self.from_rest,
@@ -159,6 +162,18 @@ class HaltPlan(JobResult):
             "paper": dict(p000.HALT_RESULTS) if self.paper_scenario else None,
             **self._notes(),
         }
+
+    def spacecraft_response(self, n: int | None = None) -> SpacecraftResponse | None:
+        """What a free spacecraft does during the halt (:func:`~jointlock.analysis.spacecraft.
+        spacecraft_response`): attitude, rate and drift on ``n`` time samples (default the
+        objective's grid); None for a model without a spacecraft.  With ``base="fixed"`` (000's
+        torque, the spacecraft held) it says what the spacecraft would do if it were free."""
+        p = self.problem
+        if not p.model.floating:
+            return None
+        t = p.times(n)
+        q, dq, _ = self.motion.trajectory(t)
+        return spacecraft_response(p.model, t, q, dq)
 
     @property
     def from_rest(self) -> bool:
@@ -217,6 +232,10 @@ class HaltPlan(JobResult):
             lines += ["", f"feasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}", f"k* = {k_text(res)}"]
         if res.feasible and res.minimum_T is not None:
             lines.append(f"smallest halt time with a feasible k: T = {res.minimum_T:.3f} s")
+        sc = self.spacecraft_response()
+        if sc is not None:
+            label = "spacecraft (free)" if p.base == "floating" else "spacecraft if it were free (the torque is for it held)"
+            lines += sc.summary(label)
         at = "k*" if res.feasible else "least-violating k (infeasible)"
         lines.append(
             f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
@@ -256,6 +275,9 @@ class HaltPlan(JobResult):
             ("joint_profiles.png", (3 * p.dof, 7), lambda fig: plot_joint_profiles(res, fig=fig)),
             ("base_torque_vs_time.png", (7, 4), lambda fig: plot_base_torque_vs_time(res, ax=fig.add_subplot())),
         )
+        sc = self.spacecraft_response()
+        if sc is not None:
+            figures += (("spacecraft_attitude.png", (7, 4), lambda fig: plot_spacecraft_response(sc, fig=fig)),)
         written = []
         for name, size, draw in figures:
             fig = offscreen_figure(size)

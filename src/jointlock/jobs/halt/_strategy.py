@@ -204,8 +204,8 @@ def _arm_state_and_time(
     defaults = p000.SCENARIO if paper else {}
     if state is None and not paper:
         raise ScenarioError(
-            f"plan_halt needs the state at failure of {model.name!r} with {locked_text(locked_deg(model))} "
-            "(state=FailureState(...)); 000's is the default only for halt7 with joint 4 locked at 0 deg"
+            f"plan_halt needs the state at failure of {model.name!r} (locked: {locked_text(locked_deg(model))}; "
+            "state=FailureState(...)): 000's is the default only for halt7 with joint 4 locked at 0 deg"
         )
     if T is None and "T" not in defaults:
         raise ScenarioError(f"plan_halt needs the halt time T [s] for {model.name!r}")

@@ -1,0 +1,179 @@
+"""What the spacecraft feels during a free-floating motion: its attitude, angular rate and the
+drift of its centre of mass, from the zero-momentum condition (a free-floating system starting
+at rest keeps zero linear and angular momentum).
+
+At each sample the spacecraft's twist follows from the joint rates alone,
+``nu_0 = -H_b^{-1} h_arm(q, dq)`` (:func:`jointlock.dynamics.rnea`'s ``base_twist``, in the
+spacecraft's own frame).  Its attitude is the ordered product of the rotations over each time
+step, ``R(t_k) = R(t_{k-1}) exp([omega_mid] dt)`` with the step's mid-point angular velocity
+(second order in ``dt``), composed as unit quaternions by a parallel prefix scan (log2 of the
+samples' count of batched products, no Python loop over samples).  The centre of mass moves by
+``int R(t) v_0(t) dt`` (trapezoidal).  The attitude is relative to the spacecraft's attitude at
+the first sample, the drift in that first frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ..dynamics import rnea
+from ..errors import ModelError
+from ..model import ArmModel, FloatArray
+
+
+@dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
+class SpacecraftResponse:
+    """The spacecraft's motion while the arm moves, its base free.
+
+    Attributes
+    ----------
+    t
+        (m,) times [s].
+    attitude
+        (m, 4) unit quaternions ``(w, x, y, z)``: the spacecraft's attitude relative to its
+        attitude at ``t[0]``.
+    angular_velocity
+        (m, 3) angular velocity [rad/s], spacecraft frame.
+    com_displacement
+        (m, 3) displacement of the spacecraft's centre of mass [m], in its frame at ``t[0]``.
+    """
+
+    t: FloatArray
+    attitude: FloatArray
+    angular_velocity: FloatArray
+    com_displacement: FloatArray
+
+    @property
+    def attitude_change_deg(self) -> FloatArray:
+        """(m,) angle of the rotation from the first attitude [deg]."""
+        w = np.clip(np.abs(self.attitude[:, 0]), 0.0, 1.0)
+        return np.degrees(2.0 * np.arccos(w))
+
+    @property
+    def final_attitude_change_deg(self) -> float:
+        """Attitude change at the end of the motion [deg]."""
+        return float(self.attitude_change_deg[-1])
+
+    @property
+    def peak_rate_deg_s(self) -> float:
+        """Largest angular rate of the spacecraft [deg/s]."""
+        return float(np.degrees(np.linalg.norm(self.angular_velocity, axis=-1).max()))
+
+    @property
+    def com_drift_m(self) -> float:
+        """Distance of the spacecraft's centre of mass from where it started, at the end [m]."""
+        return float(np.linalg.norm(self.com_displacement[-1]))
+
+    def summary(self, label: str = "spacecraft (free)") -> list[str]:
+        """One line: final attitude change, peak rate, centre-of-mass drift."""
+        return [
+            f"{label}: attitude change {self.final_attitude_change_deg:.4g} deg "
+            f"(largest {self.attitude_change_deg.max():.4g} deg), peak rate {self.peak_rate_deg_s:.4g} deg/s, "
+            f"centre-of-mass drift {self.com_drift_m:.4g} m"
+        ]
+
+    def to_dict(self) -> dict[str, Any]:
+        """The headline figures (degrees, metres); the histories are in :meth:`time_series`."""
+        return {
+            "attitude_change_deg": self.final_attitude_change_deg,
+            "max_attitude_change_deg": float(self.attitude_change_deg.max()),
+            "peak_rate_deg_s": self.peak_rate_deg_s,
+            "com_drift_m": self.com_drift_m,
+        }
+
+    def time_series(self) -> dict[str, FloatArray]:
+        """``t`` [s], ``attitude`` (m, 4), ``angular_velocity`` (m, 3) [rad/s],
+        ``com_displacement`` (m, 3) [m], ``attitude_change_deg`` (m,)."""
+        return {
+            "t": self.t,
+            "attitude": self.attitude,
+            "angular_velocity": self.angular_velocity,
+            "com_displacement": self.com_displacement,
+            "attitude_change_deg": self.attitude_change_deg,
+        }
+
+
+def spacecraft_response(model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLike) -> SpacecraftResponse:
+    """The spacecraft's attitude, rate and drift while the joints follow ``q(t)``, ``dq(t)``.
+
+    Parameters
+    ----------
+    model
+        A free-floating arm (with its spacecraft; locked joints allowed).
+    t
+        (m,) increasing times [s], m >= 2.
+    q, dq
+        (m, n) joint angles [rad] and rates [rad/s] at those times.
+
+    Returns
+    -------
+    SpacecraftResponse
+    """
+    if not model.floating:
+        raise ModelError(
+            f"spacecraft_response needs a free-floating model (a spacecraft body); {model.name!r} has a "
+            "fixed base: load it with base='floating'"
+        )
+    t = np.asarray(t, dtype=float)
+    if t.ndim != 1 or t.size < 2 or not np.all(np.isfinite(t)) or np.any(np.diff(t) <= 0):
+        raise ModelError(f"t must be (m,) increasing finite times, m >= 2 [s]; got shape {t.shape}")
+    q = np.asarray(q, dtype=float)
+    dq = np.asarray(dq, dtype=float)
+    if q.shape != (t.size, model.dof) or dq.shape != q.shape:
+        raise ModelError(f"q and dq must have shape ({t.size}, {model.dof}); got {q.shape} and {dq.shape}")
+    twist = rnea(model, q, dq, np.zeros_like(q), base="floating").base_twist  # needs no ddq
+    v0, w0 = twist[:, :3], twist[:, 3:]
+    dt = np.diff(t)
+    steps = _rotvec_quaternions(0.5 * (w0[1:] + w0[:-1]) * dt[:, None])
+    attitude = np.concatenate([[[1.0, 0.0, 0.0, 0.0]], _prefix_products(steps)])
+    velocity = _rotate(attitude, v0)  # the centre of mass's velocity in the first frame
+    drift = np.concatenate([np.zeros((1, 3)), np.cumsum(0.5 * (velocity[1:] + velocity[:-1]) * dt[:, None], axis=0)])
+    return SpacecraftResponse(t, attitude, w0, drift)
+
+
+def _rotvec_quaternions(rotvec: FloatArray) -> FloatArray:
+    """(k, 4) unit quaternions ``(w, x, y, z)`` of rotation vectors (k, 3) [rad]."""
+    angle = np.linalg.norm(rotvec, axis=-1)
+    half = 0.5 * angle
+    # sin(a/2)/a, with its limit 1/2 at a = 0
+    scale = np.where(angle > 1e-12, np.sin(half) / np.where(angle > 1e-12, angle, 1.0), 0.5 - angle**2 / 48.0)
+    return np.concatenate([np.cos(half)[:, None], rotvec * scale[:, None]], axis=-1)
+
+
+def _quaternion_product(a: FloatArray, b: FloatArray) -> FloatArray:
+    """(..., 4) Hamilton products ``a b`` (rotation ``b`` first, in ``a``'s frame)."""
+    aw, ax, ay, az = np.moveaxis(a, -1, 0)
+    bw, bx, by, bz = np.moveaxis(b, -1, 0)
+    return np.stack(
+        [
+            aw * bw - ax * bx - ay * by - az * bz,
+            aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+        ],
+        axis=-1,
+    )
+
+
+def _prefix_products(steps: FloatArray) -> FloatArray:
+    """(k, 4) ordered products ``s_0 s_1 ... s_i`` of unit quaternions (k, 4): a Hillis-Steele
+    scan, ceil(log2 k) batched products (the product is associative, not commutative: the
+    earlier step stays on the left), renormalised against round-off."""
+    out = steps.copy()
+    offset = 1
+    while offset < len(out):
+        out[offset:] = _quaternion_product(out[:-offset], out[offset:])
+        offset *= 2
+    return out / np.linalg.norm(out, axis=-1, keepdims=True)
+
+
+def _rotate(quaternion: FloatArray, vector: FloatArray) -> FloatArray:
+    """(m, 3) vectors (m, 3) rotated by unit quaternions (m, 4)."""
+    w, xyz = quaternion[:, :1], quaternion[:, 1:]
+    cross = np.cross(xyz, vector)
+    return vector + 2.0 * w * cross + 2.0 * np.cross(xyz, cross)
+
