@@ -85,3 +85,26 @@ def test_a_fixed_model_has_no_spacecraft_response():
     arm = jl.load_robot("puma6")
     with pytest.raises(jl.ModelError, match="free-floating model"):
         spacecraft_response(arm, [0.0, 1.0], np.zeros((2, 6)), np.zeros((2, 6)))
+
+
+@pytest.mark.parametrize(("n", "tol_m"), [(501, 1e-4), (4001, 2e-6)])
+def test_the_whole_systems_centre_of_mass_stays_put(paper_halt, n, tol_m):
+    """Zero momentum: the system's centre of mass does not move.  In the first frame it is the
+    spacecraft's drift plus its attitude applied to (system CoM - spacecraft CoM) in its own
+    frame: this checks the order of the rotations (the other order moves it by ~0.16 m) and the
+    drift, independently of how they were computed."""
+    from jointlock.analysis.spacecraft import _rotate
+    from jointlock.kinematics import system_com
+
+    p = paper_halt.problem
+    sc = paper_halt.spacecraft_response(n)
+    q, _, _ = paper_halt.motion.trajectory(sc.t)
+    inertial = sc.com_displacement + _rotate(sc.attitude, system_com(p.model, q) - p.model.root_body.com)
+    assert np.abs(inertial - inertial[0]).max() < tol_m
+
+
+def test_the_attitude_needs_no_fine_objective_grid():
+    """The halt's objective may use few samples; the attitude keeps its own 0.02 s step."""
+    coarse = jl.plan_halt("halt7", paper_qf=True, n_samples=11).spacecraft_response()
+    assert coarse.final_attitude_change_deg == pytest.approx(123.89, abs=0.01)
+    assert coarse.rotation_path_deg >= coarse.final_attitude_change_deg

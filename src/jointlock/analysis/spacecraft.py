@@ -4,12 +4,15 @@ at rest keeps zero linear and angular momentum).
 
 At each sample the spacecraft's twist follows from the joint rates alone,
 ``nu_0 = -H_b^{-1} h_arm(q, dq)`` (:func:`jointlock.dynamics.rnea`'s ``base_twist``, in the
-spacecraft's own frame).  Its attitude is the ordered product of the rotations over each time
-step, ``R(t_k) = R(t_{k-1}) exp([omega_mid] dt)`` with the step's mid-point angular velocity
-(second order in ``dt``), composed as unit quaternions by a parallel prefix scan (log2 of the
-samples' count of batched products, no Python loop over samples).  The centre of mass moves by
-``int R(t) v_0(t) dt`` (trapezoidal).  The attitude is relative to the spacecraft's attitude at
-the first sample, the drift in that first frame.
+spacecraft's own frame).  Zero momentum is assumed throughout, as the free-floating dynamics do:
+the system at rest before the motion (an arm already moving when it fails would have given the
+spacecraft its share of that momentum).  The attitude is the ordered product of the rotations over
+each time step, ``R(t_k) = R(t_{k-1}) exp([omega_k] dt)`` with ``omega_k`` the average of the
+step's end rates (second order in ``dt``), composed as unit quaternions by a parallel prefix scan
+(log2 of the samples' count of batched products, no Python loop over samples).  The centre of
+mass moves by ``int R(t) v_0(t) dt`` (trapezoidal).  The attitude is relative to the spacecraft's
+attitude at the first sample, the drift in that first frame.  Checked in the tests: the whole
+system's centre of mass stays put.
 """
 
 from __future__ import annotations
@@ -34,8 +37,9 @@ class SpacecraftResponse:
     t
         (m,) times [s].
     attitude
-        (m, 4) unit quaternions ``(w, x, y, z)``: the spacecraft's attitude relative to its
-        attitude at ``t[0]``.
+        (m, 4) unit quaternions ``(w, x, y, z)`` (Hamilton, active): the spacecraft's attitude
+        relative to its attitude at ``t[0]``, mapping spacecraft-frame components into the
+        first frame.
     angular_velocity
         (m, 3) angular velocity [rad/s], spacecraft frame.
     com_displacement
@@ -49,9 +53,16 @@ class SpacecraftResponse:
 
     @property
     def attitude_change_deg(self) -> FloatArray:
-        """(m,) angle of the rotation from the first attitude [deg]."""
-        w = np.clip(np.abs(self.attitude[:, 0]), 0.0, 1.0)
-        return np.degrees(2.0 * np.arccos(w))
+        """(m,) angle of the smallest rotation from the first attitude to each [deg], in
+        [0, 180] (see :attr:`rotation_path_deg` for the angle turned along the way)."""
+        half_sin = np.linalg.norm(self.attitude[:, 1:], axis=-1)
+        return np.degrees(2.0 * np.arctan2(half_sin, np.abs(self.attitude[:, 0])))  # exact near 0 too
+
+    @property
+    def rotation_path_deg(self) -> float:
+        """Angle turned along the way, ``int |omega| dt`` [deg] (>= the final attitude change)."""
+        rate = np.linalg.norm(self.angular_velocity, axis=-1)
+        return float(np.degrees(np.sum(0.5 * (rate[1:] + rate[:-1]) * np.diff(self.t))))
 
     @property
     def final_attitude_change_deg(self) -> float:
@@ -72,8 +83,8 @@ class SpacecraftResponse:
         """One line: final attitude change, peak rate, centre-of-mass drift."""
         return [
             f"{label}: attitude change {self.final_attitude_change_deg:.4g} deg "
-            f"(largest {self.attitude_change_deg.max():.4g} deg), peak rate {self.peak_rate_deg_s:.4g} deg/s, "
-            f"centre-of-mass drift {self.com_drift_m:.4g} m"
+            f"(largest {self.attitude_change_deg.max():.4g} deg, {self.rotation_path_deg:.4g} deg turned along the "
+            f"way), peak rate {self.peak_rate_deg_s:.4g} deg/s, centre-of-mass drift {self.com_drift_m:.4g} m"
         ]
 
     def to_dict(self) -> dict[str, Any]:
@@ -81,6 +92,7 @@ class SpacecraftResponse:
         return {
             "attitude_change_deg": self.final_attitude_change_deg,
             "max_attitude_change_deg": float(self.attitude_change_deg.max()),
+            "rotation_path_deg": self.rotation_path_deg,
             "peak_rate_deg_s": self.peak_rate_deg_s,
             "com_drift_m": self.com_drift_m,
         }

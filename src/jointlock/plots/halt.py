@@ -162,7 +162,7 @@ def plot_spacecraft_response(response: Any, *, fig: Any | None = None) -> Any:
     rate.plot(t, np.degrees(np.linalg.norm(response.angular_velocity, axis=-1)), color="C1", label="rate [deg/s]")
     rate.set_ylabel("angular rate [deg/s]", color="C1")
     ax.set_title(
-        f"spacecraft: {response.final_attitude_change_deg:.3g} deg turned, peak {response.peak_rate_deg_s:.3g} deg/s, "
+        f"spacecraft: attitude change {response.final_attitude_change_deg:.3g} deg, peak {response.peak_rate_deg_s:.3g} deg/s, "
         f"drift {response.com_drift_m:.3g} m",
         fontsize=9,
     )
