@@ -189,3 +189,24 @@ def test_plots_make_their_own_axes_without_changing_the_backend(results):
     finally:
         plt.close("all")
     assert matplotlib.get_backend() == backend
+
+
+def test_a_floating_jump_without_a_feasible_kappa_says_the_task_breaks_the_limits(capsys):
+    """Issue 14, item 6: NOTES-001's task on the free-floating canadarm7 breaks the limits with
+    no compensation and no failure (the spacecraft's reaction adds joint motion): the error
+    names the limits, by how much and when, instead of only 'no feasible kappa'."""
+    from jointlock.cli import main
+
+    assert main(["jump", "canadarm7", "--base", "floating", "--sweep", "6", "--quiet"]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1
+    assert "with kappa = 0 and no failure, the free-floating arm (generalized Jacobian) already breaks its limits" in err
+    assert "joint speed 27.78 deg/s > limit 10 deg/s (joint 5" in err and "path deviation" in err
+
+
+def test_uncompensated_violations_is_empty_for_a_task_within_the_limits():
+    import jointlock as jl
+    from jointlock.planning.jump import JumpScenario
+    from jointlock.planning.jump._simulate import uncompensated_violations
+
+    assert uncompensated_violations(jl.load_robot("canadarm7"), JumpScenario()) == []

@@ -264,3 +264,35 @@ def jump_reduction(before: ArrayLike, after: ArrayLike) -> Any:
     with np.errstate(divide="ignore", invalid="ignore"):
         out = np.where(b != 0.0, 1.0 - a / np.where(b != 0.0, b, 1.0), np.nan)
     return float(out) if out.ndim == 0 else out
+
+
+def uncompensated_violations(model: ArmModel, scenario: JumpScenario | None = None) -> list[str]:
+    """Which limits the task breaks with no compensation and no failure (kappa = 0), by how much
+    and when: the first thing to know when no kappa is feasible (a task the healthy arm cannot
+    follow within its limits leaves nothing for kappa to keep).  One phrase per broken limit,
+    in degrees and millimetres; empty when the uncompensated task keeps every limit."""
+    sc = JumpScenario() if scenario is None else scenario
+    run = simulate(model, sc, 0.0)
+    out = []
+    rate = np.abs(run.qd)  # (N, n)
+    acc = np.abs(np.diff(run.qd, axis=0)) / sc.dt  # (N - 1, n)
+    for name, values, limit, unit, scale in (
+        ("joint speed", rate, sc.vmax, "deg/s", math.degrees(1.0)),
+        ("joint acceleration", acc, sc.amax, "deg/s^2", math.degrees(1.0)),
+    ):
+        over = values > limit * (1.0 + LIMIT_RTOL)
+        if over.any():
+            k, j = np.unravel_index(int(np.argmax(values)), values.shape)
+            steps = np.flatnonzero(over.any(axis=1))
+            out.append(
+                f"{name} {values[k, j] * scale:.4g} {unit} > limit {limit * scale:.4g} {unit} (joint "
+                f"{model.joint_numbers[j]}, over the limit from t = {run.t[steps[0]]:.3g} to {run.t[steps[-1] + 1]:.3g} s)"
+            )
+    dev = run.deviation
+    if np.any(dev > sc.eps * (1.0 + LIMIT_RTOL)):
+        steps = np.flatnonzero(dev > sc.eps * (1.0 + LIMIT_RTOL))
+        out.append(
+            f"path deviation {1e3 * dev.max():.4g} mm > {1e3 * sc.eps:.4g} mm (t = {run.t[steps[0]]:.3g} to "
+            f"{run.t[steps[-1]]:.3g} s)"
+        )
+    return out

@@ -15,7 +15,7 @@ from ...model import ArmModel, FloatArray
 from ._engine import _healthy_runs, _kappa_rows, _post_runs, _problem, _RunOut, _unsort
 from ._fit import KappaFit, fit_kappa
 from ._search import KappaSearch, search_kappa
-from ._simulate import LimitReport, _limit_report, _table, jump_reduction
+from ._simulate import LimitReport, _limit_report, _table, jump_reduction, uncompensated_violations
 from ._task import JumpScenario
 from ._verify import Verification, verify_kappa
 
@@ -102,7 +102,7 @@ def jump_at_time(
         if not np.isfinite(kappa):
             raise InfeasibleError(
                 f"no kappa in [{search.probe_range[0]:.4g}, {search.probe_range[1]:.4g}] keeps every limit "
-                f"with joint {sc.lock_joint} locking at {k * sc.dt:g} s"
+                f"with joint {sc.lock_joint} locking at {k * sc.dt:g} s; {_why_no_kappa(model, sc)}"
             )
     krows = _kappa_rows(prob, np.array([0.0, float(kappa)]))
     healthy = _healthy_runs(prob, krows)
@@ -207,7 +207,10 @@ def study_jump(
     if p is not None:
         p.close()
     t1 = time.perf_counter()
-    fit = fit_kappa(model, search, order=order, max_order=max_order, **dict(fit_options or {}))
+    try:
+        fit = fit_kappa(model, search, order=order, max_order=max_order, **dict(fit_options or {}))
+    except InfeasibleError as exc:  # say why: usually the task itself, not the failure
+        raise InfeasibleError(f"{exc}; {_why_no_kappa(model, sc)}") from None
     if fit.search is not None:  # failure times added around the breaks of kappa(t)
         search = fit.search
     t2 = time.perf_counter()
@@ -224,3 +227,17 @@ def study_jump(
     t3 = time.perf_counter()
     log.info("jump study: search %.2fs fit %.2fs verify %.2fs", t1 - t0, t2 - t1, t3 - t2)
     return JumpStudy(search, fit, ver, ver_c, {"search": t1 - t0, "fit": t2 - t1, "verify": t3 - t2}, sc)
+
+
+def _why_no_kappa(model: ArmModel, sc: JumpScenario) -> str:
+    """Why no kappa keeps the limits, in words: the limits the task breaks without compensation
+    and without a failure (so no compensation can help), else the jump at the failure itself."""
+    broken = uncompensated_violations(model, sc)
+    base = "the free-floating arm (generalized Jacobian)" if sc.base == "floating" else "the arm"
+    if broken:
+        return (
+            f"with kappa = 0 and no failure, {base} already breaks its limits on this task: "
+            + "; ".join(broken)
+            + " -- a slower task (duration_s), a shorter line (dx_m) or other limits"
+        )
+    return f"{base} keeps its limits on this task without a failure: the jump at each failure time breaks them"
