@@ -657,3 +657,49 @@ def test_moment_about_reaches_the_scenario_run_and_its_equivalent_command():
     with contextlib.redirect_stdout(buf):
         assert main(argv) == 0
     assert json.loads(buf.getvalue())["global_torque_k0_Nm"] == pytest.approx(run["halt"].motion.global_torque_k0, rel=1e-12)
+
+
+def test_a_margin_is_kept_on_every_sample_and_margins_are_reported():
+    """Issue 14, item 3: with margin 0.05 every speed and acceleration stays 5 % below its limit
+    on the whole constraint grid; without it 000's halt runs joint 6 at its speed limit, which
+    the table calls "at the limit" (not kept)."""
+    import jointlock as jl
+
+    state = jl.FailureState.from_degrees(
+        jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0),
+        [-180, -180, -100, -10, 20, 20], [20, 30, 15, 25, 30, 30], [8, 10, 12, 10, -8, 6],
+    )  # fmt: skip
+    plain = jl.plan_halt("halt7", samples=3000)
+    assert plain.feasible and plain.to_dict()["smallest_margin"] < 0.01
+    assert any("(40, at the limit)" in line for line in plain.summary())
+    kept = jl.plan_halt("halt7", state, T=10.0, samples=3000, margin=0.05)
+    assert kept.feasible
+    m = kept.margins()
+    assert min(m["velocity"].min(), m["acceleration"].min()) >= 0.05 - 1e-9
+    data = kept.to_dict()
+    assert data["margin_kept"] == 0.05 and data["smallest_margin"] >= 0.05 - 1e-9
+    assert any(line.startswith("margin kept: 5 %") for line in kept.summary())
+
+
+def test_a_margin_the_start_state_already_eats_into_is_refused():
+    import jointlock as jl
+
+    with pytest.raises(jl.InfeasibleError, match="already within the 5 % margin of a limit.*joint 6 starts with velocity 40"):
+        jl.plan_halt("halt7", samples=1000, margin=0.05)  # 000's state: joint 6 at 40 deg/s, the limit
+    with pytest.raises(jl.ScenarioError, match="margin must be a finite real number >= 0 and <= 0.5"):
+        jl.plan_halt("halt7", samples=1000, margin=0.7)
+
+
+def test_a_narrow_feasible_interval_is_flagged_fragile():
+    """With 1000 Monte Carlo samples 000's halt lands on a configuration whose feasible k
+    interval is 0.4 % of k* wide (k* at its upper end): flagged FRAGILE; with 3000 samples the
+    interval is wide and nothing is flagged."""
+    import jointlock as jl
+
+    wide = jl.plan_halt("halt7", samples=3000, n_samples=101)
+    assert wide.feasible and not wide.fragile and not wide.to_dict()["fragile"]
+    narrow = jl.plan_halt("halt7", samples=1000, n_samples=101)
+    lo, hi = narrow.motion.k_interval
+    assert narrow.feasible and (hi - lo) < 0.01 * abs(float(narrow.motion.k))
+    assert narrow.fragile and narrow.to_dict()["fragile"]
+    assert any(line.startswith("FRAGILE: the feasible k interval is 0.38 % of k* wide") for line in narrow.summary())

@@ -96,6 +96,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="accelerations at failure [deg/s^2]",
     )
     p.add_argument(
+        "--margin",
+        type=field_arg("halt", "margin"),
+        default=0.0,
+        help="share of each speed and acceleration limit the halt keeps free, 0 .. 0.5 (default 0; "
+        "0.05: 5 %%); each limit's margin is reported either way",
+    )
+    p.add_argument(
         "--moment-about",
         choices=("spacecraft_com", "joint1"),
         default="spacecraft_com",
@@ -248,6 +255,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         progress=progress,
         state_source=source,
         moment_about=args.moment_about,
+        margin=args.margin,
         _names=CLI_NAMES,
     )
 

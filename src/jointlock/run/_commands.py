@@ -89,6 +89,7 @@ def job_argv(
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
         argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])
         argv += ["--moment-about", t["moment_about"]] if t["moment_about"] != "spacecraft_com" else []
+        argv += ["--margin", _num(t["margin"])] if t["margin"] else []
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "jump":
         fields = jump_fields(d)

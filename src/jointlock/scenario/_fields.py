@@ -208,6 +208,13 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "n_samples": Field("int", 501, lo=11, hi=200_001, help="time samples of the objective (odd)"),
         "generations": Field("int", 100, lo=0, hi=100_000, help="GA generations (0: the first population only)"),
         "population": Field("int", 50, lo=2, hi=100_000, help="GA population"),
+        "margin": Field(
+            "number",
+            0.0,
+            lo=0.0,
+            hi=0.5,
+            help="share of each speed and acceleration limit kept free by the halt (0.05: 5 %)",
+        ),
         "moment_about": Field(
             "choice",
             "spacecraft_com",

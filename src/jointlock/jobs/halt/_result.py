@@ -41,6 +41,11 @@ from ...plots.halt import (
 from .._common import JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
 
+#: A limit met with less than this share of it free is "at the limit", not kept.
+AT_LIMIT = 0.01
+#: A feasible k interval narrower than this share of |k*| is fragile.
+FRAGILE_WIDTH = 0.01
+
 #: Longest time step of the spacecraft's attitude integration [s] (the objective's grid may be
 #: coarse: 11 samples put 000's 124 deg off by 0.5 deg; 0.02 s keeps it within 1e-3 deg).
 SPACECRAFT_STEP_S = 0.02
@@ -92,6 +97,7 @@ class HaltPlan(JobResult):
     reachability_requested: bool = True
     seed: int | None = 0
     state_source: str = "given"
+    margin: float = 0.0
 
     @property
     def problem(self) -> HaltProblem:
@@ -154,6 +160,11 @@ class HaltPlan(JobResult):
             "spacecraft": None if (sc := self.spacecraft_response()) is None else sc.to_dict(),
             "state_source": self.state_source,
             "moment_about": p.moment_about,
+            "margin_kept": self.margin,
+            "velocity_margin": (m := self.margins())["velocity"],
+            "acceleration_margin": m["acceleration"],
+            "smallest_margin": float(min(m["velocity"].min(), m["acceleration"].min())),
+            "fragile": self.fragile,
             "from_rest": self.from_rest,
             "q_final_deg": np.degrees(p.qf),
             "peak_velocity_deg_s": np.degrees(np.abs(dq).max(axis=0)),
@@ -179,6 +190,27 @@ class HaltPlan(JobResult):
         t = p.times(n if n is not None else max(p.n_samples, math.ceil(p.T / SPACECRAFT_STEP_S) + 1))
         q, dq, _ = self.motion.trajectory(t)
         return spacecraft_response(p.model, t, q, dq)
+
+    def margins(self) -> dict[str, np.ndarray]:
+        """Each limit's margin over the halt, against the limit itself (not the one reduced by
+        :attr:`margin`): ``{"velocity": (n,), "acceleration": (n,)}``, ``1 - peak / limit``
+        (0: at the limit; negative: broken)."""
+        res, p = self.motion, self.problem
+        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        return {
+            "velocity": 1.0 - np.abs(dq).max(axis=0) / self.limits.velocity,
+            "acceleration": 1.0 - np.abs(ddq).max(axis=0) / self.limits.acceleration,
+        }
+
+    @property
+    def fragile(self) -> bool:
+        """The feasible k interval is narrow next to k* (width < :data:`FRAGILE_WIDTH` of
+        |k*|): a small error in the model or the timing can break a limit."""
+        res = self.motion
+        if not res.feasible or res.per_joint:
+            return False
+        lo, hi = res.k_interval
+        return bool(hi - lo < FRAGILE_WIDTH * max(abs(float(res.k)), 1e-300))
 
     @property
     def from_rest(self) -> bool:
@@ -222,8 +254,8 @@ class HaltPlan(JobResult):
         lim = self.limits
         lines += [
             f"halt time T = {p.T:g} s",
-            f"speed limits: {limits_text(nums, p.dq_max, lim.velocity_source, 'deg/s')}",
-            f"acceleration limits: {limits_text(nums, p.ddq_max, lim.acceleration_source, 'deg/s^2')}",
+            f"speed limits: {limits_text(nums, lim.velocity, lim.velocity_source, 'deg/s')}",
+            f"acceleration limits: {limits_text(nums, lim.acceleration, lim.acceleration_source, 'deg/s^2')}",
         ]
         scale = K_UNIT_SCALE["deg/s^6"]
         if not res.feasible:
@@ -254,11 +286,21 @@ class HaltPlan(JobResult):
             lines.append(f"{_printed_text()} -- not reproduced, see docs/halt-motion.md")
         _, dq, ddq = res.trajectory(p.times(p.n_check))
         peak_v, peak_a = np.degrees(np.abs(dq).max(axis=0)), np.degrees(np.abs(ddq).max(axis=0))
-        v_lim, a_lim = np.degrees(p.dq_max), np.degrees(p.ddq_max)
-        lines += ["", "joint   peak |dq| [deg/s] (limit)   peak |ddq| [deg/s^2] (limit)"]
+        v_lim, a_lim = np.degrees(lim.velocity), np.degrees(lim.acceleration)
+        m = self.margins()
+        if self.fragile:
+            lo, hi = res.k_interval
+            lines.append(
+                f"FRAGILE: the feasible k interval is {100 * (hi - lo) / abs(float(res.k)):.2g} % of k* wide: a small "
+                "model or timing error breaks a limit (--margin keeps a share of each limit free)"
+            )
+        if self.margin:
+            lines.append(f"margin kept: {100 * self.margin:g} % of each speed and acceleration limit")
+        lines += ["", "joint   peak |dq| [deg/s] (limit, margin)   peak |ddq| [deg/s^2] (limit, margin)"]
         for j, num in enumerate(nums):
-            v_text = f"({v_lim[j]:.6g})"
-            lines.append(f"{num:>5}   {peak_v[j]:10.3f} {v_text:<14}  {peak_a[j]:10.3f} ({a_lim[j]:.6g})")
+            v_text = f"({v_lim[j]:.6g}, {_margin_text(m['velocity'][j])})"
+            a_text = f"({a_lim[j]:.6g}, {_margin_text(m['acceleration'][j])})"
+            lines.append(f"{num:>5}   {peak_v[j]:10.3f} {v_text:<24}  {peak_a[j]:10.3f} {a_text}")
         return "\n".join(lines).split("\n")  # one entry per printed line
 
     def time_series(self) -> dict[str, np.ndarray]:
@@ -314,6 +356,15 @@ class HaltPlan(JobResult):
             atomic_write_text(out / "spacecraft.csv", csv_text(cols))
             files.append("spacecraft.csv")
         return files
+
+
+def _margin_text(margin: float) -> str:
+    """A limit's margin in words: "12 %" kept, "at the limit" (< :data:`AT_LIMIT`), "broken"."""
+    if margin < -1e-9:
+        return "broken"
+    if margin < AT_LIMIT:
+        return "at the limit"
+    return f"{100 * margin:.0f} %"
 
 
 def _violation(v: Any) -> dict[str, Any]:

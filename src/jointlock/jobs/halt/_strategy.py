@@ -7,12 +7,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
+from ...bounds import as_real
 from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
 from ...model import ArmModel
@@ -42,6 +44,10 @@ MIN_N_SAMPLES = 11
 HCOM_JACOBIAN = "generalized"
 
 Solver = Literal["scan", "ga", "vector"]
+
+
+#: Largest margin kept free on each limit (half of it: beyond, the "limits" are others).
+MAX_MARGIN = 0.5
 
 
 def halt_model(robot: str, locks: Mapping[int, float] | None, base: str = "fixed") -> ArmModel:
@@ -99,6 +105,21 @@ def _check_start(
         )
 
 
+def _check_start_margin(
+    model: ArmModel, state: FailureState, T: float, kept: JointLimits, margin: float, names: Mapping[str, Any]
+) -> None:
+    """Refuse a margin the state at failure already eats into: every halt starts from that
+    state, so the margin cannot be kept from t = 0."""
+    reach = HaltReachability(state.q, state.dq, state.ddq, T, kept.velocity, kept.acceleration)
+    bad = reach.bind(model).start_violations(model.joint_numbers)
+    if bad:
+        raise InfeasibleError(
+            f"the state at failure ({names['state']}) is already within the {100 * margin:g} % margin of a limit, "
+            f"and every halt starts from it: {'; '.join(bad)} (the limits reduced by the margin); a smaller "
+            f"{names.get('margin', 'margin')} can be kept"
+        )
+
+
 def _search_halt_configuration(
     model: ArmModel,
     state: FailureState,
@@ -143,13 +164,15 @@ def _search_halt_configuration(
 
 #: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
 LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
-                 "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg")}  # fmt: skip
+                 "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg"),
+                 "margin": "margin"}  # fmt: skip
 CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
              "generations": "--generations", "qf": "--qf-deg", "state": "--q0-deg, --dq0-deg, --ddq0-deg",
-             "limits": CLI_LIMIT_NAMES}  # fmt: skip
+             "limits": CLI_LIMIT_NAMES, "margin": "--margin"}  # fmt: skip
 SCENARIO_NAMES = {"T": "halt.T", "n_samples": "halt.n_samples", "samples": "halt.samples",
                   "population": "halt.population", "generations": "halt.generations", "qf": "halt.qf_deg",
-                  "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES}  # fmt: skip
+                  "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES,
+                  "margin": "halt.margin"}  # fmt: skip
 
 
 def check_halt_settings(
@@ -246,6 +269,7 @@ def plan_halt(
     progress: bool = False,
     state_source: str | None = None,
     moment_about: MomentAbout = "spacecraft_com",
+    margin: float = 0.0,
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -295,6 +319,11 @@ def plan_halt(
         configuration); an infeasible halt always reports it.
     progress
         Show progress bars on stderr.
+    margin
+        Fraction of each speed and acceleration limit kept free (0 <= margin <=
+        :data:`MAX_MARGIN`): the halt configuration and ``k`` are chosen under the limits
+        scaled by ``1 - margin``; the result reports each limit's margin against the limit
+        itself (:attr:`HaltPlan.margins`).
     moment_about
         Point of the base torque: ``"spacecraft_com"`` (default: the spacecraft's centre of mass)
         or ``"joint1"`` (joint 1's origin, the reading of an independent reproduction of 000);
@@ -318,6 +347,8 @@ def plan_halt(
     if limits is None:
         limits = halt_limits(model, vmax_deg, amax_deg, names=_names["limits"])
     paper_scenario = _is_paper_state(model, state, T, limits)
+    margin = as_real(margin, _names.get("margin", "margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError)
+    kept = replace(limits, velocity=limits.velocity * (1 - margin), acceleration=limits.acceleration * (1 - margin))
     if state_source is None:
         state_source = "given" if state_given and not paper_scenario else "000 §5.2"
     rng = resolve_seed(rng)  # one seed for the search and the GA, recorded
@@ -332,15 +363,17 @@ def plan_halt(
         qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"), "000's printed q_best"
     else:
         _check_start(model, state, T, limits, _names["state"])
+        if margin:
+            _check_start_margin(model, state, T, kept, margin, _names)
         configuration, reach_note = _search_halt_configuration(
-            model, state, T, limits, samples=samples, seed=rng, reachable=reachable,
+            model, state, T, kept, samples=samples, seed=rng, reachable=reachable,
             per_joint=solver == "vector", progress=progress,
         )  # fmt: skip
         qf_arr = np.asarray(configuration.q_best, dtype=float)
         seed_text = "a numpy Generator" if isinstance(rng, np.random.Generator) else rng
         qf_source = f"optimal halt configuration (Monte Carlo, {samples} samples, seed {seed_text})"
     problem = HaltProblem(
-        model, state.q, state.dq, state.ddq, qf_arr, T, limits.velocity, limits.acceleration,
+        model, state.q, state.dq, state.ddq, qf_arr, T, kept.velocity, kept.acceleration,
         base=base, n_samples=n_samples, moment_about=moment_about,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
@@ -360,6 +393,7 @@ def plan_halt(
         reachability_requested=reachable,
         seed=None if isinstance(rng, np.random.Generator) else rng,
         state_source=state_source,
+        margin=margin,
     )
 
 
@@ -401,5 +435,6 @@ def halt_from_scenario(
         minimum_T=bool(t["minimum_T"]),
         progress=progress,
         moment_about=t["moment_about"],
+        margin=float(t["margin"]),
         _names=names,
     )
