@@ -80,3 +80,12 @@ def test_report_renders_in_headless_chromium(report, tmp_path):
     assert "<h1>jointlock run:" in dom and dom.count("<img") >= 3 and "Limits kept or broken" in dom
     console = [line for line in proc.stderr.splitlines() if "CONSOLE" in line]
     assert not console, console
+
+
+def test_a_limit_met_with_no_margin_is_at_the_limit_not_kept():
+    """Issue 14, item 3: the report's limits say "at the limit" within 1 % of a limit."""
+    from jointlock.report import limit_status
+
+    assert limit_status(39.0, 40.0) == "kept"
+    assert limit_status(40.0, 40.0) == limit_status(39.8, 40.0) == "at the limit"
+    assert limit_status(40.1, 40.0) == "BROKEN"

@@ -27,19 +27,23 @@ from .io.files import (  # noqa: F401  (re-exported: the writers used to live he
     figure_svg,
     save_figure,
 )
+from .jobs._common import AT_LIMIT
 from .plots.arm import arm_figure, arm_points, draw_arm, set_equal_3d  # noqa: F401  (re-exported)
 
 
 def limit_status(value: float, limit: float) -> str:
-    """``"kept"`` when ``value <= limit`` (up to a relative 1e-9), else ``"BROKEN"``."""
-    return "kept" if value <= limit * (1 + 1e-9) else "BROKEN"
+    """``"kept"`` when ``value`` stays at least :data:`AT_LIMIT` of ``limit`` below it, ``"at the
+    limit"`` when it reaches it within that share (up to a relative 1e-9), else ``"BROKEN"``."""
+    if value > limit * (1 + 1e-9):
+        return "BROKEN"
+    return "kept" if value <= limit * (1 - AT_LIMIT) else "at the limit"
 
 
 def limits_rows(
     joints: Sequence[int], values: Sequence[float], limits: Sequence[float], quantity: str, unit: str
 ) -> list[list[Any]]:
     """Rows ``[joint, quantity, peak, limit, margin, status]`` for a limits table; status is
-    ``"kept"`` or ``"BROKEN"`` (coloured by :func:`render_html`)."""
+    ``"kept"``, ``"at the limit"`` or ``"BROKEN"`` (coloured by :func:`render_html`)."""
     rows = []
     for j, v, lim in zip(joints, values, limits):
         v, lim = abs(float(v)), float(lim)
@@ -96,6 +100,7 @@ _STATUS_CLASS = {
     "not reproduced": "bad",
     "INFEASIBLE": "bad",
     "ours only": "warn",
+    "at the limit": "warn",
 }
 
 

@@ -88,6 +88,11 @@ def locked_deg(model: ArmModel) -> dict[str, float]:
     return {str(lj.number): math.degrees(lj.angle) for lj in model.locked}
 
 
+#: A limit met with less than this share of it free is "at the limit", not "kept" (halt tables,
+#: the run report's limits).
+AT_LIMIT = 0.01
+
+
 def locked_text(locked: dict[str, float]) -> str:
     """``"joint J at DEG deg, ..."`` (or ``"none"``) from :func:`locked_deg`'s mapping."""
     return ", ".join(f"joint {k} at {v + 0.0:g} deg" for k, v in locked.items()) or "none"  # + 0.0: no "-0"

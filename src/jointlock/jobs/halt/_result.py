@@ -38,11 +38,9 @@ from ...plots.halt import (
     plot_joint_profiles,
     plot_spacecraft_response,
 )
-from .._common import JobResult, locked_deg, locked_text
+from .._common import AT_LIMIT, JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
 
-#: A limit met with less than this share of it free is "at the limit", not kept.
-AT_LIMIT = 0.01
 #: A feasible k interval narrower than this share of |k*| is fragile.
 FRAGILE_WIDTH = 0.01
 
