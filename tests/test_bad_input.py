@@ -46,6 +46,22 @@ inertia_kgm2 = [1.0, 1.0, 1.0]
 """
 JUMP_TASK = "q0_deg = [10.0, 40.0, -70.0, 100.0, -60.0, 30.0, 20.0]\ndx_m = [1.2, -1.5, 0.8]\n"
 BIG = "9" * 400
+#: Valid leading options of the replan and tolerance-angle commands (puma6, joint 2 at 59.4 deg).
+REPLAN = ["replan", "puma6", "--lock", "2=59.4", "--from-deg", "0", "60", "0", "0", "0", "0"]
+REPLAN += ["--to-deg", "5", "60", "35", "10", "-120", "90"]
+TOLERANCE = [
+    "tolerance-angle",
+    "puma6",
+    "--lock",
+    "2=59.4",
+    "--q-target-deg",
+    "5",
+    "60",
+    "35",
+    "10",
+    "-120",
+    "90",
+]
 
 
 def cli(capsys, *argv: str) -> tuple[int, str, str]:
@@ -178,21 +194,7 @@ def test_a_jump_task_too_many_steps(capsys, tmp_path):
         (["workspace", "puma6", "--voxel", "1e-300", "--samples", "1000"], ["--voxel", ">= 1e-06"]),
         (["workspace", "puma6", "--voxel", "1e308", "--samples", "1000"], ["--voxel", "<= 1e+06"]),
         (
-            [
-                "tolerance-angle",
-                "puma6",
-                "--lock",
-                "2=59.4",
-                "--q-target-deg",
-                "5",
-                "60",
-                "35",
-                "10",
-                "-120",
-                "90",
-                "--step-deg",
-                "1e-320",
-            ],
+            [*TOLERANCE, "--step-deg", "1e-320"],
             ["--step-deg"],
         ),
         (["halt-config", "halt7", "--lock", "4=0", "--length", "1e-320", "--samples", "100"], ["--length"]),
@@ -200,28 +202,7 @@ def test_a_jump_task_too_many_steps(capsys, tmp_path):
         (["halt", "halt7", "--lock", "4=0", "--T", "1e308"], ["--T", "[s]"]),
         (["halt", "halt7", "--lock", "4=0", "--T", "1e-300"], ["--T"]),
         (
-            [
-                "replan",
-                "puma6",
-                "--lock",
-                "2=59.4",
-                "--from-deg",
-                "0",
-                "60",
-                "0",
-                "0",
-                "0",
-                "0",
-                "--to-deg",
-                "5",
-                "60",
-                "35",
-                "10",
-                "-120",
-                "90",
-                "--cycle",
-                "1e-320",
-            ],
+            [*REPLAN, "--cycle", "1e-320"],
             ["--cycle"],
         ),
         (["jump", "canadarm7", "--kappa", "1e308", "--fail-at", "3"], ["--kappa"]),
@@ -242,28 +223,7 @@ def test_extreme_option_values_name_the_option(capsys, argv, words):
     [
         ["halt-config", "halt7", "--lock", "4=0", "--samples", "4294967297"],
         ["workspace", "puma6", "--samples", "4294967297"],
-        [
-            "replan",
-            "puma6",
-            "--lock",
-            "2=59.4",
-            "--from-deg",
-            "0",
-            "60",
-            "0",
-            "0",
-            "0",
-            "0",
-            "--to-deg",
-            "5",
-            "60",
-            "35",
-            "10",
-            "-120",
-            "90",
-            "--steps",
-            "4294967297",
-        ],
+        [*REPLAN, "--steps", "4294967297"],
         ["singular", "canadarm7", "--search", "--samples", "4294967297"],
         ["jump", "canadarm7", "--sweep", "4294967297"],
         ["halt", "halt7", "--lock", "4=0", "--samples", "4294967297"],

@@ -34,6 +34,7 @@ from hypothesis.extra import numpy as hnp
 import jointlock as jl
 from jointlock.cli import build_parser, main
 from jointlock.errors import JointlockError
+from jointlock.io.files import toml_value  # the project's TOML value writer (nan, inf, any int)
 
 ROOT = Path(__file__).resolve().parents[1]
 ARM5 = (ROOT / "tests" / "data" / "arm5.urdf").read_text()
@@ -150,22 +151,6 @@ HOSTILE_VALUE = st.recursive(
     max_leaves=10,
 )
 TOML_VALUE = st.one_of(PLAUSIBLE_VALUE, HOSTILE_VALUE)
-
-
-def toml_value(v) -> str:
-    if isinstance(v, bool):
-        return "true" if v else "false"
-    if isinstance(v, str):
-        return json.dumps(v)
-    if isinstance(v, float):
-        return {"nan": "nan", "inf": "inf", "-inf": "-inf"}.get(repr(v), repr(v))
-    if isinstance(v, int):
-        return str(v)
-    if isinstance(v, list):
-        return "[" + ", ".join(toml_value(x) for x in v) + "]"
-    if isinstance(v, dict):
-        return "{" + ", ".join(f"{json.dumps(k)} = {toml_value(x)}" for k, x in v.items()) + "}"
-    raise TypeError(v)
 
 
 def toml_text(data: dict) -> str:

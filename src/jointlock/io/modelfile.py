@@ -171,27 +171,23 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
     if not isinstance(name, str):
         raise ModelError(f"{where}: field 'name' must be a string; got {shown(name)}")
     try:
-        return _model(name, cols, bodies, tool, spacecraft, data, where)
+        return from_dh(
+            name,
+            a=cols["a"],
+            alpha=cols["alpha"],
+            d=cols["d"],
+            theta=cols["theta"],
+            convention=_CONVENTIONS[convention],  # type: ignore[arg-type]
+            bodies=bodies,
+            tool=tool,
+            lower=cols["lower"],
+            upper=cols["upper"],
+            velocity_limit=cols["vmax"],
+            spacecraft=spacecraft,
+            description=str(data.get("description", f"read from {where}")),
+        )
     except ModelError as exc:  # e.g. a joint's limits: named with the file
         raise ModelError(f"{where}: {exc}") from None
-
-
-def _model(name: str, cols: dict, bodies: list, tool: Any, spacecraft: Any, data: dict, where: str) -> ArmModel:
-    return from_dh(
-        name,
-        a=cols["a"],
-        alpha=cols["alpha"],
-        d=cols["d"],
-        theta=cols["theta"],
-        convention=_CONVENTIONS[data["convention"]],  # type: ignore[arg-type]
-        bodies=bodies,
-        tool=tool,
-        lower=cols["lower"],
-        upper=cols["upper"],
-        velocity_limit=cols["vmax"],
-        spacecraft=spacecraft,
-        description=str(data.get("description", f"read from {where}")),
-    )
 
 
 def read_model_toml(path: str | Path) -> ArmModel:
