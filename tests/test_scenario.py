@@ -262,7 +262,8 @@ def test_new_limit_names_resolve_to_the_same_keys(tmp_path, fresh_warnings):
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the new names do not warn
         sc = load_scenario(write(tmp_path, LIMITS_HEAD + NEW_LIMITS))
-    assert sc.data["limits"] == {"vmax_deg": 30.0, "amax_deg": 15.0, "eps_m": 0.002}
+    torques = {"torque_max_Nm": None, "brake_max_Nm": None}
+    assert sc.data["limits"] == {"vmax_deg": 30.0, "amax_deg": 15.0, "eps_m": 0.002, **torques}
 
 
 def test_former_limit_names_work_and_warn_once(tmp_path, fresh_warnings):
@@ -273,7 +274,7 @@ def test_former_limit_names_work_and_warn_once(tmp_path, fresh_warnings):
         first = load_scenario(path)
         second = load_scenario(path, {"limits.vmax_deg": 30.0})  # an override by the former name
     assert first.data == second.data == new.data and first.jobs == new.jobs
-    assert list(first.data["limits"]) == list(new.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m"]
+    assert list(first.data["limits"]) == list(new.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m", "torque_max_Nm", "brake_max_Nm"]
     assert former_name_warnings(record) == [
         f"{path}: limits.vmax_deg is deprecated: write limits.vmax_deg_s instead (the same quantity, "
         "in deg/s); the old name still works for now",
@@ -301,8 +302,9 @@ def test_an_override_replaces_the_files_value_under_either_name(tmp_path, fresh_
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         sc = load_scenario(path, {key: 12.5})
-    assert sc.data["limits"] == {"vmax_deg": 12.5, "amax_deg": 15.0, "eps_m": 0.002}
-    assert list(sc.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m"]  # the file's order
+    torques = {"torque_max_Nm": None, "brake_max_Nm": None}
+    assert sc.data["limits"] == {"vmax_deg": 12.5, "amax_deg": 15.0, "eps_m": 0.002, **torques}
+    assert list(sc.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m", *torques]  # the file's order, then defaults
     assert sc.overrides == {key: {"file": 30.0, "value": 12.5}}
 
 
@@ -310,7 +312,7 @@ def test_limit_names_in_errors_and_hints(tmp_path, fresh_warnings):
     cases = [
         (
             "[limits]\nvmax_dg = 1\n",
-            ["[limits]", "'vmax_dg'", "did you mean 'vmax_deg_s'", "allowed: vmax_deg_s, amax_deg_s2, eps_m"],
+            ["[limits]", "'vmax_dg'", "did you mean 'vmax_deg_s'", "allowed: vmax_deg_s, amax_deg_s2, eps_m, torque_max_Nm, brake_max_Nm"],
         ),
         ("[limits]\namax_deg_s2 = -1\n", ["limits.amax_deg_s2 must be a finite number > 0 and <= 1e+06 [deg/s^2]"]),
         ("[limits]\nvmax_deg = -1\n", ["limits.vmax_deg must be a finite number > 0 and <= 1e+06 [deg/s]"]),

@@ -59,6 +59,9 @@ MAX_GAIN = 1e6
 #: Largest joint speed and acceleration limits [deg/s, deg/s^2]: far above any arm (the ISS arm
 #: moves at a few deg/s), low enough that rates and accelerations derived from them stay finite.
 MAX_RATE_DEG = 1e6
+
+#: Largest torque limit [N m]: a billion newton-metres is no limit for any arm.
+MAX_TORQUE_NM = 1e9
 #: Largest |angle| of a command-line angle option [deg] (a scenario's *_deg fields keep +-360).
 MAX_OPTION_DEG = 1e6
 #: Largest seed (numpy takes any integer >= 0; seeds are stored as 64-bit integers).

@@ -56,6 +56,7 @@ def from_dh(
     lower: ArrayLike | None = None,
     upper: ArrayLike | None = None,
     velocity_limit: ArrayLike | None = None,
+    effort_limit: ArrayLike | None = None,
     spacecraft: Body | None = None,
     description: str = "",
 ) -> ArmModel:
@@ -77,6 +78,8 @@ def from_dh(
         (4, 4) pose of the end-effector frame in DH frame ``n`` [m]; identity when omitted.
     lower, upper, velocity_limit
         (n,) joint limits [rad], [rad/s]; +-pi and unlimited speed when omitted.
+    effort_limit
+        (n,) motor torque limits [N m]; unlimited when omitted.
     spacecraft
         Spacecraft body (centre of mass and inertia in the root frame = DH frame 0); the arm
         is free-floating when given, fixed-base otherwise.
@@ -100,6 +103,12 @@ def from_dh(
         raise ModelError(
             f"velocity_limit must hold {n} numbers > 0 [rad/s] (inf for unlimited); "
             f"got {shown(np.asarray(velocity_limit).tolist())}"
+        )
+    effort = np.full(n, math.inf) if effort_limit is None else np.asarray(effort_limit, dtype=float)
+    if effort.shape != (n,) or not np.all(effort > 0):
+        raise ModelError(
+            f"effort_limit must hold {n} numbers > 0 [N m] (inf for unlimited); "
+            f"got {shown(np.asarray(effort_limit).tolist())}"
         )
     if bodies is None:
         bodies = [Body(0.0, name=f"link{i + 1}") for i in range(n)]
@@ -131,7 +140,16 @@ def from_dh(
         model_tool = fixed[-1] @ tool_arr
 
     joints = tuple(
-        Joint(placements[i], (0.0, 0.0, 1.0), lo[i], hi[i], vmax[i], number=i + 1, name=f"joint{i + 1}")
+        Joint(
+            placements[i],
+            (0.0, 0.0, 1.0),
+            lo[i],
+            hi[i],
+            vmax[i],
+            number=i + 1,
+            name=f"joint{i + 1}",
+            effort_limit=effort[i],
+        )
         for i in range(n)
     )
     return ArmModel(

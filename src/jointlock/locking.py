@@ -47,7 +47,8 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
     Returns
     -------
     ArmModel
-        ``model.dof - 1`` movable joints; ``locked`` gains ``LockedJoint(joint, angle)``.
+        ``model.dof - 1`` movable joints; ``locked`` gains ``LockedJoint(joint, angle)``;
+        ``unlocked`` is the arm before its first lock.
     """
     if isinstance(joint, bool) or not isinstance(joint, (int, np.integer)):
         raise ModelError(f"joint must be an integer joint number (1-based); got {joint!r}")
@@ -88,6 +89,7 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
         tool=tool,
         root_body=root_body,
         locked=model.locked + (LockedJoint(int(joint), angle),),
+        unlocked=model.unlocked if model.locked else model,
     )
 
 

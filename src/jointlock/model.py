@@ -180,6 +180,8 @@ class Joint:
         The joint's number in the full arm, 1-based as in the papers.
     name
         Free text (URDF joint name, ``"joint3"``, ...).
+    effort_limit
+        The motor's torque limit [N m] (``inf`` when unknown; URDF ``<limit effort>``).
     """
 
     placement: FloatArray
@@ -189,6 +191,7 @@ class Joint:
     velocity_limit: float = math.inf
     number: int = 0
     name: str = ""
+    effort_limit: float = math.inf
 
     def __post_init__(self) -> None:
         label = self.name or f"joint {self.number}"
@@ -207,7 +210,10 @@ class Joint:
         object.__setattr__(self, "axis", _readonly(axis / np.linalg.norm(axis)))
         object.__setattr__(self, "lower", lower)
         object.__setattr__(self, "upper", upper)
+        if not (self.effort_limit > 0):
+            raise ModelError(f"{label}: effort_limit must be > 0 [N m]; got {self.effort_limit}")
         object.__setattr__(self, "velocity_limit", float(self.velocity_limit))
+        object.__setattr__(self, "effort_limit", float(self.effort_limit))
         object.__setattr__(self, "name", self.name or f"joint{self.number}")
 
 
@@ -243,6 +249,10 @@ class ArmModel:
         The joints that were folded into this chain, in the order they were locked.
     description
         Free text: where the numbers come from and the readings chosen.
+    unlocked
+        The arm before any lock (same base), kept by :func:`jointlock.locking.lock` so that
+        the locked joints' brake torques can be computed (None for an arm without locks, or
+        when unknown).  Not compared.
     """
 
     name: str
@@ -253,6 +263,7 @@ class ArmModel:
     floating: bool = False
     locked: tuple[LockedJoint, ...] = ()
     description: str = ""
+    unlocked: ArmModel | None = field(default=None, compare=False, repr=False)
 
     def __post_init__(self) -> None:
         joints = tuple(self.joints)
@@ -337,12 +348,15 @@ class ArmModel:
         when ``spacecraft`` is None.  The spacecraft's centre of mass and inertia are given
         in the root frame."""
         if spacecraft is None:
-            return replace(self, floating=False)
-        return replace(self, root_body=spacecraft, floating=True)
+            return self.fixed()
+        # joint 1 locked: link 1 was merged into the old root body, which is replaced here
+        keeps_links = all(lj.number != 1 for lj in self.locked)
+        full = self.unlocked.with_base(spacecraft) if self.unlocked is not None and keeps_links else None
+        return replace(self, root_body=spacecraft, floating=True, unlocked=full)
 
     def fixed(self) -> ArmModel:
         """Fixed-base copy (the root body is kept but plays no part in dynamics)."""
-        return replace(self, floating=False)
+        return replace(self, floating=False, unlocked=None if self.unlocked is None else self.unlocked.fixed())
 
     def expand(self, q: ArrayLike) -> FloatArray:
         """Insert the locked joints' angles into a healthy-joint vector.

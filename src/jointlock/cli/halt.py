@@ -99,7 +99,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--margin",
         type=field_arg("halt", "margin"),
         default=0.0,
-        help="share of each speed and acceleration limit the halt keeps free, 0 .. 0.5 (default 0; "
+        help="share of each speed, acceleration and torque limit the halt keeps free, 0 .. 0.5 (default 0; "
         "0.05: 5 %%); each limit's margin is reported either way",
     )
     p.add_argument(
@@ -118,7 +118,11 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--T", type=field_arg("halt", "T"), help="halt time [s], 0.001 .. 1e6 (000: 10)")
     qf = p.add_mutually_exclusive_group()
     qf.add_argument("--qf-deg", type=deg_arg, nargs="+", metavar="DEG", help="halt configuration [deg]")
-    qf.add_argument("--paper-qf", action="store_true", help="use 000's printed q_best (000's failure only: halt7, joint 4 locked at 0)")
+    qf.add_argument(
+        "--paper-qf",
+        action="store_true",
+        help="use 000's printed q_best (000's failure only: halt7, joint 4 locked at 0)",
+    )
     p.add_argument(
         "--vmax-deg",
         type=field_arg("limits", "vmax_deg_s"),
@@ -133,6 +137,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         nargs="+",
         metavar="DEG",
         help=f"acceleration limit(s) [deg/s^2], one or one per healthy joint (default {DEFAULT_AMAX_DEG:g}, as 000)",
+    )
+    p.add_argument(
+        "--torque-max-Nm",
+        type=field_arg("limits", "torque_max_Nm"),
+        nargs="+",
+        metavar="NM",
+        help="motor torque limit(s) [N m], one or one per healthy joint, capped by the model's own effort "
+        "limit (default: the model's, else none); kept on every sample of the halt (solver scan)",
+    )
+    p.add_argument(
+        "--brake-max-Nm",
+        type=field_arg("limits", "brake_max_Nm"),
+        nargs="+",
+        metavar="NM",
+        help="brake torque limit(s) of the locked joint(s) [N m], one or one per locked joint (default none)",
     )
     p.add_argument("--solver", choices=("scan", "ga", "vector"), default="scan", help="default scan (exact)")
     p.add_argument(
@@ -215,7 +234,11 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
             "time [s]; 000's scenario is the default only for halt7 with joint 4 locked at 0 deg; "
             "--from-rest sets zero rates and accelerations)"
         )
-    given = [opt for opt, v in (("--q0-deg", args.q0_deg), ("--dq0-deg", args.dq0_deg), ("--ddq0-deg", args.ddq0_deg)) if v]
+    given = [
+        opt
+        for opt, v in (("--q0-deg", args.q0_deg), ("--dq0-deg", args.dq0_deg), ("--ddq0-deg", args.ddq0_deg))
+        if v
+    ]
     rest = [0.0] * model.dof
     state = FailureState.from_degrees(
         model,
@@ -224,7 +247,13 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         (rest if args.from_rest else args.ddq0_deg) or defaults["ddq0_deg"],
         names=("--q0-deg", "--dq0-deg", "--ddq0-deg"),
     )
-    source = "000 §5.2" if not given else "given" if len(given) == 3 else f"{', '.join(given)} given, the rest 000 §5.2's"
+    source = (
+        "000 §5.2"
+        if not given
+        else "given"
+        if len(given) == 3
+        else f"{', '.join(given)} given, the rest 000 §5.2's"
+    )
     if args.from_rest:
         source = "--q0-deg, from rest" if args.q0_deg else "000 §5.2's angles, from rest"
     elif 0 < len(given) < 3:
@@ -235,7 +264,9 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
             stacklevel=1,
         )
     if args.paper_qf and not paper:
-        raise ScenarioError("--paper-qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give --qf-deg")
+        raise ScenarioError(
+            "--paper-qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give --qf-deg"
+        )
     return plan_halt(
         model,
         state,
@@ -244,6 +275,8 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         paper_qf=args.paper_qf,
         vmax_deg=args.vmax_deg,
         amax_deg=args.amax_deg,
+        torque_max_Nm=args.torque_max_Nm,
+        brake_max_Nm=args.brake_max_Nm,
         base=args.base,
         solver=args.solver,
         rng=args.seed,

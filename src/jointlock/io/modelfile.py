@@ -14,6 +14,7 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     lower_deg = -180.0                  # optional, default -180
     upper_deg = 180.0                   # optional, default 180
     velocity_limit_deg_s = 4.0          # optional, default unlimited
+    effort_limit_Nm = 300.0             # optional: the motor's torque limit, default unlimited
     mass_kg = 42.5                      # optional body of the link, in its DH frame
     com_m = [0.0, 0.25, 0.0]
     inertia_kgm2 = [0.89, 0.05, 0.89]   # [Ixx, Iyy, Izz], 6 values or 3x3
@@ -53,6 +54,7 @@ _JOINT_KEYS = {
     "lower_deg",
     "upper_deg",
     "velocity_limit_deg_s",
+    "effort_limit_Nm",
     "mass_kg",
     "com_m",
     "inertia_kgm2",
@@ -123,7 +125,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
     rows = data.get("joint")
     if not isinstance(rows, list) or not rows:
         raise ModelError(f"{where}: needs at least one [[joint]] table")
-    cols: dict[str, list[float]] = {k: [] for k in ("a", "alpha", "d", "theta", "lower", "upper", "vmax")}
+    cols: dict[str, list[float]] = {k: [] for k in ("a", "alpha", "d", "theta", "lower", "upper", "vmax", "effort")}
     bodies = []
     for i, row in enumerate(rows, start=1):
         jw = f"{where}: joint {i}"
@@ -140,6 +142,10 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
         if vmax <= 0:
             raise ModelError(f"{jw}: field 'velocity_limit_deg_s' must be > 0; got {vmax}")
         cols["vmax"].append(math.radians(vmax))
+        effort = _num(row, "effort_limit_Nm", jw, math.inf)
+        if effort <= 0:
+            raise ModelError(f"{jw}: field 'effort_limit_Nm' must be > 0 [N m]; got {effort}")
+        cols["effort"].append(effort)
         if cols["lower"][-1] > cols["upper"][-1]:
             raise ModelError(
                 f"{jw}: lower_deg must be <= upper_deg; got {row.get('lower_deg')} > {row.get('upper_deg')}"
@@ -183,6 +189,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
             lower=cols["lower"],
             upper=cols["upper"],
             velocity_limit=cols["vmax"],
+            effort_limit=cols["effort"],
             spacecraft=spacecraft,
             description=str(data.get("description", f"read from {where}")),
         )

@@ -36,6 +36,7 @@ class _UrdfJoint:
     lower: float
     upper: float
     velocity: float
+    effort: float
 
 
 def _floats(text: str | None, count: int, where: str, default: list[float]) -> np.ndarray:
@@ -196,7 +197,7 @@ def read_urdf(
             f"{where} <axis>",
             [1, 0, 0],
         )
-        lower, upper, velocity = -math.inf, math.inf, math.inf
+        lower, upper, velocity, effort = -math.inf, math.inf, math.inf, math.inf
         limit = jel.find("limit")
         if kind == "revolute":
             if limit is None:
@@ -207,11 +208,15 @@ def read_urdf(
             velocity = _number(limit, "velocity", f"{where} <limit>")
             if velocity <= 0:
                 velocity = math.inf
+        if limit is not None and limit.get("effort") is not None:
+            effort = _number(limit, "effort", f"{where} <limit>")
+            if effort <= 0:  # URDF's "no effort given" in many files: no limit
+                effort = math.inf
         if kind != "fixed" and np.max(np.abs(axis)) < 1e-12:  # (a norm would overflow at 1e154)
             raise ModelError(f"{where}: <axis xyz> must be non-zero")
         joints.append(
             _UrdfJoint(
-                jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity
+                jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity, effort
             )
         )
 
@@ -292,7 +297,7 @@ def read_urdf(
 
     try:
         model_joints = tuple(
-            Joint(placement, j.axis, j.lower, j.upper, j.velocity, number=i + 1, name=j.name)
+            Joint(placement, j.axis, j.lower, j.upper, j.velocity, number=i + 1, name=j.name, effort_limit=j.effort)
             for i, (j, placement, _) in enumerate(movable)
         )
     except ModelError as exc:  # e.g. lower > upper: named with the file

@@ -159,11 +159,40 @@ def plot_spacecraft_response(response: Any, *, fig: Any | None = None) -> Any:
     ax.set_xlabel("t [s]")
     ax.set_ylabel("attitude change from t = 0 [deg]")
     rate = ax.twinx()
-    rate.plot(t, np.degrees(np.linalg.norm(response.angular_velocity, axis=-1)), color="C1", label="rate [deg/s]")
+    rate.plot(
+        t, np.degrees(np.linalg.norm(response.angular_velocity, axis=-1)), color="C1", label="rate [deg/s]"
+    )
     rate.set_ylabel("angular rate [deg/s]", color="C1")
     ax.set_title(
         f"spacecraft: attitude change {response.final_attitude_change_deg:.3g} deg, peak {response.peak_rate_deg_s:.3g} deg/s, "
         f"drift {response.com_drift_m:.3g} m",
         fontsize=9,
     )
+    return fig
+
+
+def plot_actuator_loads(
+    loads: Any, *, motor_limits: Any = None, brake_limits: Any = None, fig: Any | None = None
+) -> Any:
+    """Motor torques of the healthy joints (top) and brake torques of the locked joints
+    (bottom) over a motion (:class:`~jointlock.analysis.actuators.ActuatorLoads`), with the
+    limits (N m, ``inf``: none) as dashed lines.  Returns the figure."""
+    fig = new_figure(fig, (7, 6))
+    rows = 2 if loads.locked_numbers else 1
+    axes = np.atleast_1d(fig.subplots(rows, 1, sharex=True))
+    for ax, values, numbers, limits, what in (
+        (axes[0], loads.motor, loads.joint_numbers, motor_limits, "motor"),
+        (axes[-1] if rows == 2 else None, loads.brake, loads.locked_numbers, brake_limits, "brake (locked)"),
+    ):
+        if ax is None:
+            continue
+        for j, num in enumerate(numbers):
+            line = ax.plot(loads.t, values[:, j], label=f"joint {num}")[0]
+            if limits is not None and math.isfinite(limits[j]):
+                for sgn in (-1, 1):
+                    ax.axhline(sgn * limits[j], color=line.get_color(), ls="--", lw=0.7)
+        ax.set_ylabel(f"{what} torque [N m]")
+        ax.legend(fontsize=7, ncol=min(len(numbers), 4))
+    axes[-1].set_xlabel("t [s]")
+    axes[0].set_title(f"actuator torques over the motion ({loads.base} base; dashed: limits)", fontsize=9)
     return fig

@@ -14,6 +14,7 @@ from ..bounds import (
     MAX_RATE_DEG,
     MAX_SEED,
     MAX_TIME_S,
+    MAX_TORQUE_NM,
     MIN_LENGTH_M,
     MIN_STEP_S,
     MIN_TIME_S,
@@ -155,6 +156,10 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
             "deg/s^2", "joint acceleration limit (halt, halt_config, jump); formerly amax_deg", hi=MAX_RATE_DEG
         ),
         "eps_m": _pos("m", "end-effector position-deviation threshold (jump)", hi=MAX_LENGTH_M),
+        "torque_max_Nm": _pos(
+            "N m", "motor torque limit of every healthy joint, capped by the model's own (halt)", hi=MAX_TORQUE_NM
+        ),
+        "brake_max_Nm": _pos("N m", "brake torque limit of every locked joint (halt)", hi=MAX_TORQUE_NM),
     },
 }
 
@@ -213,7 +218,7 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             0.0,
             lo=0.0,
             hi=0.5,
-            help="share of each speed and acceleration limit kept free by the halt (0.05: 5 %)",
+            help="share of each speed, acceleration and torque limit kept free by the halt (0.05: 5 %)",
         ),
         "moment_about": Field(
             "choice",

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 import numpy as np
@@ -54,12 +54,16 @@ class FailureState:
         for name in ("q", "dq", "ddq"):
             arr = np.array(getattr(self, name), dtype=float)
             if arr.ndim != 1 or not np.all(np.isfinite(arr)):
-                raise ScenarioError(f"FailureState.{name} must be one finite value per movable joint; got {arr.tolist()}")
+                raise ScenarioError(
+                    f"FailureState.{name} must be one finite value per movable joint; got {arr.tolist()}"
+                )
             arr.setflags(write=False)
             arrays[name] = arr
         sizes = {name: arr.size for name, arr in arrays.items()}
         if len(set(sizes.values())) != 1:
-            raise ScenarioError(f"FailureState: q, dq and ddq need one value per movable joint each; got sizes {sizes}")
+            raise ScenarioError(
+                f"FailureState: q, dq and ddq need one value per movable joint each; got sizes {sizes}"
+            )
         for name, arr in arrays.items():
             object.__setattr__(self, name, arr)
 
@@ -95,12 +99,32 @@ class JointLimits:
         (n,) ``v_max`` [rad/s] and ``a_max`` [rad/s^2].
     velocity_source, acceleration_source
         (n,) plain-language origin of each joint's limit.
+    torque, brake
+        (n,) motor torque limits of the healthy joints and (n_locked,) brake torque limits of
+        the locked joints (:attr:`ArmModel.locked` order) [N m], ``inf`` where there is none;
+        None: no torque limit at all.
+    torque_source, brake_source
+        Their origins (empty when None).
     """
 
     velocity: np.ndarray
     acceleration: np.ndarray
     velocity_source: tuple[str, ...]
     acceleration_source: tuple[str, ...]
+    torque: np.ndarray | None = None
+    brake: np.ndarray | None = None
+    torque_source: tuple[str, ...] = ()
+    brake_source: tuple[str, ...] = ()
+
+    def scaled(self, factor: float) -> JointLimits:
+        """Every limit times ``factor`` (a margin kept free: ``1 - margin``), sources kept."""
+        return replace(
+            self,
+            velocity=self.velocity * factor,
+            acceleration=self.acceleration * factor,
+            torque=None if self.torque is None else self.torque * factor,
+            brake=None if self.brake is None else self.brake * factor,
+        )
 
 
 def _limit_values(values: Any, name: str, n: int) -> np.ndarray | None:
@@ -111,8 +135,39 @@ def _limit_values(values: Any, name: str, n: int) -> np.ndarray | None:
     if arr.size == 1:
         arr = np.full(n, arr[0])
     if arr.shape != (n,) or not np.all(np.isfinite(arr) & (arr > 0)):
-        raise ScenarioError(f"{name} needs one value or {n} values, finite and > 0; got {np.ravel(values).tolist()}")
+        raise ScenarioError(
+            f"{name} needs one value or {n} values, finite and > 0; got {np.ravel(values).tolist()}"
+        )
     return arr
+
+
+def _torque_limits(
+    model: ArmModel, torque_max_Nm: Any, brake_max_Nm: Any, names: tuple[str, str]
+) -> tuple[np.ndarray | None, np.ndarray | None, tuple[str, ...], tuple[str, ...]]:
+    """Motor limits: ``torque_max_Nm`` capped by the model's own effort limits, else the
+    model's where finite; brake limits: ``brake_max_Nm`` (a model has none)."""
+    n = model.dof
+    given = _limit_values(torque_max_Nm, names[0], n)
+    effort = np.array([j.effort_limit for j in model.joints])
+    torque, t_src = None, ()
+    if given is not None or np.any(np.isfinite(effort)):
+        g = np.full(n, np.inf) if given is None else given
+        torque = np.minimum(g, effort)
+        t_src = tuple(
+            ("model's limit" if given is None else f"model's limit, below {names[0]} {g[i]:g}")
+            if effort[i] < g[i]
+            else (names[0] if given is not None else "none")
+            for i in range(n)
+        )
+    brake, b_src = None, ()
+    if brake_max_Nm is not None:
+        if not model.locked:
+            raise ScenarioError(
+                f"{names[1]} is the locked joints' brake limit, but {model.name!r} has no locked joint"
+            )
+        brake = _limit_values(brake_max_Nm, names[1], len(model.locked))
+        b_src = (names[1],) * len(model.locked)
+    return torque, brake, t_src, b_src
 
 
 def halt_limits(
@@ -120,22 +175,30 @@ def halt_limits(
     vmax_deg: ArrayLike | None = None,
     amax_deg: ArrayLike | None = None,
     *,
+    torque_max_Nm: ArrayLike | None = None,
+    brake_max_Nm: ArrayLike | None = None,
     names: tuple[str, str] = ("vmax_deg", "amax_deg"),
+    torque_names: tuple[str, str] = ("torque_max_Nm", "brake_max_Nm"),
 ) -> JointLimits:
     """Speed and acceleration limits of the healthy joints by ``jointlock halt``'s rule.
 
     A joint's speed limit is ``vmax_deg`` capped by the model's own ``velocity_limit`` (the
     smaller of the two); without ``vmax_deg``, the model's limit where finite, else 000's
     :data:`DEFAULT_VMAX_DEG`.  The acceleration limit is ``amax_deg``, else
-    :data:`DEFAULT_AMAX_DEG` (a model has no acceleration limit).
+    :data:`DEFAULT_AMAX_DEG` (a model has no acceleration limit).  A motor's torque limit is
+    ``torque_max_Nm`` capped by the model's own effort limit, else the model's where finite,
+    else none; a locked joint's brake limit is ``brake_max_Nm``, else none.
 
     Parameters
     ----------
     vmax_deg, amax_deg
         One value or one per healthy joint [deg/s, deg/s^2] (limits are typed by people, in
         degrees), or None.
-    names
-        How the two inputs are named in the sources and in error messages (the CLI's options).
+    torque_max_Nm, brake_max_Nm
+        One value or one per healthy joint [N m]; one value or one per locked joint
+        (:attr:`ArmModel.locked` order) [N m]; or None.
+    names, torque_names
+        How the inputs are named in the sources and in error messages (the CLI's options).
     """
     n = model.dof
     v_opt = _limit_values(vmax_deg, names[0], n)
@@ -160,12 +223,17 @@ def halt_limits(
         amax, a_src = a_opt, [names[1]] * n
     else:
         amax, a_src = np.full(n, DEFAULT_AMAX_DEG), ["000's default"] * n
-    return JointLimits(np.radians(vmax), np.radians(amax), tuple(v_src), tuple(a_src))
+    torque, brake, t_src, b_src = _torque_limits(model, torque_max_Nm, brake_max_Nm, torque_names)
+    return JointLimits(
+        np.radians(vmax), np.radians(amax), tuple(v_src), tuple(a_src), torque, brake, t_src, b_src
+    )
 
 
 #: How the two limits are named in the limit sources and errors, by caller.
 CLI_LIMIT_NAMES = ("--vmax-deg", "--amax-deg")
 SCENARIO_LIMIT_NAMES = ("limits.vmax_deg_s", "limits.amax_deg_s2")
+CLI_TORQUE_NAMES = ("--torque-max-Nm", "--brake-max-Nm")
+SCENARIO_TORQUE_NAMES = ("limits.torque_max_Nm", "limits.brake_max_Nm")
 
 
 def resolve_limits(
@@ -177,11 +245,14 @@ def resolve_limits(
     return lim.velocity, lim.acceleration, list(lim.velocity_source), list(lim.acceleration_source)
 
 
-def limits_text(numbers: Sequence[int], values_rad: ArrayLike, sources: Sequence[str], unit: str) -> str:
+def limits_text(
+    numbers: Sequence[int], values_rad: ArrayLike, sources: Sequence[str], unit: str, *, degrees: bool = True
+) -> str:
     """``"40 deg/s (model's limit)"`` when every joint has the same limit from the same
     source, else the joints grouped: ``"joints 1, 2: 10 deg/s (model's limit); joint 4: ..."``."""
     groups: dict[tuple[str, str], list[int]] = {}
-    for num, v, src in zip(numbers, np.degrees(values_rad), sources):
+    values = np.degrees(values_rad) if degrees else np.asarray(values_rad, dtype=float)
+    for num, v, src in zip(numbers, values, sources):
         groups.setdefault((f"{v:.6g}", src), []).append(num)
     if len(groups) == 1:
         (value, src), _ = next(iter(groups.items()))

@@ -11,6 +11,7 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from ...analysis.actuators import ActuatorLoads, actuator_loads
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...io.files import (
     atomic_write_bytes,
@@ -33,6 +34,7 @@ from ...plots._common import offscreen_figure
 from ...plots.halt import (
     global_torque_curve,
     k_text,
+    plot_actuator_loads,
     plot_base_torque_vs_time,
     plot_global_torque_vs_k,
     plot_joint_profiles,
@@ -161,7 +163,15 @@ class HaltPlan(JobResult):
             "margin_kept": self.margin,
             "velocity_margin": (m := self.margins())["velocity"],
             "acceleration_margin": m["acceleration"],
-            "smallest_margin": float(min(m["velocity"].min(), m["acceleration"].min())),
+            "torque_margin": _none_for_nan(m["torque"]),
+            "brake_margin": _none_for_nan(m["brake"]),
+            "smallest_margin": (binding := self.binding_limit())[1],
+            "binding_limit": binding[0],
+            "actuators": None if (loads := self.actuator_loads()) is None else loads.to_dict(),
+            "torque_limit_Nm": _none_for_inf(self.limits.torque),
+            "brake_limit_Nm": _none_for_inf(self.limits.brake),
+            "torque_limit_source": list(self.limits.torque_source),
+            "brake_limit_source": list(self.limits.brake_source),
             "fragile": self.fragile,
             "from_rest": self.from_rest,
             "q_final_deg": np.degrees(p.qf),
@@ -189,16 +199,54 @@ class HaltPlan(JobResult):
         q, dq, _ = self.motion.trajectory(t)
         return spacecraft_response(p.model, t, q, dq)
 
+    def actuator_loads(self) -> ActuatorLoads | None:
+        """Motor torques of the healthy joints and brake torques of the locked joints over the
+        halt (:func:`~jointlock.analysis.actuators.actuator_loads`), with the base of the
+        disturbance torque, on the constraint grid; None for a locked model that lost its
+        unlocked arm (built by hand)."""
+        p = self.problem
+        if p.model.locked and p.model.unlocked is None:
+            return None
+        t = p.times(p.n_check)
+        q, dq, ddq = self.motion.trajectory(t)
+        return actuator_loads(p.model, t, q, dq, ddq, base=p.base)
+
     def margins(self) -> dict[str, np.ndarray]:
         """Each limit's margin over the halt, against the limit itself (not the one reduced by
-        :attr:`margin`): ``{"velocity": (n,), "acceleration": (n,)}``, ``1 - peak / limit``
-        (0: at the limit; negative: broken)."""
+        :attr:`margin`): ``{"velocity": (n,), "acceleration": (n,), "torque": (n,), "brake":
+        (n_locked,)}``, ``1 - peak / limit`` (0: at the limit; negative: broken; NaN: no limit)."""
         res, p = self.motion, self.problem
         _, dq, ddq = res.trajectory(p.times(p.n_check))
-        return {
+        out = {
             "velocity": 1.0 - np.abs(dq).max(axis=0) / self.limits.velocity,
             "acceleration": 1.0 - np.abs(ddq).max(axis=0) / self.limits.acceleration,
+            "torque": np.full(p.dof, np.nan),
+            "brake": np.full(len(p.model.locked), np.nan),
         }
+        loads = (
+            self.actuator_loads() if self.limits.torque is not None or self.limits.brake is not None else None
+        )
+        for key, limits, peaks in (
+            ("torque", self.limits.torque, None if loads is None else loads.peak_motor),
+            ("brake", self.limits.brake, None if loads is None else loads.peak_brake),
+        ):
+            if limits is not None and peaks is not None:
+                with np.errstate(divide="ignore", invalid="ignore"):
+                    out[key] = np.where(np.isfinite(limits), 1.0 - peaks / limits, np.nan)
+        return out
+
+    def binding_limit(self) -> tuple[str, float]:
+        """The limit with the smallest margin over the halt, in words (``"joint 3 brake
+        torque"``), and that margin [-] (:meth:`margins`)."""
+        names = {"velocity": "speed", "acceleration": "acceleration", "torque": "motor torque",
+                 "brake": "brake torque (locked)"}  # fmt: skip
+        numbers = {"brake": [lj.number for lj in self.problem.model.locked]}
+        best = ("", math.inf)
+        for key, values in self.margins().items():
+            for num, value in zip(numbers.get(key, self.problem.model.joint_numbers), values):
+                if not math.isnan(value) and value < best[1]:
+                    best = (f"joint {num} {names[key]}", float(value))
+        return best
 
     @property
     def fragile(self) -> bool:
@@ -239,7 +287,9 @@ class HaltPlan(JobResult):
         lines = [
             f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
             f"base torque with {p.base} base about {MOMENT_TEXT[p.moment_about]}",
-            f"halt configuration ({self.qf_source}): " + ", ".join(f"{v:.2f}" for v in np.degrees(p.qf)) + " deg",
+            f"halt configuration ({self.qf_source}): "
+            + ", ".join(f"{v:.2f}" for v in np.degrees(p.qf))
+            + " deg",
         ]
         hc = self.configuration
         if hc is not None:
@@ -264,7 +314,14 @@ class HaltPlan(JobResult):
                 lines.append(f"  joint {num}: [{lo:.6g}, {hi:.6g}], k* = {kj:.6g}")
         else:
             lo, hi = res.k_interval / scale
-            lines += ["", f"feasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}", f"k* = {k_text(res)}"]
+            lines += [
+                "",
+                f"feasible k: [{lo:.6g}, {hi:.6g}] deg/s^6; solver {res.solver}",
+            ]
+            if res.k_segments is not None:
+                stretches = ", ".join(f"[{a / scale:.6g}, {b / scale:.6g}]" for a, b in res.k_segments)
+                lines.append(f"  of which the torque limits keep: {stretches} deg/s^6")
+            lines.append(f"k* = {k_text(res)}")
         if res.feasible and res.minimum_T is not None:
             lines.append(f"smallest halt time with a feasible k: T = {res.minimum_T:.3f} s")
         sc = self.spacecraft_response()
@@ -293,12 +350,41 @@ class HaltPlan(JobResult):
                 "model or timing error breaks a limit (--margin keeps a share of each limit free)"
             )
         if self.margin:
-            lines.append(f"margin kept: {100 * self.margin:g} % of each speed and acceleration limit")
-        lines += ["", "joint   peak |dq| [deg/s] (limit, margin)   peak |ddq| [deg/s^2] (limit, margin)"]
+            lines.append(f"margin kept: {100 * self.margin:g} % of each speed, acceleration and torque limit")
+        loads = self.actuator_loads()
+        lines += [
+            "",
+            "joint   peak |dq| [deg/s] (limit, margin)   peak |ddq| [deg/s^2] (limit, margin)   "
+            "peak |tau| [N m] (limit, margin)",
+        ]
+        tau_lim = self.limits.torque if self.limits.torque is not None else np.full(p.dof, np.inf)
         for j, num in enumerate(nums):
             v_text = f"({v_lim[j]:.6g}, {_margin_text(m['velocity'][j])})"
             a_text = f"({a_lim[j]:.6g}, {_margin_text(m['acceleration'][j])})"
-            lines.append(f"{num:>5}   {peak_v[j]:10.3f} {v_text:<24}  {peak_a[j]:10.3f} {a_text}")
+            t_text = (
+                ""
+                if loads is None
+                else f"{loads.peak_motor[j]:10.1f} {_torque_limit_text(tau_lim[j], m['torque'][j])}"
+            )
+            lines.append(
+                f"{num:>5}   {peak_v[j]:10.3f} {v_text:<24}  {peak_a[j]:10.3f} {a_text:<24}  {t_text}"
+            )
+        if loads is not None:
+            brake_lim = (
+                self.limits.brake
+                if self.limits.brake is not None
+                else np.full(len(loads.locked_numbers), np.inf)
+            )
+            for j, num in enumerate(loads.locked_numbers):
+                lines.append(
+                    f"{num:>5}   locked: brake holds peak {loads.peak_brake[j]:.1f} N m "
+                    f"{_torque_limit_text(brake_lim[j], m['brake'][j])}"
+                )
+        name, value = self.binding_limit()
+        if res.feasible:
+            lines.append(
+                f"binding limit: {name}, {_margin_text(value)}" + (" margin" if value >= AT_LIMIT else "")
+            )
         return "\n".join(lines).split("\n")  # one entry per printed line
 
     def time_series(self) -> dict[str, np.ndarray]:
@@ -320,13 +406,29 @@ class HaltPlan(JobResult):
         grid, tau = global_torque_curve(res)
         ts = self.time_series()
         figures = (
-            ("global_torque_vs_k.png", (7, 4), lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot())),
+            (
+                "global_torque_vs_k.png",
+                (7, 4),
+                lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot()),
+            ),
             ("joint_profiles.png", (3 * p.dof, 7), lambda fig: plot_joint_profiles(res, fig=fig)),
-            ("base_torque_vs_time.png", (7, 4), lambda fig: plot_base_torque_vs_time(res, ax=fig.add_subplot())),
+            (
+                "base_torque_vs_time.png",
+                (7, 4),
+                lambda fig: plot_base_torque_vs_time(res, ax=fig.add_subplot()),
+            ),
         )
+        loads = self.actuator_loads()
+        if loads is not None:
+            figures += (
+                ("actuator_torques.png", (7, 6), lambda fig: plot_actuator_loads(
+                    loads, motor_limits=self.limits.torque, brake_limits=self.limits.brake, fig=fig)),
+            )  # fmt: skip
         sc = self.spacecraft_response()
         if sc is not None:
-            figures += (("spacecraft_attitude.png", (7, 4), lambda fig: plot_spacecraft_response(sc, fig=fig)),)
+            figures += (
+                ("spacecraft_attitude.png", (7, 4), lambda fig: plot_spacecraft_response(sc, fig=fig)),
+            )
         written = []
         for name, size, draw in figures:
             fig = offscreen_figure(size)
@@ -346,10 +448,15 @@ class HaltPlan(JobResult):
         atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**ts, k_grid=grid, global_torque_grid=tau))
         atomic_write_json(out / "result.json", self.to_dict())
         files = written + ["halt_motion.csv", "halt_motion.npz", "result.json"]
+        if loads is not None:
+            atomic_write_text(out / "actuators.csv", csv_text({"t_s": loads.t, **loads.columns()}))
+            files.append("actuators.csv")
         if sc is not None:
             cols = {"t_s": sc.t, "attitude_change_deg": sc.attitude_change_deg}
             cols.update({f"q_{c}": sc.attitude[:, i] for i, c in enumerate("wxyz")})
-            cols.update({f"omega_{c}_deg_s": np.degrees(sc.angular_velocity[:, i]) for i, c in enumerate("xyz")})
+            cols.update(
+                {f"omega_{c}_deg_s": np.degrees(sc.angular_velocity[:, i]) for i, c in enumerate("xyz")}
+            )
             cols.update({f"com_{c}_m": sc.com_displacement[:, i] for i, c in enumerate("xyz")})
             atomic_write_text(out / "spacecraft.csv", csv_text(cols))
             files.append("spacecraft.csv")
@@ -365,13 +472,30 @@ def _margin_text(margin: float) -> str:
     return f"{100 * margin:.0f} %"
 
 
+def _torque_limit_text(limit: float, margin: float) -> str:
+    """``"(no limit)"`` or ``"(300, 12 %)"``."""
+    return "(no limit)" if not math.isfinite(limit) else f"({limit:.6g}, {_margin_text(margin)})"
+
+
+def _none_for_nan(values: np.ndarray) -> list[float | None]:
+    return [None if math.isnan(v) else float(v) for v in values]
+
+
+def _none_for_inf(values: np.ndarray | None) -> list[float | None] | None:
+    return None if values is None else [float(v) if math.isfinite(v) else None for v in values]
+
+
 def _violation(v: Any) -> dict[str, Any]:
+    """A violation in people's units: ``*_deg`` for angles and rates (deg, deg/s, deg/s^2),
+    ``*_Nm`` for motor and brake torques."""
+    value, limit, excess, unit = v.display
+    suffix = "Nm" if unit == "N m" else "deg"
     return {
         "joint": v.joint,
         "limit": v.kind,
-        "limit_value_deg": math.degrees(v.limit),
-        "value_deg": math.degrees(v.value),
-        "excess_deg": math.degrees(v.excess),
+        f"limit_value_{suffix}": limit,
+        f"value_{suffix}": value,
+        f"excess_{suffix}": excess,
         "time_s": v.time,
     }
 

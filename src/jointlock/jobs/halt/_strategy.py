@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
+from ...analysis.actuators import actuator_torques
 from ...bounds import as_real
 from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
@@ -27,7 +27,9 @@ from ...robots import load_robot
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_lock
 from ._inputs import (
     CLI_LIMIT_NAMES,
+    CLI_TORQUE_NAMES,
     SCENARIO_LIMIT_NAMES,
+    SCENARIO_TORQUE_NAMES,
     FailureState,
     JointLimits,
     halt_limits,
@@ -120,6 +122,41 @@ def _check_start_margin(
         )
 
 
+def _check_start_torques(
+    model: ArmModel,
+    state: FailureState,
+    base: str,
+    kept: JointLimits,
+    margin: float,
+    names: Mapping[str, Any],
+) -> None:
+    """Refuse torque limits the state at failure already breaks: the torques at t = 0 depend
+    on that state alone (the k-part and its two derivatives vanish there), whatever the halt
+    configuration, T and k."""
+    if kept.torque is None and kept.brake is None:
+        return
+    motor, brake = actuator_torques(model, state.q, state.dq, state.ddq, base=base)  # type: ignore[arg-type]
+    bad = []
+    for what, values, limits, numbers in (
+        ("motor torque", motor, kept.torque, model.joint_numbers),
+        ("brake torque (locked)", brake, kept.brake, [lj.number for lj in model.locked]),
+    ):
+        if limits is None:
+            continue
+        bad += [
+            f"joint {num} {what} {abs(v):.4g} N m > {lim:.4g} N m"
+            for num, v, lim in zip(numbers, values, limits)
+            if abs(v) > lim * (1 + 1e-9)
+        ]
+    if bad:
+        within = f" (the limits reduced by the {100 * margin:g} % margin)" if margin else ""
+        raise InfeasibleError(
+            f"the state at failure ({names['state']}) already needs more torque than a limit allows{within}, "
+            f"with the {base} base, and every halt starts from it: {'; '.join(bad)}; no halt configuration, "
+            "halt time or k helps"
+        )
+
+
 def _search_halt_configuration(
     model: ArmModel,
     state: FailureState,
@@ -152,7 +189,9 @@ def _search_halt_configuration(
         note = f"not met, searched the whole ranges instead (000's way): {exc}"
         bar.close()
         bar = Progress(samples, "halt configuration", enabled=progress)
-        hc = optimal_halt_configuration(model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar)
+        hc = optimal_halt_configuration(
+            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar
+        )
     bar.close()
     if reach is not None and hc.reachability is not None:
         note = (
@@ -165,14 +204,14 @@ def _search_halt_configuration(
 #: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
 LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
                  "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg"),
-                 "margin": "margin"}  # fmt: skip
+                 "margin": "margin", "torques": ("torque_max_Nm", "brake_max_Nm")}  # fmt: skip
 CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
              "generations": "--generations", "qf": "--qf-deg", "state": "--q0-deg, --dq0-deg, --ddq0-deg",
-             "limits": CLI_LIMIT_NAMES, "margin": "--margin"}  # fmt: skip
+             "limits": CLI_LIMIT_NAMES, "margin": "--margin", "torques": CLI_TORQUE_NAMES}  # fmt: skip
 SCENARIO_NAMES = {"T": "halt.T", "n_samples": "halt.n_samples", "samples": "halt.samples",
                   "population": "halt.population", "generations": "halt.generations", "qf": "halt.qf_deg",
                   "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES,
-                  "margin": "halt.margin"}  # fmt: skip
+                  "margin": "halt.margin", "torques": SCENARIO_TORQUE_NAMES}  # fmt: skip
 
 
 def check_halt_settings(
@@ -193,7 +232,9 @@ def check_halt_settings(
             f"Simpson's rule); got {n_samples}"
         )
     if samples < 2:
-        raise ScenarioError(f"{names['samples']} must be an integer >= 2 (Monte Carlo samples); got {samples}")
+        raise ScenarioError(
+            f"{names['samples']} must be an integer >= 2 (Monte Carlo samples); got {samples}"
+        )
     if solver == "ga":
         bad = []
         if ga.n_pop < 2:
@@ -257,6 +298,8 @@ def plan_halt(
     paper_qf: bool = False,
     vmax_deg: ArrayLike | None = None,
     amax_deg: ArrayLike | None = None,
+    torque_max_Nm: ArrayLike | None = None,
+    brake_max_Nm: ArrayLike | None = None,
     limits: JointLimits | None = None,
     base: Literal["fixed", "floating"] | None = None,
     solver: Solver = "scan",
@@ -293,9 +336,12 @@ def plan_halt(
     qf
         (n,) halt configuration [rad]; None = search it (HCOM), unless ``paper_qf`` (000's
         printed q_best, on 000's failure only).
-    vmax_deg, amax_deg, limits
-        The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s] and ``amax_deg``
-        [deg/s^2], or ``limits`` as they are.
+    vmax_deg, amax_deg, torque_max_Nm, brake_max_Nm, limits
+        The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s], ``amax_deg``
+        [deg/s^2], the healthy joints' motor torque limits ``torque_max_Nm`` [N m] (capped by
+        the model's effort limits) and the locked joints' brake torque limits ``brake_max_Nm``
+        [N m], or ``limits`` as they are.  Torque limits are kept on every sample of the
+        constraint grid; they need ``solver="scan"``.
     base
         Base of the disturbance torque: ``"fixed"`` (000) or ``"floating"``; None: ``"fixed"``
         for a robot given by name (000's), the model's own base for a model.  The halt
@@ -345,10 +391,14 @@ def plan_halt(
     state_given = state is not None
     model, state, T, base, paper = _arm_state_and_time(robot, state, locks, T, base, _state_names)
     if limits is None:
-        limits = halt_limits(model, vmax_deg, amax_deg, names=_names["limits"])
+        limits = halt_limits(
+            model, vmax_deg, amax_deg, torque_max_Nm=torque_max_Nm, brake_max_Nm=brake_max_Nm,
+            names=_names["limits"], torque_names=_names["torques"],
+        )  # fmt: skip
     paper_scenario = _is_paper_state(model, state, T, limits)
     margin = as_real(margin, _names.get("margin", "margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError)
-    kept = replace(limits, velocity=limits.velocity * (1 - margin), acceleration=limits.acceleration * (1 - margin))
+    kept = limits.scaled(1 - margin)
+    _check_start_torques(model, state, base, kept, margin, _names)
     if state_source is None:
         state_source = "given" if state_given and not paper_scenario else "000 §5.2"
     rng = resolve_seed(rng)  # one seed for the search and the GA, recorded
@@ -360,7 +410,10 @@ def plan_halt(
             raise ScenarioError(
                 "paper_qf is 000's q_best for halt7 with joint 4 locked at 0 deg only; give qf"
             )
-        qf_arr, qf_source = joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"), "000's printed q_best"
+        qf_arr, qf_source = (
+            joint_vector_deg(model, list(p000.SCENARIO["qf_deg"]), "paper_qf"),
+            "000's printed q_best",
+        )
     else:
         _check_start(model, state, T, limits, _names["state"])
         if margin:
@@ -374,7 +427,7 @@ def plan_halt(
         qf_source = f"optimal halt configuration (Monte Carlo, {samples} samples, seed {seed_text})"
     problem = HaltProblem(
         model, state.q, state.dq, state.ddq, qf_arr, T, kept.velocity, kept.acceleration,
-        base=base, n_samples=n_samples, moment_about=moment_about,
+        base=base, n_samples=n_samples, moment_about=moment_about, tau_max=kept.torque, brake_max=kept.brake,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
     motion = optimal_halt_motion(
@@ -409,7 +462,11 @@ def halt_from_scenario(
     base = t.get("base") or data["base"]
     model = halt_model(data["robot"], locks, base)
     state = FailureState.from_degrees(
-        model, st["q0_deg"], st["dq0_deg"], st["ddq0_deg"], names=("state.q0_deg", "state.dq0_deg", "state.ddq0_deg")
+        model,
+        st["q0_deg"],
+        st["dq0_deg"],
+        st["ddq0_deg"],
+        names=("state.q0_deg", "state.dq0_deg", "state.ddq0_deg"),
     )
     names = dict(SCENARIO_NAMES)
     qf = None
@@ -426,6 +483,8 @@ def halt_from_scenario(
         paper_qf=bool(t["paper_qf"]) and qf is None,
         vmax_deg=lim["vmax_deg"],
         amax_deg=lim["amax_deg"],
+        torque_max_Nm=lim["torque_max_Nm"],
+        brake_max_Nm=lim["brake_max_Nm"],
         base=base,
         solver=t["solver"],
         rng=data["seed"],

@@ -18,4 +18,4 @@ CHUNK_SAMPLES = 60_000
 TORQUE_FLOOR = 1e-300
 
 Solver = Literal["scan", "ga", "vector"]
-LimitKind = Literal["angle", "velocity", "acceleration"]
+LimitKind = Literal["angle", "velocity", "acceleration", "torque", "brake"]

@@ -20,7 +20,7 @@ from ._problem import HaltProblem
 class Violation:
     """One violated limit: joint number (1-based), which limit, the limit, the worst value
     reached, by how much it is exceeded (same unit, > 0), and when [s].  Values in SI
-    (rad, rad/s, rad/s^2)."""
+    (rad, rad/s, rad/s^2; N m for a motor ``"torque"`` or a locked joint's ``"brake"``)."""
 
     joint: int
     kind: LimitKind
@@ -29,12 +29,21 @@ class Violation:
     excess: float
     time: float
 
-    def describe(self) -> str:
+    @property
+    def display(self) -> tuple[float, float, float, str]:
+        """``(value, limit, excess, unit)`` as people read them: degrees, or N m."""
+        if self.kind in ("torque", "brake"):
+            return self.value, self.limit, self.excess, "N m"
         unit = {"angle": "deg", "velocity": "deg/s", "acceleration": "deg/s^2"}[self.kind]
+        return math.degrees(self.value), math.degrees(self.limit), math.degrees(self.excess), unit
+
+    def describe(self) -> str:
+        value, limit, excess, unit = self.display
+        what = {"torque": "motor torque", "brake": "brake torque (locked)"}.get(self.kind, self.kind)
         return (
-            f"joint {self.joint} {self.kind} reaches {math.degrees(self.value):.3f} {unit} at "
-            f"t = {self.time:.3f} s: limit {math.degrees(self.limit):.3f} {unit} exceeded by "
-            f"{math.degrees(self.excess):.3f} {unit} ({100 * self.excess / abs(self.limit):.1f} %)"
+            f"joint {self.joint} {what} reaches {value:.3f} {unit} at "
+            f"t = {self.time:.3f} s: limit {limit:.3f} {unit} exceeded by "
+            f"{excess:.3f} {unit} ({100 * self.excess / abs(self.limit):.1f} %)"
         )
 
 

@@ -76,6 +76,12 @@ class HaltProblem:
         origin for a model without a spacecraft) or ``"joint1"``, joint 1's origin: the root
         frame's origin, where joint 1 is mounted on the spacecraft (DH frame 0; 000 eq. 30's
         ``bP_1`` ends there) -- the reading of an independent reproduction of 000.
+    tau_max
+        (n,) motor torque limits of the healthy joints [N m], ``inf`` for none; None: none.
+    brake_max
+        (n_locked,) brake torque limits of the locked joints [N m] (:attr:`ArmModel.locked`
+        order), ``inf`` for none; None: none.  Torque limits are checked on the ``n_check``
+        grid (:mod:`._actuator_limits`) with ``solver="scan"``.
     """
 
     model: ArmModel
@@ -92,6 +98,8 @@ class HaltProblem:
     n_samples: int = 501
     n_check: int = 2001
     moment_about: MomentAbout = "spacecraft_com"
+    tau_max: FloatArray | None = None
+    brake_max: FloatArray | None = None
 
     def __post_init__(self) -> None:
         n = self.model.dof
@@ -124,14 +132,40 @@ class HaltProblem:
             raise ScenarioError(f"n_samples must be odd and >= {MIN_SAMPLES}; got {self.n_samples}")
         if self.n_check < 3:
             raise ScenarioError(f"n_check must be >= 3; got {self.n_check}")
+        for name, size in (("tau_max", n), ("brake_max", len(self.model.locked))):
+            value = getattr(self, name)
+            if value is not None:
+                arr = np.asarray(value, dtype=float)
+                arr = np.full(size, float(arr)) if arr.ndim == 0 else arr
+                if arr.shape != (size,) or np.any(np.isnan(arr)) or not np.all(arr > 0):
+                    raise ScenarioError(
+                        f"{name} must be one value or {size} values > 0 [N m] (inf: no limit); got {arr.tolist()}"
+                    )
+                arr = arr.copy()
+                arr.setflags(write=False)
+                object.__setattr__(self, name, arr)
         if self.moment_about not in MOMENT_POINTS:
-            raise ScenarioError(f"moment_about must be one of {', '.join(MOMENT_POINTS)}; got {self.moment_about!r}")
+            raise ScenarioError(
+                f"moment_about must be one of {', '.join(MOMENT_POINTS)}; got {self.moment_about!r}"
+            )
 
     @property
     def moment_point(self) -> FloatArray | None:
         """(3,) point of the base torque in the root frame [m], or None for the spacecraft's
         centre of mass (:func:`~jointlock.dynamics.rnea`'s default)."""
         return np.zeros(3) if self.moment_about == "joint1" else None
+
+    def torque_limits(self) -> tuple[FloatArray, FloatArray]:
+        """``(tau_max (n,), brake_max (n_locked,))`` [N m], ``inf`` where there is none."""
+        tau = np.full(self.dof, np.inf) if self.tau_max is None else self.tau_max
+        brake = np.full(len(self.model.locked), np.inf) if self.brake_max is None else self.brake_max
+        return tau, brake
+
+    @property
+    def has_torque_limits(self) -> bool:
+        """Whether some motor or brake torque limit is finite."""
+        tau, brake = self.torque_limits()
+        return bool(np.any(np.isfinite(tau)) or np.any(np.isfinite(brake)))
 
     @property
     def dof(self) -> int:

@@ -24,8 +24,16 @@ def infeasibility_message(result: HaltMotion, *, k_unit: str = "deg/s^6") -> str
         f"least-violating k = {k} {k_unit}; there:",
     ]
     lines += ["  " + v.describe() for v in result.violations[:6]]
+    torque = any(v.kind in ("torque", "brake") for v in result.violations)
+    if torque:
+        lines[0] = (
+            f"no k keeps the torque limits for a {p.T:g} s halt: every k within the speed and acceleration "
+            "limits breaks a motor or brake torque limit."
+        )
     if result.minimum_T is not None:
         lines.append(f"smallest halt time with a feasible k: T = {result.minimum_T:.3f} s")
+    elif torque:
+        lines.append("no halt time up to the search limit keeps the torque limits")
     elif _start_breaks_limits(p):
         lines.append("the state at failure already breaks a limit (at t = 0): no halt time or k helps")
     else:

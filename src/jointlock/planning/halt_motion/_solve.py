@@ -16,6 +16,12 @@ from ..._random import resolve_seed
 from ...errors import InfeasibleError, ScenarioError
 from ...model import FloatArray
 from ..ga import GAResult, GASettings, adaptive_ga, bits_for_precision
+from ._actuator_limits import (
+    least_torque_violating_k,
+    minimum_halt_time_with_torques,
+    torque_feasible_segments,
+    torque_violations,
+)
 from ._constants import K_UNIT_SCALE, TORQUE_FLOOR, Solver
 from ._feasibility import (
     Violation,
@@ -66,6 +72,9 @@ class HaltMotion:
         The :class:`HaltProblem` solved.
     ga
         The GA run (solver ``"ga"``).
+    k_segments
+        With torque limits: the stretches ``(lo, hi)`` [rad/s^6] of ``k_interval`` whose halts
+        also keep every motor and brake torque limit (empty: none does); None without them.
     """
 
     k: Any
@@ -82,6 +91,17 @@ class HaltMotion:
     seed: int | None
     problem: HaltProblem = field(repr=False)
     ga: GAResult | None = field(default=None, repr=False)
+    k_segments: tuple[tuple[float, float], ...] | None = None
+
+    @property
+    def feasible_stretch(self) -> tuple[float, float] | None:
+        """The feasible stretch of a shared ``k`` holding the chosen one [rad/s^6]: the torque
+        segment around it with torque limits, else :attr:`k_interval`; None when infeasible."""
+        if not self.feasible or self.per_joint:
+            return None
+        if self.k_segments is not None:
+            return next((s for s in self.k_segments if s[0] <= float(self.k) <= s[1]), None)
+        return float(self.k_interval[0]), float(self.k_interval[1])
 
     @property
     def reduction(self) -> float:
@@ -119,6 +139,49 @@ def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[floa
         if res.fun < values[i]:
             best = float(res.x)
     return best, grid, values
+
+
+def _scan_segments(problem: HaltProblem, segments: Sequence[tuple[float, float]], n_scan: int) -> float:
+    """:func:`_scan` over several stretches of ``k``, the scan's points shared by width (at
+    least 3 each); the best of their optima."""
+    total = sum(b - a for a, b in segments) or 1.0
+    best = [_scan(problem, a, b, max(3, round(n_scan * (b - a) / total)))[0] for a, b in segments]
+    values = global_base_torque(problem, np.array(best))
+    return float(best[int(np.argmin(values))])
+
+
+def _torque_infeasible_result(
+    problem: HaltProblem,
+    per: FloatArray,
+    interval: tuple[float, float],
+    k0: tuple[float, tuple[Violation, ...]],
+    settings: dict[str, Any],
+    on_infeasible: Literal["report", "raise"],
+) -> HaltMotion:
+    """Every ``k`` that keeps the speed and acceleration limits breaks a torque limit: the
+    least-violating of them, its torque violations and the smallest halt time that keeps all."""
+    k = least_torque_violating_k(problem, interval[0], interval[1], settings["n_scan"])
+    result = HaltMotion(
+        k=k,
+        global_torque=float(global_base_torque(problem, k)),
+        global_torque_k0=k0[0],
+        feasible=False,
+        violations=torque_violations(problem, k) + constraint_violations(problem, k),
+        violations_k0=torque_violations(problem, 0.0) + k0[1],
+        k_interval=np.array(interval),
+        joint_intervals=per,
+        minimum_T=minimum_halt_time_with_torques(problem),
+        solver="scan",
+        settings=settings,
+        seed=None,
+        problem=problem,
+        k_segments=(),
+    )
+    msg = infeasibility_message(result)
+    log.info("infeasible halt: %s", msg.splitlines()[0])
+    if on_infeasible == "raise":
+        raise InfeasibleError(msg)
+    return result
 
 
 def _check_k_bounds(k_bounds: Sequence[float] | None) -> tuple[float, float] | None:
@@ -300,6 +363,12 @@ def optimal_halt_motion(
         raise ScenarioError(f"n_scan must be an integer >= 1 (grid points of the scan); got {n_scan!r}")
     bounds_k = _check_k_bounds(k_bounds)
     rng = resolve_seed(rng)  # None -> a fresh int seed, recorded by the GA
+    torques = problem.has_torque_limits
+    if torques and solver != "scan":
+        raise ScenarioError(
+            f"motor and brake torque limits need solver 'scan' (got {solver!r}): the torques are not affine "
+            "in k, and only the scan finds every stretch of k that keeps them"
+        )
     per = feasible_k_intervals(problem)
     lo, hi = _search_interval(per, bounds_k)
     tau0 = float(global_base_torque(problem, 0.0))
@@ -310,9 +379,16 @@ def optimal_halt_motion(
 
     ga_result = None
     seed = None
-    if solver == "ga":
+    segments = None
+    if torques:
+        segments = tuple(torque_feasible_segments(problem, lo, hi, n_scan))
+        if not segments:
+            return _torque_infeasible_result(problem, per, (lo, hi), (tau0, viol0), settings, on_infeasible)
+        k: Any = _scan_segments(problem, segments, n_scan)
+        viol0 = torque_violations(problem, 0.0) + viol0
+    elif solver == "ga":
         ga_result, settings["ga"] = _solve_ga(problem, lo, hi, ga_settings, ga_precision, rng, progress)
-        k: Any = float(ga_result.x[0])
+        k = float(ga_result.x[0])
         seed = ga_result.seed
     else:
         k, _, _ = _scan(problem, lo, hi, n_scan)
@@ -321,6 +397,10 @@ def optimal_halt_motion(
     per_joint = np.ndim(k) == 1
     tau = float(global_base_torque(problem, k, per_joint=per_joint))
     viol = constraint_violations(problem, k, per_joint=per_joint)
+    if torques:
+        viol = torque_violations(problem, k) + viol
+    if find_minimum_T:
+        t_min = minimum_halt_time_with_torques(problem) if torques else minimum_halt_time(problem)
     return HaltMotion(
         k=k,
         global_torque=tau,
@@ -330,10 +410,11 @@ def optimal_halt_motion(
         violations_k0=viol0,
         k_interval=np.array([lo, hi]),
         joint_intervals=per,
-        minimum_T=minimum_halt_time(problem) if find_minimum_T else None,
+        minimum_T=t_min if find_minimum_T else None,
         solver=solver,
         settings=settings,
         seed=seed,
         problem=problem,
         ga=ga_result,
+        k_segments=segments,
     )

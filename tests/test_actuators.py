@@ -1,0 +1,179 @@
+"""Motor and brake torques of a crippled arm (issue 14, item 2): against Pinocchio's ``rnea``
+on the full arm with the locked joint held, fixed and free-floating, and the invariant that
+the healthy joints' torques equal the locked model's."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.analysis.actuators import actuator_loads, actuator_torques
+
+from pin_oracle import pin, pin_q, to_pinocchio
+
+
+def _state(rng, n, batch=()):
+    return (rng.uniform(-2, 2, batch + (n,)), rng.uniform(-0.5, 0.5, batch + (n,)), rng.uniform(-1, 1, batch + (n,)))
+
+
+def _pinocchio_torques(full: jl.ArmModel, q, dq, ddq, floating: bool) -> np.ndarray:
+    """Full-arm joint torques by Pinocchio; floating: the base twist from zero momentum and its
+    acceleration from the base rows of the dynamics (no wrench on the spacecraft)."""
+    pm, _ = to_pinocchio(full, free_flyer=floating)
+    pm.gravity = pin.Motion.Zero()  # in orbit
+    data = pm.createData()
+    qq = pin_q(pm, q, floating)
+    if not floating:
+        return pin.rnea(pm, data, qq, dq, ddq).copy()
+    mass = pin.crba(pm, data, qq).copy()
+    mass = np.triu(mass) + np.triu(mass, 1).T
+    nb = 6
+    v = np.concatenate([-np.linalg.solve(mass[:nb, :nb], mass[:nb, nb:] @ dq), dq])
+    nle = pin.nonLinearEffects(pm, data, qq, v).copy()
+    a_base = -np.linalg.solve(mass[:nb, :nb], mass[:nb, nb:] @ ddq + nle[:nb])
+    tau = pin.rnea(pm, data, qq, v, np.concatenate([a_base, ddq])).copy()
+    assert np.allclose(tau[:nb], 0.0, atol=1e-9 * max(1.0, np.abs(tau).max()))  # the base is free
+    return tau[nb:]
+
+
+@pytest.mark.parametrize("floating", [False, True])
+@pytest.mark.parametrize(("robot", "locks"), [("halt7", {4: 0.0}), ("halt7", {1: 0.3}), ("halt7", {3: -0.4, 7: 1.0}),
+                                               ("canadarm7", {4: 0.5})])  # fmt: skip
+def test_motor_and_brake_torques_match_pinocchio_with_the_joint_held(rng, robot, locks, floating):
+    full = jl.load_robot(robot, base="floating")
+    locked = jl.lock_joints(full, locks)
+    base = "floating" if floating else "fixed"
+    for _ in range(3):
+        q, dq, ddq = _state(rng, locked.dof)
+        motor, brake = actuator_torques(locked, q, dq, ddq, base=base)
+        held = {"q": locked.expand(q), "dq": np.zeros(full.dof), "ddq": np.zeros(full.dof)}
+        for name, x in (("dq", dq), ("ddq", ddq)):
+            idx = [full.index_of(n) for n in locked.joint_numbers]
+            held[name][idx] = x
+        ref = _pinocchio_torques(full, held["q"], held["dq"], held["ddq"], floating)
+        scale = max(1.0, np.abs(ref).max())
+        np.testing.assert_allclose(motor, ref[[full.index_of(n) for n in locked.joint_numbers]], atol=1e-10 * scale)
+        np.testing.assert_allclose(brake, ref[[full.index_of(lj.number) for lj in locked.locked]], atol=1e-10 * scale)
+        assert np.abs(brake).max() > 1e-3  # the brake really holds something
+
+
+@pytest.mark.parametrize("base", ["fixed", "floating"])
+def test_the_motors_feel_what_the_locked_model_says(rng, base):
+    locked = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.2)
+    q, dq, ddq = _state(rng, locked.dof, (5, 4))
+    motor, brake = actuator_torques(locked, q, dq, ddq, base=base)
+    assert motor.shape == (5, 4, 6) and brake.shape == (5, 4, 1)
+    np.testing.assert_allclose(motor, jl.rnea(locked, q, dq, ddq, base=base).torques, rtol=1e-12, atol=1e-9)
+
+
+def test_an_arm_without_locks_has_no_brakes(rng):
+    arm = jl.load_robot("halt7")
+    q, dq, ddq = _state(rng, 7, (3,))
+    loads = actuator_loads(arm, np.arange(3.0), q, dq, ddq)
+    assert loads.brake.shape == (3, 0) and loads.peak_brake.size == 0
+    assert loads.to_dict()["peak_brake_torque_Nm"] == {}
+
+
+def test_a_locked_model_without_its_full_arm_is_refused_in_one_line(rng):
+    from dataclasses import replace
+
+    locked = replace(jl.lock(jl.load_robot("halt7"), 4, 0.0), unlocked=None)
+    with pytest.raises(jl.ModelError, match="brake torques of 'halt7' need the arm before its locks"):
+        actuator_torques(locked, *_state(rng, 6))
+
+
+# -- torque limits as constraints of the halt (000's scenario, free-floating) ----------------------
+
+from jointlock.jobs.halt import plan_halt  # noqa: E402
+from jointlock.planning.halt_motion._actuator_limits import actuator_peaks  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def free_halt():
+    return plan_halt("halt7", base="floating", samples=4000)  # 000's q_best breaks a limit when free
+
+
+@pytest.fixture
+def _halt(free_halt):
+    return lambda **kw: plan_halt("halt7", qf=free_halt.problem.qf, base="floating", **kw)
+
+
+def test_every_halt_reports_motor_and_brake_torques(free_halt):
+    loads = free_halt.actuator_loads()
+    p = free_halt.problem
+    assert loads.locked_numbers == (4,) and loads.joint_numbers == p.model.joint_numbers
+    q, dq, ddq = free_halt.motion.trajectory(loads.t)
+    np.testing.assert_allclose(loads.motor, jl.rnea(p.model, q, dq, ddq, base="floating").torques, atol=1e-8)
+    d = free_halt.to_dict()
+    assert d["actuators"]["peak_brake_torque_Nm"]["4"] == pytest.approx(loads.peak_brake[0])
+    assert d["torque_limit_Nm"] is None and d["brake_margin"] == [None]
+    assert any("locked: brake holds peak" in line for line in free_halt.summary())
+
+
+def test_a_brake_limit_moves_k_and_is_kept_on_every_sample(free_halt, _halt):
+    peak = free_halt.actuator_loads().peak_brake[0]
+    limit = 0.97 * peak
+    plan = _halt(brake_max_Nm=limit)
+    assert plan.feasible and plan.motion.k != free_halt.motion.k
+    fine = plan.problem.times(20001)
+    q, dq, ddq = plan.motion.trajectory(fine)
+    _, brake = actuator_torques(plan.problem.model, q, dq, ddq, base="floating")
+    assert np.abs(brake).max() <= limit * (1 + 1e-6)
+    name, margin = plan.binding_limit()
+    assert name == "joint 4 brake torque (locked)" and -1e-9 <= margin < 0.01  # on the limit, to round-off
+    assert plan.to_dict()["binding_limit"] == name
+    # the segment's ends are the boundary: just inside keeps the limit, just outside breaks it
+    (a, b), = plan.motion.k_segments
+    width = b - a
+    ratio = actuator_peaks(plan.problem, np.array([a, b, a - 1e-4 * width, b + 1e-4 * width]))[2]
+    inside_a, inside_b, out_a, out_b = ratio
+    assert inside_a <= 1 + 1e-6 and inside_b <= 1 + 1e-6
+    assert (out_a > 1 or a == plan.motion.k_interval[0]) and (out_b > 1 or b == plan.motion.k_interval[1])
+
+
+def test_a_margin_keeps_a_share_of_the_torque_limits(free_halt):
+    limit = 0.97 * free_halt.actuator_loads().peak_motor.max()
+    s = free_halt.problem  # 000's state has joint 6 at its speed limit: a slower one leaves room for a margin
+    state = jl.FailureState(s.q0, 0.9 * s.dq0, s.ddq0)
+    plan = plan_halt(s.model, state, T=10.0, base="floating", samples=4000, torque_max_Nm=limit, margin=0.02)
+    assert plan.feasible
+    assert plan.actuator_loads().peak_motor.max() <= 0.98 * limit * (1 + 1e-6)
+    assert np.nanmin(plan.margins()["torque"]) >= 0.02 - 1e-6
+
+
+def test_a_torque_limit_no_k_keeps_is_reported_as_the_binding_one(free_halt, _halt):
+    limit = 0.5 * free_halt.actuator_loads().peak_motor.max()
+    plan = _halt(torque_max_Nm=limit)
+    assert not plan.feasible
+    worst = plan.motion.violations[0]
+    assert worst.kind == "torque" and worst.limit == pytest.approx(limit)
+    text = "\n".join(plan.summary())
+    assert "no k keeps the torque limits for a 10 s halt" in text
+    assert "motor torque reaches" in text and "N m" in text
+    assert plan.to_dict()["violations"][0]["limit_value_Nm"] == pytest.approx(limit)
+
+
+def test_a_state_at_failure_beyond_a_torque_limit_is_refused_up_front():
+    with pytest.raises(jl.InfeasibleError, match=r"already needs more torque than a limit allows.*joint 1 motor torque"):
+        plan_halt("halt7", paper_qf=True, base="fixed", torque_max_Nm=1000.0)
+
+
+def test_torque_limits_need_the_scan_solver():
+    with pytest.raises(jl.ScenarioError, match="torque limits need solver 'scan'"):
+        plan_halt("halt7", paper_qf=True, base="floating", brake_max_Nm=1e6, solver="ga")
+
+
+def test_a_model_effort_limit_is_the_default_motor_limit():
+    arm = jl.from_dh("two", a=[1.0, 1.0], alpha=[0, 0], d=[0, 0], convention="standard",
+                     bodies=[jl.Body(1.0, [0.5, 0, 0]), jl.Body(1.0, [0.5, 0, 0])], effort_limit=[50.0, np.inf])  # fmt: skip
+    limits = jl.halt_limits(arm)
+    assert limits.torque.tolist() == [50.0, np.inf] and limits.torque_source == ("model's limit", "none")
+    capped = jl.halt_limits(arm, torque_max_Nm=[80.0, 20.0])
+    assert capped.torque.tolist() == [50.0, 20.0]
+    assert capped.torque_source == ("model's limit, below torque_max_Nm 80", "torque_max_Nm")
+
+
+def test_brake_limits_without_a_locked_joint_are_refused():
+    with pytest.raises(jl.ScenarioError, match="brake limit, but 'halt7' has no locked joint"):
+        jl.halt_limits(jl.load_robot("halt7"), brake_max_Nm=100.0)
