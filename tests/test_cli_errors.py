@@ -615,7 +615,9 @@ def test_000s_defaults_belong_to_joint_4_at_0_only(tmp_path, capsys):
     assert "warning: --q0-deg given, the rest of the state is 000 §5.2's" in err
 
 
-def test_run_refuses_a_second_lock_instead_of_keeping_the_last(capsys):
+def test_run_keeps_every_lock_or_says_why_it_cannot(capsys):
     scenario = str(Path(__file__).resolve().parents[1] / "examples" / "replan_002.toml")
-    assert exit_code(["run", scenario, "--lock", "2=59.4", "--lock", "3=0"]) == 2
-    assert "--lock given 2 times: a scenario has one failure" in err_line(capsys)
+    assert exit_code(["run", scenario, "--lock", "2=59.4", "--lock", "3=0"]) == 2  # not the last one silently
+    assert "[replan] work with one locked joint" in err_line(capsys)
+    assert exit_code(["run", scenario, "--lock", "2=59.4", "--lock", "2=0"]) == 2
+    assert "--lock: each joint once; got joints [2, 2]" in err_line(capsys)

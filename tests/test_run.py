@@ -102,7 +102,7 @@ def test_cli_options_override_the_file_and_json_is_clean(tmp_path):
     assert code == 0
     res = json.loads(stdout)  # --json: one JSON object, nothing else on stdout
     assert res["seed"] == 5 and res["scenario"]["workspace"]["samples"] == 2000
-    assert res["scenario"]["failure"] == {"joint": 2, "angle_deg": pytest.approx(60.0), "time_s": None}
+    assert res["scenario"]["failure"] == {"joint": 2, "angle_deg": pytest.approx(60.0), "also_locked_deg": None, "time_s": None}
     assert "--lock 2=" in res["jobs"]["workspace"]["command"]
     assert (tmp_path / "o" / "report.html").is_file() and not (tmp_path / "ignored").exists()
 

@@ -18,7 +18,7 @@ system's centre of mass stays put.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -109,7 +109,9 @@ class SpacecraftResponse:
         }
 
 
-def spacecraft_response(model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLike) -> SpacecraftResponse:
+def spacecraft_response(
+    model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLike, *, rates: Literal["linear", "hold"] = "linear"
+) -> SpacecraftResponse:
     """The spacecraft's attitude, rate and drift while the joints follow ``q(t)``, ``dq(t)``.
 
     Parameters
@@ -120,6 +122,11 @@ def spacecraft_response(model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLi
         (m,) increasing times [s], m >= 2.
     q, dq
         (m, n) joint angles [rad] and rates [rad/s] at those times.
+    rates
+        ``"linear"``: a smooth motion sampled at ``t`` (each step turns by the average of its
+        end rates, second order).  ``"hold"``: a control loop's steps, ``dq[k]`` applied over
+        ``[t_k, t_{k+1})`` from ``q[k]`` (each step turns by its own rate, as the jump study's
+        integrator does; the last row's rate is the one after the motion).
 
     Returns
     -------
@@ -140,20 +147,44 @@ def spacecraft_response(model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLi
     twist = rnea(model, q, dq, np.zeros_like(q), base="floating").base_twist  # needs no ddq
     v0, w0 = twist[:, :3], twist[:, 3:]
     dt = np.diff(t)
-    steps = _rotvec_quaternions(0.5 * (w0[1:] + w0[:-1]) * dt[:, None])
+    if rates not in ("linear", "hold"):
+        raise ModelError(f"rates must be 'linear' or 'hold'; got {rates!r}")
+    w_step = 0.5 * (w0[1:] + w0[:-1]) if rates == "linear" else w0[:-1]
+    steps = _rotvec_quaternions(w_step * dt[:, None])
     attitude = np.concatenate([[[1.0, 0.0, 0.0, 0.0]], _prefix_products(steps)])
     velocity = _rotate(attitude, v0)  # the centre of mass's velocity in the first frame
-    drift = np.concatenate([np.zeros((1, 3)), np.cumsum(0.5 * (velocity[1:] + velocity[:-1]) * dt[:, None], axis=0)])
+    v_step = 0.5 * (velocity[1:] + velocity[:-1]) if rates == "linear" else velocity[:-1]
+    drift = np.concatenate([np.zeros((1, 3)), np.cumsum(v_step * dt[:, None], axis=0)])
     return SpacecraftResponse(t, attitude, w0, drift)
 
 
+def final_attitude_change_deg(model: ArmModel, t: ArrayLike, q: ArrayLike, dq: ArrayLike) -> FloatArray:
+    """The spacecraft's attitude change at the end of many motions at once [deg], (...):
+    :func:`spacecraft_response`'s ``final_attitude_change_deg`` (``rates="linear"``) for
+    ``q``, ``dq`` (..., m, n) on the times ``t`` (m,), the ordered product of the steps taken by
+    a pairwise tree (log2 m batched products).  ``model`` must be free-floating."""
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(q, dtype=float)
+    twist = rnea(model, q, dq, np.zeros_like(q), base="floating").base_twist
+    w0 = twist[..., 3:]
+    steps = _rotvec_quaternions(0.5 * (w0[..., 1:, :] + w0[..., :-1, :]) * np.diff(t)[:, None])
+    while steps.shape[-2] > 1:
+        if steps.shape[-2] % 2:  # an identity after the last step keeps the pairs in order
+            identity = np.zeros(steps.shape[:-2] + (1, 4))
+            identity[..., 0] = 1.0
+            steps = np.concatenate([steps, identity], axis=-2)
+        steps = _quaternion_product(steps[..., 0::2, :], steps[..., 1::2, :])
+    final = steps[..., 0, :] / np.linalg.norm(steps[..., 0, :], axis=-1, keepdims=True)
+    return np.degrees(2.0 * np.arctan2(np.linalg.norm(final[..., 1:], axis=-1), np.abs(final[..., 0])))
+
+
 def _rotvec_quaternions(rotvec: FloatArray) -> FloatArray:
-    """(k, 4) unit quaternions ``(w, x, y, z)`` of rotation vectors (k, 3) [rad]."""
+    """(..., 4) unit quaternions ``(w, x, y, z)`` of rotation vectors (..., 3) [rad]."""
     angle = np.linalg.norm(rotvec, axis=-1)
     half = 0.5 * angle
     # sin(a/2)/a, with its limit 1/2 at a = 0
     scale = np.where(angle > 1e-12, np.sin(half) / np.where(angle > 1e-12, angle, 1.0), 0.5 - angle**2 / 48.0)
-    return np.concatenate([np.cos(half)[:, None], rotvec * scale[:, None]], axis=-1)
+    return np.concatenate([np.cos(half)[..., None], rotvec * scale[..., None]], axis=-1)
 
 
 def _quaternion_product(a: FloatArray, b: FloatArray) -> FloatArray:

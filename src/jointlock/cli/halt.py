@@ -103,6 +103,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "0.05: 5 %%); each limit's margin is reported either way",
     )
     p.add_argument(
+        "--objective",
+        choices=("mean_torque", "peak_torque", "attitude_change"),
+        default="mean_torque",
+        help="what k minimises: 000's time-averaged base torque (default), the peak base torque, or the "
+        "free spacecraft's attitude change at the end of the halt",
+    )
+    p.add_argument(
         "--moment-about",
         choices=("spacecraft_com", "joint1"),
         default="spacecraft_com",
@@ -289,6 +296,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         state_source=source,
         moment_about=args.moment_about,
         margin=args.margin,
+        objective=args.objective,
         _names=CLI_NAMES,
     )
 

@@ -43,7 +43,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="J=DEG",
         type=parse_lock,
         action="append",
-        help="override the failure: joint J locked at DEG degrees (once: a scenario has one failure)",
+        help="override the failure: joint J locked at DEG degrees; repeat it to lock several (the last is "
+        "the failure, the others [failure] also_locked_deg, locked before it)",
     )
     p.add_argument("--jobs", nargs="+", choices=JOB_ORDER, metavar="JOB", help="run only these jobs")
     p.add_argument(
@@ -68,13 +69,13 @@ def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
     if args.seed is not None:
         out["seed"] = args.seed
     if args.lock is not None:
-        if len(args.lock) > 1:  # not the last one silently
-            raise ScenarioError(
-                f"--lock given {len(args.lock)} times: a scenario has one failure ([failure] joint, angle_deg); "
-                "lock several joints with `jointlock kinematics/halt/... --lock A --lock B` or lock_joints in Python"
-            )
-        out["failure.joint"] = args.lock[0][0]
-        out["failure.angle_deg"] = math.degrees(args.lock[0][1])
+        numbers = [j for j, _ in args.lock]
+        if len(set(numbers)) != len(numbers):
+            raise ScenarioError(f"--lock: each joint once; got joints {numbers}")
+        *earlier, (joint, angle) = args.lock  # the last --lock is the failure, the others locked before it
+        out["failure.joint"] = joint
+        out["failure.angle_deg"] = math.degrees(angle)
+        out["failure.also_locked_deg"] = {str(j): math.degrees(a) for j, a in earlier} or None
     if args.jobs:
         out["jobs"] = list(args.jobs)
     if args.out is not None:

@@ -9,8 +9,9 @@ from pathlib import Path
 from ..analysis.workspace import MIN_SAMPLES
 from ..errors import ScenarioError
 from ..jobs.workspace import VoxelTooSmallError, study_workspace
+from ..locking import lock_joints
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, field_arg, print_json, seed_arg
+from ._common import add_robot_arguments, check_out_dir, field_arg, lock_map, print_json, seed_arg
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -24,7 +25,9 @@ def register(sub: argparse._SubParsersAction) -> None:
             "(cubes of side --voxel holding at least one sample). The share of the full workspace "
             "that the locked arm keeps is a Monte Carlo estimate that moves with --samples and "
             "--voxel: it is printed next to the same estimate from half the samples, and a warning "
-            "says when the two differ or when many locked voxels fall outside the full cloud."
+            "says when the two differ or when many locked voxels fall outside the full cloud. With "
+            "--lock repeated, the last is the failure and the others were locked before it: the "
+            "comparison is then before vs after the failure."
         ),
     )
     add_robot_arguments(p)
@@ -49,13 +52,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
-    if len(args.lock) > 1:
-        raise ScenarioError(f"--lock may be given at most once; got {len(args.lock)}")
     model = load_robot(args.robot, base=args.base)
+    lock_map(args.lock)  # each joint once
+    if len(args.lock) > 1:  # the last --lock is the failure; the others were locked before it
+        model = lock_joints(model, lock_map(args.lock[:-1]))
     try:
         result = study_workspace(
             model,
-            args.lock[0] if args.lock else None,
+            args.lock[-1] if args.lock else None,
             samples=args.samples,
             voxel=args.voxel,
             rng=args.seed,

@@ -83,6 +83,16 @@ def scenario_lock(data: Mapping[str, Any], job: str | None = None) -> tuple[int,
     return int(failure["joint"]), math.radians(float(failure["angle_deg"]))
 
 
+def scenario_locks(data: Mapping[str, Any]) -> dict[int, float]:
+    """``{joint number: angle [rad]}`` of every locked joint of a resolved scenario: the joints
+    of ``[failure] also_locked_deg``, then the failure's (empty without a failure)."""
+    lk = scenario_lock(data)
+    if lk is None:
+        return {}
+    earlier = (data.get("failure") or {}).get("also_locked_deg") or {}
+    return {**{int(j): math.radians(float(a)) for j, a in earlier.items()}, lk[0]: lk[1]}
+
+
 def locked_deg(model: ArmModel) -> dict[str, float]:
     """``{"J": angle [deg]}`` of the locked joints, for JSON output."""
     return {str(lj.number): math.degrees(lj.angle) for lj in model.locked}

@@ -36,7 +36,7 @@ from ..planning.halt_config import (
 from ..plots.halt_config import section_figures
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult, scenario_lock
+from ._common import JobResult, scenario_locks
 from .halt import SCENARIO_LIMIT_NAMES, FailureState, JointLimits, halt_limits, limits_text
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
@@ -370,9 +370,9 @@ def halt_config_from_scenario(
     shown from :data:`PROGRESS_MIN_SAMPLES` samples on, as the command does."""
     t, st, lim = data["halt_config"], data["state"], data["limits"]
     model = load_robot(data["robot"], base=t.get("base") or data["base"])
-    lk = scenario_lock(data)
-    if lk is not None:
-        model = lock_joints(model, dict([lk]))
+    locks = scenario_locks(data)
+    if locks:
+        model = lock_joints(model, locks)
     reach = None
     if t["reachable"]:
         state = FailureState.from_degrees(

@@ -11,13 +11,14 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, write_png
 from ..kinematics import ee_pose
@@ -60,6 +61,8 @@ class ReplanJobResult(JobResult):
         Largest ``|gamma|`` accepted [deg], as given.
     step_weight
         Tracking error [m] traded per rad^2 of joint step (``method="continuous"``).
+    model
+        The locked arm the plan moves (None when not kept).
     """
 
     job: ClassVar[str] = "replan"
@@ -68,6 +71,15 @@ class ReplanJobResult(JobResult):
     plan: ReplanResult
     tolerance_deg: float
     step_weight: float
+    model: ArmModel | None = field(default=None, repr=False)
+
+    def spacecraft_response(self) -> SpacecraftResponse | None:
+        """What the free spacecraft does while the locked arm follows the plan's waypoints at
+        their times (rates by central differences, :func:`~jointlock.analysis.spacecraft.
+        spacecraft_response`); None unless the arm is free-floating."""
+        if self.model is None or not self.model.floating:
+            return None
+        return spacecraft_response(self.model, self.plan.times, self.plan.q, self.plan.dq)
 
     def trajectory(self) -> dict[str, np.ndarray]:
         """The time series of the JSON output: ``time_s`` (K,), ``q_deg`` (K, 6), ``gamma_deg``,
@@ -119,8 +131,11 @@ class ReplanJobResult(JobResult):
         }
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object of ``jointlock replan --json`` (without ``files``)."""
-        return {**self.headline(), "trajectory": self.trajectory()}
+        """The JSON object of ``jointlock replan --json`` (without ``files``); ``spacecraft``
+        (:meth:`spacecraft_response`) with a free-floating arm."""
+        sc = self.spacecraft_response()
+        extra = {} if sc is None else {"spacecraft": sc.to_dict()}
+        return {**self.headline(), **extra, "trajectory": self.trajectory()}
 
     def summary(self) -> list[str]:
         """The lines ``jointlock replan`` prints."""
@@ -153,6 +168,9 @@ class ReplanJobResult(JobResult):
         elif np.all(np.isfinite(res.velocity_limit)):
             lines.append("  every joint step is within the speed limits at this cycle")
         lines.append("  goal q [deg]: " + " ".join(f"{v:.4f}" for v in s["q_goal_deg"]))
+        sc = self.spacecraft_response()
+        if sc is not None:
+            lines += ["  " + line for line in sc.summary("spacecraft (free, zero momentum)")]
         return lines
 
     def trajectory_csv(self) -> str:
@@ -174,7 +192,8 @@ class ReplanJobResult(JobResult):
 
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (its JSON lists them as paths)."""
-        return ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json"]
+        names = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json"]
+        return names + (["spacecraft_attitude.png"] if self.spacecraft_response() is not None else [])
 
     def write(self, out: str | Path) -> list[str]:
         """Write ``joints.png`` (002 Figs. 11/17), ``pose.png`` (Figs. 12/18), ``error.png``
@@ -202,6 +221,12 @@ class ReplanJobResult(JobResult):
             write_png(plot(self.plan, fig=offscreen_figure(PANELS_FIGSIZE)), folder / name, dpi=110)
         atomic_write_text(folder / "trajectory.csv", self.trajectory_csv())
         atomic_write_json(folder / "plan.json", self.to_dict())
+        sc = self.spacecraft_response()
+        if sc is not None:
+            from ..plots.spacecraft import plot_spacecraft_responses
+
+            fig = plot_spacecraft_responses({"re-planned path": sc}, fig=offscreen_figure((7, 5)))
+            write_png(fig, folder / "spacecraft_attitude.png", dpi=110)
         return self.file_names()
 
 
@@ -297,7 +322,7 @@ def plan_replan(
         )
         bar.update()
     return ReplanJobResult(
-        robot=model.name, plan=plan, tolerance_deg=float(tolerance_deg), step_weight=float(step_weight)
+        robot=model.name, plan=plan, tolerance_deg=float(tolerance_deg), step_weight=float(step_weight), model=locked
     )
 
 

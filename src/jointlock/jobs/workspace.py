@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -32,10 +32,11 @@ from ..analysis.workspace import (
 from ..errors import ScenarioError
 from ..io import files as _files
 from ..io.files import atomic_write_json, npz_bytes, write_png
+from ..locking import lock_joints
 from ..model import ArmModel
 from ..progress import Progress
 from ..robots import load_robot
-from ._common import JobResult, scenario_lock
+from ._common import JobResult, locked_deg, locked_text, scenario_lock, scenario_locks
 
 #: Points of each cloud drawn in the projections, and in the 3-D clouds.
 PROJECTION_POINTS = 20000
@@ -95,6 +96,9 @@ class WorkspaceStudy(JobResult):
         (``points`` (N, 3) [m], ``voxel`` [m], ``volume`` [m^3]).  With one: the
         :class:`~jointlock.analysis.workspace.WorkspaceComparison` (``full`` (N, 3), ``locked``
         (N, 3) [m], both volumes, the share kept and its half-sample estimate).
+    already_locked
+        ``{joint: angle [deg]}`` locked before the failure (``model.locked`` of the arm given):
+        then "full" is the arm before this failure, with those joints locked.
     """
 
     job: ClassVar[str] = "workspace"
@@ -103,6 +107,12 @@ class WorkspaceStudy(JobResult):
     samples: int
     seed: int | None
     workspace: Workspace | WorkspaceComparison
+    already_locked: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def _before(self) -> str:
+        """How the summary names the arm before the failure."""
+        return "full arm" if not self.already_locked else f"arm before ({locked_text(self.already_locked)})"
 
     @property
     def locked(self) -> bool:
@@ -164,6 +174,8 @@ class WorkspaceStudy(JobResult):
                 "extent_full_m": projection_extent(ws.points),
                 "samples_per_voxel": ws.samples_per_voxel,
             }
+        if self.already_locked:  # "full" is the arm before the failure
+            out["already_locked_deg"] = dict(self.already_locked)
         return out
 
     def summary(self) -> list[str]:
@@ -178,7 +190,7 @@ class WorkspaceStudy(JobResult):
         if isinstance(ws, WorkspaceComparison):
             warnings = ws.warnings()
             lines += [
-                f"  full arm volume   : {ws.volume_full:.3g} m^3",
+                f"  {self._before + ' volume':<18}: {ws.volume_full:.3g} m^3",
                 f"  locked arm volume : {ws.volume_locked:.3g} m^3 (joint {ws.joint} at "
                 f"{math.degrees(ws.angle):g} deg)",
                 f"  share kept        : {100 * ws.share_kept:.0f} % (from half the samples: "
@@ -187,7 +199,7 @@ class WorkspaceStudy(JobResult):
                 f"  locked voxels outside the full cloud (sampling): {100 * ws.outside:.1f} %",
             ]
         else:
-            lines.append(f"  full arm volume   : {ws.volume:.3g} m^3")
+            lines.append(f"  {self._before + ' volume':<18}: {ws.volume:.3g} m^3")
         return lines
 
     def file_names(self) -> list[str]:
@@ -286,6 +298,7 @@ def study_workspace(
         samples=samples,
         seed=None if isinstance(seed, np.random.Generator) else seed,
         workspace=ws,
+        already_locked=locked_deg(model),
     )
 
 
@@ -296,10 +309,14 @@ def workspace_from_scenario(
     ``seed`` and ``[failure]`` (optional), and the ``[workspace]`` table); ``previous`` is not
     used.  Same result as ``jointlock workspace`` with the scenario's options."""
     t = data["workspace"]
+    locks = scenario_locks(data)
+    failure = scenario_lock(data)
     model = load_robot(data["robot"], base=data["base"])
+    if failure is not None:  # joints locked before the failure: the arm before it
+        model = lock_joints(model, {j: a for j, a in locks.items() if j != failure[0]})
     return study_workspace(
         model,
-        scenario_lock(data),
+        failure,
         samples=int(t["samples"]),
         voxel=None if t["voxel"] is None else float(t["voxel"]),
         rng=int(data["seed"]),

@@ -32,13 +32,13 @@ def _nums(values: list[float]) -> list[str]:
 def _healthy_rates(scenario: Scenario, values: list[float]) -> list[float]:
     """A rate or acceleration vector of the state for the command line: the healthy joints'
     entries (a full-arm vector's locked entry is 0, checked when the scenario was loaded)."""
-    lk = scenario.lock
-    if lk is None:
+    locked = set(scenario.locks)
+    if not locked:
         return values
     full = load_robot(scenario.data["robot"], base="fixed")
     if len(values) != full.dof:
         return values
-    return [v for i, v in enumerate(values) if i + 1 != lk[0]]
+    return [v for i, v in enumerate(values) if i + 1 not in locked]
 
 
 def job_argv(
@@ -85,11 +85,14 @@ def job_argv(
         for key in ("vmax_deg", "amax_deg"):
             if lim[key] is not None:
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
+        for key, option in (("torque_max_Nm", "--torque-max-Nm"), ("brake_max_Nm", "--brake-max-Nm")):
+            argv += [option, _num(lim[key])] if lim.get(key) is not None else []
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
         argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])
         argv += ["--moment-about", t["moment_about"]] if t["moment_about"] != "spacecraft_com" else []
         argv += ["--margin", _num(t["margin"])] if t["margin"] else []
+        argv += ["--objective", t["objective"]] if t["objective"] != "mean_torque" else []
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "jump":
         fields = jump_fields(d)

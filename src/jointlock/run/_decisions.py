@@ -138,7 +138,9 @@ def _decide_workspace(scenario: Scenario, jobs: dict[str, Any]) -> tuple[list[tu
     else:
         decisions.append(
             (
-                "workspace volume full / locked [m^3]",
+                "workspace volume before / after the failure [m^3]"
+                if r.get("already_locked_deg")
+                else "workspace volume full / locked [m^3]",
                 f"{r['volume_full_m3']:.3g} / {r['volume_locked_m3']:.3g} (kept {_pct0(r.get('share_kept'))}; "
                 f"from half the samples {_pct0(r.get('share_kept_half_samples'))})",
             )

@@ -13,8 +13,9 @@ from typing import Any
 import numpy as np
 
 from ..io.files import save_figure
+from ..jobs._common import scenario_locks
 from ..jobs.halt._result import MOMENT_TEXT
-from ..locking import lock
+from ..locking import lock_joints
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
 from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_replan_error
@@ -28,6 +29,8 @@ LIMIT_LABELS = {
     "vmax_deg": "speed limit [deg/s]",
     "amax_deg": "acceleration limit [deg/s^2]",
     "eps_m": "position-deviation threshold [m]",
+    "torque_max_Nm": "motor torque limit [N m]",
+    "brake_max_Nm": "brake torque limit [N m]",
 }
 
 
@@ -43,6 +46,8 @@ def is_000_case(scenario: Scenario, model: Any) -> bool:
     """halt7 with joint 4 locked at 0 deg: 000 §5's scenario, whose headline numbers the halt
     report compares against."""
     lk = scenario.lock
+    if scenario.data.get("failure", {}).get("also_locked_deg"):
+        return False  # another joint locked too: not 000's failure
     return model.name == "halt7" and lk is not None and lk[0] == 4 and math.isclose(lk[1], 0.0, abs_tol=1e-9)
 
 
@@ -61,8 +66,8 @@ def report_sections(
     figures are read from ``out/<job>`` (written before the report)."""
     jobs = results["jobs"]
     full = load_robot(scenario.data["robot"], base="fixed")
-    lk = scenario.lock
-    locked = None if lk is None else lock(full, lk[0], math.radians(lk[1]))
+    locks = scenario_locks(scenario.data)
+    locked = lock_joints(full, locks) if locks else None
     return [
         *_scenario_section(scenario, jobs, full, locked, results["versions"]),
         *_failure_section(scenario, jobs, full, locked),
@@ -110,6 +115,10 @@ def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         ffacts.append(("joint that locks", fail["joint"]))
     if fail["angle_deg"] is not None:
         ffacts.append(("locked angle [deg]", fail["angle_deg"]))
+    if fail.get("also_locked_deg"):
+        ffacts.append(
+            ("locked before it", ", ".join(f"joint {j} at {a:g} deg" for j, a in fail["also_locked_deg"].items()))
+        )
     if scenario.failure_overridden():
         changed = {
             k.split(".", 1)[1]: v["file"]
@@ -138,7 +147,7 @@ def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         def healthy(v: list[float] | None) -> list[Any]:
             if v is None:
                 return [None] * n_h
-            return list(v) if len(v) == n_h else [x for i, x in enumerate(v) if i + 1 != fail["joint"]]
+            return list(v) if len(v) == n_h else [x for i, x in enumerate(v) if i + 1 in locked.joint_numbers]
 
         rows = [
             [num, a, b, c]
@@ -205,14 +214,14 @@ def _limits_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked:
                         [
                             v["joint"],
                             v["limit"],
-                            v["limit_value_deg"],
-                            v["value_deg"],
-                            v["excess_deg"],
+                            v.get("limit_value_deg", v.get("limit_value_Nm")),
+                            v.get("value_deg", v.get("value_Nm")),
+                            v.get("excess_deg", v.get("excess_Nm")),
                             v["time_s"],
                         ]
                         for v in r["violations"]
                     ],
-                    "limits broken (deg, deg/s, deg/s^2)",
+                    "limits broken (deg, deg/s, deg/s^2; N m for motor and brake torques)",
                 )
             )
     if "jump" in jobs:

@@ -71,6 +71,8 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
                 "warnings",
             )
         }
+        if r.get("already_locked_deg"):
+            s["workspace"]["already_locked_deg"] = r["already_locked_deg"]
     if "singular" in jobs:
         r = jobs["singular"]["result"]
         if "conditions" in r and isinstance(r["conditions"], dict) and "cond1" in r["conditions"]:
@@ -147,7 +149,7 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     if "workspace" in s:
         w = s["workspace"]
         lines.append(
-            f"  workspace: full {w['volume_full_m3']:.3g} m^3"
+            f"  workspace: {'before the failure' if w.get('already_locked_deg') else 'full'} {w['volume_full_m3']:.3g} m^3"
             + (
                 f", locked {w['volume_locked_m3']:.3g} m^3, kept {_pct0(w['share_kept'])} "
                 f"(half the samples: {_pct0(w.get('share_kept_half_samples'))})"

@@ -72,6 +72,42 @@ def _load(out: dict[str, Any], base: str, source: str, cache: dict) -> Any:
     return cache[key]
 
 
+#: Jobs whose method has one locked joint: 002's tolerance angle and re-planning are about the
+#: one joint that locked (closed-form on 002's arm), 001's jump locks one joint during a task.
+ONE_LOCK_JOBS = ("tolerance_angle", "replan", "jump")
+
+
+def _check_earlier_locks(
+    earlier: dict[int, float], fail: dict[str, Any], jobs: tuple[str, ...], source: str, robot: str, n: int
+) -> None:
+    """``failure.also_locked_deg``: joints of the arm, not the failure's own, with a failure to
+    add them to, and only for jobs whose method allows several locked joints."""
+    if fail["joint"] is None or fail["angle_deg"] is None:
+        raise ScenarioError(
+            f"{source}: failure.also_locked_deg lists joints locked before the failure: give failure.joint and "
+            "failure.angle_deg too"
+        )
+    for j in earlier:
+        if not 1 <= j <= n:
+            raise ScenarioError(
+                f"{source}: failure.also_locked_deg: joint {j} is no joint of {robot} (1..{n})"
+            )
+        if j == fail["joint"]:
+            raise ScenarioError(
+                f"{source}: failure.also_locked_deg: joint {j} is the failure's own joint (failure.joint); "
+                "list only the joints locked before it"
+            )
+    if len(earlier) + 1 >= n:
+        raise ScenarioError(f"{source}: failure.also_locked_deg: {len(earlier) + 1} locks leave no movable joint of {robot}")
+    bad = [job for job in jobs if job in ONE_LOCK_JOBS]
+    if bad:
+        raise ScenarioError(
+            f"{source}: failure.also_locked_deg: job(s) {', '.join(f'[{b}]' for b in bad)} work with one locked "
+            "joint (002's tolerance angle and re-planning are closed-form for the one joint that locked; "
+            "001's jump locks one joint during the task); remove also_locked_deg or these jobs"
+        )
+
+
 def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) -> None:
     """Cross-field checks of ``out`` (in place: a few defaults depend on other fields).
 
@@ -104,9 +140,19 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
             raise ScenarioError(
                 f"{source}: job [{job}] needs the failure: set failure.joint (1..{n}) and failure.angle_deg"
             )
-    locked = None
+    earlier = {int(j): a for j, a in (fail.get("also_locked_deg") or {}).items()}
+    if earlier:
+        _check_earlier_locks(earlier, fail, jobs, source, model.name, n)
+    locks_deg: dict[int, float] = {}
     if fail["joint"] is not None and fail["angle_deg"] is not None:
-        locked = lock(model, fail["joint"], math.radians(fail["angle_deg"]))
+        locks_deg = {**earlier, int(fail["joint"]): float(fail["angle_deg"])}
+    locked = None
+    for j, a in locks_deg.items():
+        try:
+            locked = lock(locked or model, j, math.radians(a))
+        except JointlockError as exc:
+            where = "failure.angle_deg" if j == fail["joint"] else f"failure.also_locked_deg.{j}"
+            raise ScenarioError(f"{source}: {where}: {exc}") from None
     _defaults_000(out, jobs, model)
 
     def vector(
@@ -127,19 +173,21 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
                 f"{source}: {where} needs {want} values ({what} of {model.name}); got {len(values)}"
             )
         if locked is not None and not full_only and len(values) == n:
-            j = fail["joint"] - 1
-            if rates:
-                if not math.isclose(values[j], 0.0, abs_tol=1e-9):
+            for number, angle in locks_deg.items():
+                j = number - 1
+                if rates:
+                    if not math.isclose(values[j], 0.0, abs_tol=1e-9):
+                        raise ScenarioError(
+                            f"{source}: {where}: entry {j + 1} (the locked joint) must be 0, as a locked "
+                            f"joint does not move; got {values[j]:g} (or give only the healthy joints)"
+                        )
+                    continue
+                if not math.isclose(values[j], angle, abs_tol=1e-9):
+                    name = "failure.angle_deg" if number == fail["joint"] else f"failure.also_locked_deg.{number}"
                     raise ScenarioError(
-                        f"{source}: {where}: entry {j + 1} (the locked joint) must be 0, as a locked "
-                        f"joint does not move; got {values[j]:g} (or give only the healthy joints)"
+                        f"{source}: {where}: entry {j + 1} (the locked joint) must equal {name} = "
+                        f"{angle:g}; got {values[j]:g} (or give only the healthy joints)"
                     )
-                return
-            if not math.isclose(values[j], fail["angle_deg"], abs_tol=1e-9):
-                raise ScenarioError(
-                    f"{source}: {where}: entry {j + 1} (the locked joint) must equal failure.angle_deg = "
-                    f"{fail['angle_deg']:g}; got {values[j]:g} (or give only the healthy joints)"
-                )
 
     for key in ("q0_deg", "dq0_deg", "ddq0_deg"):
         vector(f"state.{key}", out["state"][key], rates=key != "q0_deg")

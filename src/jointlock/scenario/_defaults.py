@@ -9,6 +9,8 @@ from typing import Any
 def _is_000_failure(robot: str, fail: dict[str, Any]) -> bool:
     """halt7 with joint 4 locked at 0 deg: the failure 000's state, limits and T belong to."""
     angle = fail.get("angle_deg")
+    if fail.get("also_locked_deg"):
+        return False
     return robot == "halt7" and fail.get("joint") == 4 and angle is not None and math.isclose(angle, 0.0, abs_tol=1e-9)
 
 

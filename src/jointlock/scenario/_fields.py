@@ -55,7 +55,8 @@ class Field:
     """Schema of one scenario field.
 
     ``kind``: ``"int"``, ``"number"``, ``"bool"``, ``"str"``, ``"choice"``, ``"numbers"``
-    (list of numbers), ``"strings"`` (list of choices).  ``lo``/``hi`` bound numbers
+    (list of numbers), ``"strings"`` (list of choices), ``"locks"`` (a table of joint
+    numbers to angles).  ``lo``/``hi`` bound numbers
     (``lo_open``: strictly greater); ``choices`` lists allowed strings.
     """
 
@@ -76,6 +77,8 @@ class Field:
             return "true or false"
         if self.kind == "str":
             return "a string" + unit
+        if self.kind == "locks":
+            return f"a table {{joint number = angle}} of finite numbers >= {self.lo:g} and <= {self.hi:g}{unit}"
         if self.kind in ("choice", "strings"):
             opts = ", ".join(repr(c) for c in self.choices)
             return ("one of " if self.kind == "choice" else "a list of ") + opts
@@ -141,6 +144,15 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         ),
         "time_s": Field(
             "number", None, lo=0.0, hi=MAX_TIME_S, unit="s", help="time it locks during a task (jump)"
+        ),
+        "also_locked_deg": Field(
+            "locks",
+            None,
+            lo=-MAX_ABS_DEG,
+            hi=MAX_ABS_DEG,
+            unit="deg",
+            help="joints locked before this failure, {joint = angle}, e.g. {2 = 10.0} (halt_config, halt, "
+            "workspace, singular; not tolerance_angle, replan, jump: one locked joint by their method)",
         ),
     },
     "state": {
@@ -219,6 +231,13 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             lo=0.0,
             hi=0.5,
             help="share of each speed, acceleration and torque limit kept free by the halt (0.05: 5 %)",
+        ),
+        "objective": Field(
+            "choice",
+            "mean_torque",
+            choices=("mean_torque", "peak_torque", "attitude_change"),
+            help="what k minimises: 000's time-averaged base torque, the peak base torque, or the free "
+            "spacecraft's attitude change at the end",
         ),
         "moment_about": Field(
             "choice",

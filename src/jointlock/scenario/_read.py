@@ -91,7 +91,8 @@ def parse_set(text: str) -> tuple[str, Any]:
 
 
 def apply_overrides(data: Mapping[str, Any], overrides: Mapping[str, Any], *, source: str) -> dict[str, Any]:
-    """Copy of ``data`` with ``{"table.field": value}`` set (validated later with the rest).
+    """Copy of ``data`` with ``{"table.field": value}`` set (validated later with the rest);
+    a value of None removes the field (its default then holds).
 
     An override replaces the file's field whichever name either uses (a former name of
     :data:`DEPRECATED_FIELDS` or the current one); two overrides of one field under both names
@@ -119,6 +120,10 @@ def apply_overrides(data: Mapping[str, Any], overrides: Mapping[str, Any], *, so
         if not isinstance(table, dict):
             raise ScenarioError(f"{source}: override {key!r}: {parts[0]!r} is not a table")
         names = _spellings(parts[0], parts[1])
+        if value is None:  # back to the default (e.g. no also_locked_deg when --lock overrides the failure)
+            for n in names:
+                table.pop(n, None)
+            continue
         if any(n in table for n in names):  # in place, under the override's name: the file's order
             items = [(parts[1] if k in names else k, value if k in names else v) for k, v in table.items()]
             table.clear()
@@ -183,6 +188,15 @@ def check_value(value: Any, spec: Field, where: str) -> Any:
         return int(value)
     if kind == "number":
         return number(value)
+    if kind == "locks":
+        if not isinstance(value, dict) or not value:
+            raise bad(f" ({type(value).__name__})" if not isinstance(value, dict) else " (empty)")
+        locks = {}
+        for key, angle in value.items():
+            if not (isinstance(key, str) and key.isdigit() and len(key) <= 4 and int(key) >= 1):
+                raise bad(f" (key {shown(key)} is no joint number >= 1)")
+            locks[str(int(key))] = number(angle)
+        return locks
     if kind == "numbers":
         if not isinstance(value, list) or not value:
             raise bad(f" ({type(value).__name__})" if not isinstance(value, list) else " (empty)")

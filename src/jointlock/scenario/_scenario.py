@@ -54,8 +54,18 @@ class Scenario:
             return None
         return int(f["joint"]), float(f["angle_deg"])
 
+    @property
+    def locks(self) -> dict[int, float]:
+        """``{joint number: angle [deg]}`` of every locked joint: ``[failure] also_locked_deg``,
+        then the failure's own (empty without a failure)."""
+        lk = self.lock
+        if lk is None:
+            return {}
+        earlier = self.data.get("failure", {}).get("also_locked_deg") or {}
+        return {**{int(j): float(a) for j, a in earlier.items()}, lk[0]: lk[1]}
+
 
 def job_lock_args(scenario: Scenario) -> list[str]:
-    """``["--lock", "J=DEG"]`` for the failure, or ``[]``."""
-    lk = scenario.lock
-    return [] if lk is None else ["--lock", f"{lk[0]}={lk[1]!r}"]
+    """``["--lock", "J=DEG", ...]`` for every locked joint (those locked before the failure,
+    then the failure's), or ``[]``."""
+    return [arg for j, a in scenario.locks.items() for arg in ("--lock", f"{j}={a!r}")]

@@ -25,6 +25,7 @@ from ...papers import p000
 from ...planning.halt_config import HaltConfiguration
 from ...planning.halt_motion import (
     K_UNIT_SCALE,
+    OBJECTIVES,
     HaltMotion,
     HaltProblem,
     base_torque_history,
@@ -49,6 +50,13 @@ FRAGILE_WIDTH = 0.01
 #: Longest time step of the spacecraft's attitude integration [s] (the objective's grid may be
 #: coarse: 11 samples put 000's 124 deg off by 0.5 deg; 0.02 s keeps it within 1e-3 deg).
 SPACECRAFT_STEP_S = 0.02
+
+#: How the summary names what k minimises (:attr:`HaltProblem.objective`).
+OBJECTIVE_TEXT = {
+    "mean_torque": "time-averaged base torque (000 eq. 32)",
+    "peak_torque": "peak base torque",
+    "attitude_change": "the free spacecraft's attitude change at the end",
+}
 
 #: How the summary names the base torque's point (:attr:`HaltProblem.moment_about`).
 MOMENT_TEXT = {
@@ -160,6 +168,10 @@ class HaltPlan(JobResult):
             "spacecraft": None if (sc := self.spacecraft_response()) is None else sc.to_dict(),
             "state_source": self.state_source,
             "moment_about": p.moment_about,
+            "objective": p.objective,
+            "objective_value": res.objective_value,
+            "objective_value_k0": res.objective_value_k0,
+            "objective_unit": OBJECTIVES[p.objective],
             "margin_kept": self.margin,
             "velocity_margin": (m := self.margins())["velocity"],
             "acceleration_margin": m["acceleration"],
@@ -337,6 +349,12 @@ class HaltPlan(JobResult):
             f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
             f"({_change_text(res)})"
         )
+        if p.objective != "mean_torque" and res.objective_value is not None:
+            unit = OBJECTIVES[p.objective]
+            lines.append(
+                f"objective minimised: {OBJECTIVE_TEXT[p.objective]}: k = 0: {res.objective_value_k0:.4g} {unit}; "
+                f"k*: {res.objective_value:.4g} {unit}"
+            )
         if self.paper_scenario:  # 000's numbers belong to 000 §5's scenario on halt7 only
             lines.append(f"{_printed_text()} -- not reproduced, see docs/halt-motion.md")
         _, dq, ddq = res.trajectory(p.times(p.n_check))

@@ -24,7 +24,7 @@ from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal
 from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
 from ...progress import Progress
 from ...robots import load_robot
-from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_lock
+from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_locks
 from ._inputs import (
     CLI_LIMIT_NAMES,
     CLI_TORQUE_NAMES,
@@ -313,6 +313,7 @@ def plan_halt(
     state_source: str | None = None,
     moment_about: MomentAbout = "spacecraft_com",
     margin: float = 0.0,
+    objective: str = "mean_torque",
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -374,6 +375,11 @@ def plan_halt(
         Point of the base torque: ``"spacecraft_com"`` (default: the spacecraft's centre of mass)
         or ``"joint1"`` (joint 1's origin, the reading of an independent reproduction of 000);
         see :class:`~jointlock.planning.halt_motion.HaltProblem`.
+    objective
+        What ``k`` minimises: ``"mean_torque"`` (000 eq. 32, the time-averaged base torque),
+        ``"peak_torque"`` (the largest base torque) or ``"attitude_change"`` (the free
+        spacecraft's attitude change at the end of the halt; a model with a spacecraft).  The
+        halt configuration is 000's HCOM whatever the objective.
     state_source
         Where ``state`` comes from, in words, recorded in the result and printed with it
         (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
@@ -428,6 +434,7 @@ def plan_halt(
     problem = HaltProblem(
         model, state.q, state.dq, state.ddq, qf_arr, T, kept.velocity, kept.acceleration,
         base=base, n_samples=n_samples, moment_about=moment_about, tau_max=kept.torque, brake_max=kept.brake,
+        objective=objective,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
     motion = optimal_halt_motion(
@@ -457,8 +464,7 @@ def halt_from_scenario(
     failure of the scenario; the halt configuration from ``[halt] qf_deg``, 000's q_best
     (``paper_qf``), else the ``halt_config`` job that ran before it, else searched here."""
     t, st, lim = data["halt"], data["state"], data["limits"]
-    lk = scenario_lock(data)
-    locks = {} if lk is None else dict([lk])
+    locks = scenario_locks(data)
     base = t.get("base") or data["base"]
     model = halt_model(data["robot"], locks, base)
     state = FailureState.from_degrees(
@@ -495,5 +501,6 @@ def halt_from_scenario(
         progress=progress,
         moment_about=t["moment_about"],
         margin=float(t["margin"]),
+        objective=t["objective"],
         _names=names,
     )

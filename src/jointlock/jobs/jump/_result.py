@@ -5,12 +5,13 @@ of ``jointlock jump --json`` (``to_dict()``, built by the ``*_json`` functions h
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
 import numpy as np
 
+from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...io.files import atomic_write_bytes, atomic_write_json, atomic_write_text, figure_png
 from ...model import ArmModel
 from ...planning.jump import (
@@ -31,6 +32,7 @@ from ...plots.jump import (
     plot_objective_vs_kappa,
     plot_position_deviation,
 )
+from ...plots.spacecraft import plot_spacecraft_responses
 from .._common import JobResult
 from ._text import summary_lines
 
@@ -42,6 +44,7 @@ FIG_JOINT_RATES = "fig6_joint_velocities.png"
 FIG_DEVIATION = "fig7_position_deviation.png"
 FIG_KAPPA_FIT = "fig8_kappa_fit.png"
 FIG_JUMP = "fig9_jump_vs_failure_time.png"
+FIG_SPACECRAFT = "spacecraft_attitude.png"
 
 
 @dataclass(frozen=True, eq=False)
@@ -80,6 +83,7 @@ class JumpJobResult(JobResult):
     study: JumpStudy | None = None
     verification: Verification | None = None
     kappa: float | None = None
+    _cache: dict = field(default_factory=dict, repr=False)  # the two runs, simulated once
 
     @property
     def kappa_given(self) -> bool:
@@ -91,22 +95,49 @@ class JumpJobResult(JobResult):
         robot, sc = self.model.name, self.task
         if self.mode == "fail_at":
             assert self.at_time is not None
-            return _single_json(robot, sc, self.at_time)
-        assert self.verification is not None
-        if self.mode == "constant":
-            assert self.kappa is not None
-            return _constant_json(robot, sc, self.kappa, self.verification)
-        assert self.study is not None
-        return _study_json(robot, sc, self.study)
+            out = _single_json(robot, sc, self.at_time)
+        elif self.mode == "constant":
+            assert self.verification is not None and self.kappa is not None
+            out = _constant_json(robot, sc, self.kappa, self.verification)
+        else:
+            assert self.study is not None
+            out = _study_json(robot, sc, self.study)
+        responses = self.spacecraft_responses()
+        if responses is not None:
+            out["spacecraft"] = {"fail_time_s": self.runs()[2], **{k: r.to_dict() for k, r in responses.items()}}
+        return out
 
     def summary(self) -> list[str]:
         """The lines ``jointlock jump`` prints (jumps in deg/s)."""
-        return summary_lines(self.to_dict(), kappa_given=self.kappa_given)
+        lines = summary_lines(self.to_dict(), kappa_given=self.kappa_given)
+        responses = self.spacecraft_responses()
+        if responses is not None:
+            t_fail = self.runs()[2]
+            for label, r in responses.items():
+                lines += r.summary(f"spacecraft, failure at {t_fail:g} s, {label}")
+        return lines
+
+    def spacecraft_responses(self) -> dict[str, SpacecraftResponse] | None:
+        """What the free spacecraft does in :meth:`runs` (free-floating tasks only, else None):
+        ``{"uncompensated": ..., "compensated": ...}``, the attitude integrated over the control
+        steps as the study's integrator does (:func:`~jointlock.analysis.spacecraft.
+        spacecraft_response` with ``rates="hold"``)."""
+        if self.task.base != "floating" or not self.model.floating:
+            return None
+        r0, r1, _ = self.runs()
+
+        def response(run: Trajectory) -> SpacecraftResponse:
+            dq = np.concatenate([run.qd, np.zeros((1, run.qd.shape[1]))])  # at rest after the task
+            return spacecraft_response(self.model, run.t, run.q, dq, rates="hold")
+
+        return {"uncompensated": response(r0), "compensated": response(r1)}
 
     def runs(self) -> tuple[Trajectory, Trajectory, float]:
         """The runs of the figures: the failure with kappa = 0 and with the compensation, and
         the failure time [s] (``fail_at``: the failure time and kappa used; otherwise the
         verified schedule with the failure at the control step nearest the task's middle)."""
+        if "runs" in self._cache:
+            return self._cache["runs"]
         sc = self.task
         if self.mode == "fail_at":
             assert self.at_time is not None
@@ -118,6 +149,7 @@ class JumpJobResult(JobResult):
             t_fail = float(np.round(sc.duration / 2 / sc.dt) * sc.dt)
         r0 = simulate(self.model, sc, 0.0, failures=[(sc.lock_joint, t_fail)])
         r1 = simulate(self.model, sc, kappa, failures=[(sc.lock_joint, t_fail)])
+        self._cache["runs"] = (r0, r1, t_fail)
         return r0, r1, t_fail
 
     def write(self, out: str | Path) -> list[str]:
@@ -157,7 +189,12 @@ class JumpJobResult(JobResult):
         fig = plot_joint_rates(self.model, self.task.lock_joint, r0, r1, t_fail, fig=offscreen_figure((10, 3.6)))
         names = [_save(out, FIG_JOINT_RATES, fig)]
         ax = plot_position_deviation(r0, r1, t_fail, self.task.eps, ax=_axes())
-        return names + [_save(out, FIG_DEVIATION, ax.figure)]
+        names.append(_save(out, FIG_DEVIATION, ax.figure))
+        responses = self.spacecraft_responses()
+        if responses is not None:
+            title = f"spacecraft (free), joint {self.task.lock_joint} locks at {t_fail:g} s"
+            names.append(_save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title)))
+        return names
 
 
 # -- JSON ----------------------------------------------------------------------------------------

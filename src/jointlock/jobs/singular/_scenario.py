@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from .._common import JobResult, joint_vector_deg, scenario_lock
+from .._common import JobResult, joint_vector_deg, scenario_locks
 from ._search import SingularitySearchResult, search_singularities
 from ._shared import SEARCH_SAMPLES, VERIFY_SAMPLES, singular_model
 from ._study import SingularityResult, study_singularity
@@ -31,8 +31,7 @@ def singular_from_scenario(
     not used.
     """
     t = data["singular"]
-    lk = scenario_lock(data)
-    locks = {} if lk is None else dict([lk])
+    locks = scenario_locks(data)
     verify = bool(t["verify_conditions"])
     base = t["base"] or ("virtual" if verify else "fixed")
     model = singular_model(data["robot"], locks, base)

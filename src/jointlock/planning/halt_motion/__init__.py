@@ -69,9 +69,9 @@ from ._feasibility import (
     relative_violation,
     shared_k_interval,
 )
-from ._objective import _simpson_mean, base_torque_history, global_base_torque
+from ._objective import OBJECTIVES, _simpson_mean, base_torque_history, global_base_torque, halt_objective
 from ._polynomial import halt_coefficients, k_shape, polynomial_profile
-from ._problem import MOMENT_POINTS, HaltProblem, MomentAbout, _angle_limit, _k_array, _vec
+from ._problem import HALT_OBJECTIVES, MOMENT_POINTS, HaltProblem, MomentAbout, _angle_limit, _k_array, _vec
 from ._report import infeasibility_message
 from ._solve import HaltMotion, _check_k_bounds, _scan, log, optimal_halt_motion
 
@@ -84,6 +84,9 @@ __all__ = [
     "AffineKBounds",
     "HaltMotion",
     "HaltProblem",
+    "HALT_OBJECTIVES",
+    "OBJECTIVES",
+    "halt_objective",
     "MOMENT_POINTS",
     "MomentAbout",
     "KIntervalBatch",

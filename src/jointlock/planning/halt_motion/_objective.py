@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ...analysis.spacecraft import final_attitude_change_deg
 from ...dynamics import rnea
 from ...errors import ScenarioError
 from ...model import FloatArray
@@ -61,3 +62,47 @@ def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = 
         torque = base_torque_history(problem, flat[start : start + step], t, per_joint=per_joint)
         out[start : start + step] = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
     return out.reshape(batch)
+
+
+#: What the halt can minimise over k (:attr:`HaltProblem.objective`), and in which unit.
+OBJECTIVES = {
+    "mean_torque": "N m",  # 000 eq. 32: the time average of ||tau_b||
+    "peak_torque": "N m",  # the largest ||tau_b|| over the halt
+    "attitude_change": "deg",  # the free spacecraft's attitude change at the end of the halt
+}
+
+
+def _per_candidate(problem: HaltProblem, k: ArrayLike, per_joint: bool, reduce) -> FloatArray:
+    """``reduce(q, dq, ddq, t)`` -> (chunk,) over the candidates ``k``, in chunks of at most
+    :data:`CHUNK_SAMPLES` (candidate, time) samples."""
+    k = np.asarray(k, dtype=float)
+    batch = k.shape[:-1] if per_joint else k.shape
+    flat = k.reshape((-1, problem.dof) if per_joint else (-1,))
+    t = problem.times()
+    step = max(1, CHUNK_SAMPLES // t.size)
+    out = np.empty(flat.shape[0])
+    for start in range(0, flat.shape[0], step):
+        q, dq, ddq = problem.trajectory(flat[start : start + step], t, per_joint=per_joint)
+        out[start : start + step] = reduce(q, dq, ddq, t)
+    return out.reshape(batch)
+
+
+def halt_objective(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
+    """The quantity the halt minimises (:attr:`HaltProblem.objective`) for a batch of ``k``:
+    ``"mean_torque"`` = :func:`global_base_torque` (000 eq. 32) [N m]; ``"peak_torque"`` = the
+    largest ``||tau_b(t; k)||`` on the objective's grid [N m]; ``"attitude_change"`` = the free
+    spacecraft's attitude change at ``t = T`` [deg]
+    (:func:`~jointlock.analysis.spacecraft.final_attitude_change_deg`, zero momentum).
+    Returns (...)."""
+    if problem.objective == "mean_torque":
+        return global_base_torque(problem, k, per_joint=per_joint)
+    if problem.objective == "peak_torque":
+
+        def peak(q, dq, ddq, t):
+            tau = rnea(problem.model, q, dq, ddq, base=problem.base, moment_point=problem.moment_point).base_moment
+            return np.linalg.norm(tau, axis=-1).max(axis=-1)
+
+        return _per_candidate(problem, k, per_joint, peak)
+    return _per_candidate(
+        problem, k, per_joint, lambda q, dq, ddq, t: final_attitude_change_deg(problem.model, t, q, dq)
+    )

@@ -82,6 +82,11 @@ class HaltProblem:
         (n_locked,) brake torque limits of the locked joints [N m] (:attr:`ArmModel.locked`
         order), ``inf`` for none; None: none.  Torque limits are checked on the ``n_check``
         grid (:mod:`._actuator_limits`) with ``solver="scan"``.
+    objective
+        What the halt minimises over ``k`` (:func:`~._objective.halt_objective`):
+        ``"mean_torque"`` (000 eq. 32, default), ``"peak_torque"`` (the largest base torque) or
+        ``"attitude_change"`` (the free spacecraft's attitude change at the end; needs a model
+        with a spacecraft).
     """
 
     model: ArmModel
@@ -100,6 +105,7 @@ class HaltProblem:
     moment_about: MomentAbout = "spacecraft_com"
     tau_max: FloatArray | None = None
     brake_max: FloatArray | None = None
+    objective: str = "mean_torque"
 
     def __post_init__(self) -> None:
         n = self.model.dof
@@ -144,6 +150,12 @@ class HaltProblem:
                 arr = arr.copy()
                 arr.setflags(write=False)
                 object.__setattr__(self, name, arr)
+        if self.objective not in HALT_OBJECTIVES:
+            raise ScenarioError(f"objective must be one of {', '.join(HALT_OBJECTIVES)}; got {self.objective!r}")
+        if self.objective == "attitude_change" and not self.model.floating:
+            raise ScenarioError(
+                "objective 'attitude_change' needs a model with a spacecraft (load it with base='floating')"
+            )
         if self.moment_about not in MOMENT_POINTS:
             raise ScenarioError(
                 f"moment_about must be one of {', '.join(MOMENT_POINTS)}; got {self.moment_about!r}"
@@ -213,6 +225,9 @@ class HaltProblem:
         kk = k[..., None, :]
         return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
 
+
+#: What the halt can minimise over k (:attr:`HaltProblem.objective`).
+HALT_OBJECTIVES = ("mean_torque", "peak_torque", "attitude_change")
 
 #: Points about which the base torque can be taken (:attr:`HaltProblem.moment_about`).
 MOMENT_POINTS = ("spacecraft_com", "joint1")

@@ -30,7 +30,7 @@ from ._feasibility import (
     least_violating_k,
     minimum_halt_time,
 )
-from ._objective import global_base_torque
+from ._objective import global_base_torque, halt_objective
 from ._problem import HaltProblem
 from ._report import infeasibility_message
 
@@ -72,6 +72,9 @@ class HaltMotion:
         The :class:`HaltProblem` solved.
     ga
         The GA run (solver ``"ga"``).
+    objective_value, objective_value_k0
+        What was minimised (:attr:`HaltProblem.objective`, :func:`halt_objective`) at ``k`` and
+        at ``k = 0`` (N m, or deg for the attitude change).
     k_segments
         With torque limits: the stretches ``(lo, hi)`` [rad/s^6] of ``k_interval`` whose halts
         also keep every motor and brake torque limit (empty: none does); None without them.
@@ -92,6 +95,8 @@ class HaltMotion:
     problem: HaltProblem = field(repr=False)
     ga: GAResult | None = field(default=None, repr=False)
     k_segments: tuple[tuple[float, float], ...] | None = None
+    objective_value: float | None = None
+    objective_value_k0: float | None = None
 
     @property
     def feasible_stretch(self) -> tuple[float, float] | None:
@@ -125,13 +130,13 @@ class HaltMotion:
 
 def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[float, FloatArray, FloatArray]:
     grid = np.linspace(lo, hi, n_scan)
-    values = global_base_torque(problem, grid)
+    values = halt_objective(problem, grid)
     i = int(np.argmin(values))
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, n_scan - 1)]
     best = float(grid[i])
     if b > a:
         res = minimize_scalar(
-            lambda x: float(global_base_torque(problem, x)),
+            lambda x: float(halt_objective(problem, x)),
             bounds=(a, b),
             method="bounded",
             options={"xatol": 1e-9 * max(abs(hi - lo), 1e-30)},
@@ -146,7 +151,7 @@ def _scan_segments(problem: HaltProblem, segments: Sequence[tuple[float, float]]
     least 3 each); the best of their optima."""
     total = sum(b - a for a, b in segments) or 1.0
     best = [_scan(problem, a, b, max(3, round(n_scan * (b - a) / total)))[0] for a, b in segments]
-    values = global_base_torque(problem, np.array(best))
+    values = halt_objective(problem, np.array(best))
     return float(best[int(np.argmin(values))])
 
 
@@ -269,7 +274,7 @@ def _solve_ga(
         st = replace(st, n_bits=bits_for_precision(lo, hi, ga_precision))
     ga_result = adaptive_ga(
         # eq. 35; the floor keeps the fitness finite where the torque vanishes
-        lambda x: 1.0 / np.maximum(global_base_torque(problem, x[:, 0]), TORQUE_FLOOR),
+        lambda x: 1.0 / np.maximum(halt_objective(problem, x[:, 0]), TORQUE_FLOOR),
         lo,
         hi,
         settings=st,
@@ -289,7 +294,7 @@ def _solve_vector(
     x0 = np.clip(np.full(problem.dof, k), per[:, 0], per[:, 1])
     scale = max(hi - lo, 1e-12)
     res = minimize(
-        lambda x: float(global_base_torque(problem, x * scale, per_joint=True)),
+        lambda x: float(halt_objective(problem, x * scale, per_joint=True)),
         x0 / scale,
         method="Powell",
         bounds=[(a / scale, b / scale) for a, b in bounds],
@@ -298,7 +303,7 @@ def _solve_vector(
     kv = np.clip(res.x * scale, per[:, 0], per[:, 1])
     best = (
         kv
-        if global_base_torque(problem, kv, per_joint=True) <= global_base_torque(problem, k)
+        if halt_objective(problem, kv, per_joint=True) <= halt_objective(problem, k)
         else np.full(problem.dof, k)
     )
     return best, {"method": "Powell", "nfev": int(res.nfev), "message": str(res.message)}
@@ -417,4 +422,6 @@ def optimal_halt_motion(
         problem=problem,
         ga=ga_result,
         k_segments=segments,
+        objective_value=float(halt_objective(problem, k, per_joint=per_joint)),
+        objective_value_k0=float(halt_objective(problem, 0.0)),
     )
