@@ -177,3 +177,29 @@ def test_a_model_effort_limit_is_the_default_motor_limit():
 def test_brake_limits_without_a_locked_joint_are_refused():
     with pytest.raises(jl.ScenarioError, match="brake limit, but 'halt7' has no locked joint"):
         jl.halt_limits(jl.load_robot("halt7"), brake_max_Nm=100.0)
+
+
+# -- robust choice of k among near-optimal ones (issue 14, item 3) --------------------------------
+
+
+def test_prefer_margin_trades_a_little_objective_for_clear_limits(free_halt, _halt):
+    from jointlock.planning.halt_motion._robust import limit_margins
+
+    limit = 0.97 * free_halt.actuator_loads().peak_brake[0]
+    tight = _halt(brake_max_Nm=limit)
+    robust = _halt(brake_max_Nm=limit, prefer_margin=0.01)
+    assert tight.motion.k_optimum is None and robust.motion.k_optimum == pytest.approx(tight.motion.k)
+    assert robust.motion.global_torque <= tight.motion.global_torque * 1.01 + 1e-9
+    assert robust.motion.global_torque > tight.motion.global_torque  # it did give something up
+    p = robust.problem
+    before = np.sort(limit_margins(p, np.array([tight.motion.k]))[0])
+    after = np.sort(limit_margins(p, np.array([robust.motion.k]))[0])
+    first = int(np.argmax(np.round(before, 6) != np.round(after, 6)))
+    assert after[first] > before[first]  # leximin: the first margin that differs is larger
+    assert robust.margins()["brake"][0] > tight.margins()["brake"][0] + 0.005  # off the brake's limit
+    assert "costs" in "\n".join(robust.summary()) and robust.to_dict()["k_optimum"] is not None
+
+
+def test_prefer_margin_is_bounded_and_named():
+    with pytest.raises(jl.ScenarioError, match="prefer_margin"):
+        plan_halt("halt7", paper_qf=True, prefer_margin=-0.1)

@@ -103,6 +103,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "0.05: 5 %%); each limit's margin is reported either way",
     )
     p.add_argument(
+        "--prefer-margin",
+        type=field_arg("halt", "prefer_margin"),
+        default=0.0,
+        metavar="SHARE",
+        help="give up at most this share of the best objective (0.01: 1 %%) for the k whose halt keeps the "
+        "largest smallest margin to every limit (default 0: the optimum itself)",
+    )
+    p.add_argument(
         "--objective",
         choices=("mean_torque", "peak_torque", "attitude_change"),
         default="mean_torque",
@@ -297,6 +305,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         moment_about=args.moment_about,
         margin=args.margin,
         objective=args.objective,
+        prefer_margin=args.prefer_margin,
         _names=CLI_NAMES,
     )
 

@@ -93,6 +93,7 @@ def job_argv(
         argv += ["--moment-about", t["moment_about"]] if t["moment_about"] != "spacecraft_com" else []
         argv += ["--margin", _num(t["margin"])] if t["margin"] else []
         argv += ["--objective", t["objective"]] if t["objective"] != "mean_torque" else []
+        argv += ["--prefer-margin", _num(t["prefer_margin"])] if t["prefer_margin"] else []
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "jump":
         fields = jump_fields(d)

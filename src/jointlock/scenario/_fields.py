@@ -232,6 +232,14 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             hi=0.5,
             help="share of each speed, acceleration and torque limit kept free by the halt (0.05: 5 %)",
         ),
+        "prefer_margin": Field(
+            "number",
+            0.0,
+            lo=0.0,
+            hi=0.5,
+            help="share of the best objective given up, at most, for the k whose halt keeps the largest "
+            "smallest margin to every limit (0.01: 1 %; 0: the optimum itself)",
+        ),
         "objective": Field(
             "choice",
             "mean_torque",

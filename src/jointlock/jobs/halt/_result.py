@@ -29,6 +29,7 @@ from ...planning.halt_motion import (
     HaltMotion,
     HaltProblem,
     base_torque_history,
+    halt_objective,
     infeasibility_message,
 )
 from ...plots._common import offscreen_figure
@@ -172,6 +173,7 @@ class HaltPlan(JobResult):
             "objective_value": res.objective_value,
             "objective_value_k0": res.objective_value_k0,
             "objective_unit": OBJECTIVES[p.objective],
+            "k_optimum": None if res.k_optimum is None else res.k_optimum / scale,
             "margin_kept": self.margin,
             "velocity_margin": (m := self.margins())["velocity"],
             "acceleration_margin": m["acceleration"],
@@ -334,6 +336,14 @@ class HaltPlan(JobResult):
                 stretches = ", ".join(f"[{a / scale:.6g}, {b / scale:.6g}]" for a, b in res.k_segments)
                 lines.append(f"  of which the torque limits keep: {stretches} deg/s^6")
             lines.append(f"k* = {k_text(res)}")
+            if res.k_optimum is not None:
+                opt = res.k_optimum / scale
+                cost = res.objective_value / float(halt_objective(p, res.k_optimum)) - 1.0
+                lines.append(
+                    f"  (the objective's own optimum is k = {opt:.6g} deg/s^6; this k costs {100 * cost:.2g} % more "
+                    f"(at most {100 * res.settings['prefer_margin']:g} %) and keeps larger margins to the limits, "
+                    "smallest first)"
+                )
         if res.feasible and res.minimum_T is not None:
             lines.append(f"smallest halt time with a feasible k: T = {res.minimum_T:.3f} s")
         sc = self.spacecraft_response()

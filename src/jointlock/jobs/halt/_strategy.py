@@ -204,14 +204,17 @@ def _search_halt_configuration(
 #: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
 LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
                  "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg"),
-                 "margin": "margin", "torques": ("torque_max_Nm", "brake_max_Nm")}  # fmt: skip
+                 "margin": "margin", "torques": ("torque_max_Nm", "brake_max_Nm"),
+                 "prefer_margin": "prefer_margin"}  # fmt: skip
 CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
              "generations": "--generations", "qf": "--qf-deg", "state": "--q0-deg, --dq0-deg, --ddq0-deg",
-             "limits": CLI_LIMIT_NAMES, "margin": "--margin", "torques": CLI_TORQUE_NAMES}  # fmt: skip
+             "limits": CLI_LIMIT_NAMES, "margin": "--margin", "torques": CLI_TORQUE_NAMES,
+             "prefer_margin": "--prefer-margin"}  # fmt: skip
 SCENARIO_NAMES = {"T": "halt.T", "n_samples": "halt.n_samples", "samples": "halt.samples",
                   "population": "halt.population", "generations": "halt.generations", "qf": "halt.qf_deg",
                   "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES,
-                  "margin": "halt.margin", "torques": SCENARIO_TORQUE_NAMES}  # fmt: skip
+                  "margin": "halt.margin", "torques": SCENARIO_TORQUE_NAMES,
+                  "prefer_margin": "halt.prefer_margin"}  # fmt: skip
 
 
 def check_halt_settings(
@@ -314,6 +317,7 @@ def plan_halt(
     moment_about: MomentAbout = "spacecraft_com",
     margin: float = 0.0,
     objective: str = "mean_torque",
+    prefer_margin: float = 0.0,
     _names: Mapping[str, str] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -380,6 +384,10 @@ def plan_halt(
         ``"peak_torque"`` (the largest base torque) or ``"attitude_change"`` (the free
         spacecraft's attitude change at the end of the halt; a model with a spacecraft).  The
         halt configuration is 000's HCOM whatever the objective.
+    prefer_margin
+        A share of the best objective (0 .. :data:`MAX_MARGIN`): among the ``k`` within it,
+        the one whose halt keeps the largest smallest margin to every limit (0: the optimum
+        itself, 000's choice).
     state_source
         Where ``state`` comes from, in words, recorded in the result and printed with it
         (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
@@ -403,6 +411,9 @@ def plan_halt(
         )  # fmt: skip
     paper_scenario = _is_paper_state(model, state, T, limits)
     margin = as_real(margin, _names.get("margin", "margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError)
+    prefer_margin = as_real(
+        prefer_margin, _names.get("prefer_margin", "prefer_margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError
+    )
     kept = limits.scaled(1 - margin)
     _check_start_torques(model, state, base, kept, margin, _names)
     if state_source is None:
@@ -438,8 +449,9 @@ def plan_halt(
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
     motion = optimal_halt_motion(
-        problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar
-    )
+        problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar,
+        prefer_margin=prefer_margin,
+    )  # fmt: skip
     if bar is not None:
         bar.close()
     return HaltPlan(
@@ -502,5 +514,6 @@ def halt_from_scenario(
         moment_about=t["moment_about"],
         margin=float(t["margin"]),
         objective=t["objective"],
+        prefer_margin=float(t["prefer_margin"]),
         _names=names,
     )

@@ -33,6 +33,7 @@ from ._feasibility import (
 from ._objective import global_base_torque, halt_objective
 from ._problem import HaltProblem
 from ._report import infeasibility_message
+from ._robust import prefer_margin as _prefer_margin
 
 #: The package's logger (``jointlock.planning.halt_motion``), as before the split into modules.
 log = logging.getLogger(__package__)
@@ -72,6 +73,9 @@ class HaltMotion:
         The :class:`HaltProblem` solved.
     ga
         The GA run (solver ``"ga"``).
+    k_optimum
+        With ``prefer_margin``: the objective's own optimum [rad/s^6], when the chosen ``k``
+        differs from it for a larger margin; else None.
     objective_value, objective_value_k0
         What was minimised (:attr:`HaltProblem.objective`, :func:`halt_objective`) at ``k`` and
         at ``k = 0`` (N m, or deg for the attitude change).
@@ -97,6 +101,7 @@ class HaltMotion:
     k_segments: tuple[tuple[float, float], ...] | None = None
     objective_value: float | None = None
     objective_value_k0: float | None = None
+    k_optimum: float | None = None
 
     @property
     def feasible_stretch(self) -> tuple[float, float] | None:
@@ -321,6 +326,7 @@ def optimal_halt_motion(
     on_infeasible: Literal["report", "raise"] = "report",
     find_minimum_T: bool = False,
     progress: Any = None,
+    prefer_margin: float = 0.0,
 ) -> HaltMotion:
     """Solve 000's halt-motion model (eq. 34): ``min tau_bar(k)`` s.t. the limits of eq. 33.
 
@@ -357,6 +363,11 @@ def optimal_halt_motion(
         :class:`~jointlock.errors.InfeasibleError` with the same information.
     find_minimum_T
         Also compute the smallest feasible halt time when the problem is feasible.
+    prefer_margin
+        A share of the best objective (>= 0; e.g. 0.01: 1 %): among the shared ``k`` of the
+        feasible stretch holding the optimum whose objective is within it, the one with the
+        largest smallest margin to the speed, acceleration and torque limits
+        (:func:`~._robust.prefer_margin`; ``n_scan`` candidates).  0 (default): the optimum.
 
     Returns
     -------
@@ -366,6 +377,8 @@ def optimal_halt_motion(
         raise ScenarioError(f"solver must be 'scan', 'ga' or 'vector'; got {solver!r}")
     if isinstance(n_scan, bool) or not isinstance(n_scan, (int, np.integer)) or n_scan < 1:
         raise ScenarioError(f"n_scan must be an integer >= 1 (grid points of the scan); got {n_scan!r}")
+    if not (isinstance(prefer_margin, (int, float)) and math.isfinite(prefer_margin) and prefer_margin >= 0):
+        raise ScenarioError(f"prefer_margin must be a finite share >= 0 of the best objective; got {prefer_margin!r}")
     bounds_k = _check_k_bounds(k_bounds)
     rng = resolve_seed(rng)  # None -> a fresh int seed, recorded by the GA
     torques = problem.has_torque_limits
@@ -400,6 +413,13 @@ def optimal_halt_motion(
         if solver == "vector":
             k, settings["scipy"] = _solve_vector(problem, per, lo, hi, k)
     per_joint = np.ndim(k) == 1
+    k_optimum = None
+    if prefer_margin and not per_joint:
+        stretch = (lo, hi) if segments is None else next(s for s in segments if s[0] <= k <= s[1])
+        robust = _prefer_margin(problem, float(k), stretch, prefer_margin, n_scan)
+        if robust != k:
+            k_optimum, k = float(k), robust
+        settings["prefer_margin"] = prefer_margin
     tau = float(global_base_torque(problem, k, per_joint=per_joint))
     viol = constraint_violations(problem, k, per_joint=per_joint)
     if torques:
@@ -424,4 +444,5 @@ def optimal_halt_motion(
         k_segments=segments,
         objective_value=float(halt_objective(problem, k, per_joint=per_joint)),
         objective_value_k0=float(halt_objective(problem, 0.0)),
+        k_optimum=k_optimum,
     )
