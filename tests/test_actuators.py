@@ -10,8 +10,6 @@ import pytest
 import jointlock as jl
 from jointlock.analysis.actuators import actuator_loads, actuator_torques
 
-from pin_oracle import pin, pin_q, to_pinocchio
-
 
 def _state(rng, n, batch=()):
     return (rng.uniform(-2, 2, batch + (n,)), rng.uniform(-0.5, 0.5, batch + (n,)), rng.uniform(-1, 1, batch + (n,)))
@@ -20,6 +18,8 @@ def _state(rng, n, batch=()):
 def _pinocchio_torques(full: jl.ArmModel, q, dq, ddq, floating: bool) -> np.ndarray:
     """Full-arm joint torques by Pinocchio; floating: the base twist from zero momentum and its
     acceleration from the base rows of the dynamics (no wrench on the spacecraft)."""
+    from pin_oracle import pin, pin_q, to_pinocchio  # skips without Pinocchio
+
     pm, _ = to_pinocchio(full, free_flyer=floating)
     pm.gravity = pin.Motion.Zero()  # in orbit
     data = pm.createData()
@@ -37,6 +37,7 @@ def _pinocchio_torques(full: jl.ArmModel, q, dq, ddq, floating: bool) -> np.ndar
     return tau[nb:]
 
 
+@pytest.mark.oracle
 @pytest.mark.parametrize("floating", [False, True])
 @pytest.mark.parametrize(("robot", "locks"), [("halt7", {4: 0.0}), ("halt7", {1: 0.3}), ("halt7", {3: -0.4, 7: 1.0}),
                                                ("canadarm7", {4: 0.5})])  # fmt: skip

@@ -10,9 +10,9 @@ import json
 
 import numpy as np
 import pytest
+from equivalent_commands import call_subcommand, job_argv
 
 import jointlock as jl
-from equivalent_commands import call_subcommand, job_argv
 from jointlock.cli import main
 from jointlock.jobs.halt import halt_from_scenario
 
