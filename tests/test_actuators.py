@@ -122,7 +122,7 @@ def test_a_brake_limit_moves_k_and_is_kept_on_every_sample(free_halt, _halt):
     _, brake = actuator_torques(plan.problem.model, q, dq, ddq, base="floating")
     assert np.abs(brake).max() <= limit * (1 + 1e-6)
     name, margin = plan.binding_limit()
-    assert name == "joint 4 brake torque (locked)" and -1e-9 <= margin < 0.01  # on the limit, to round-off
+    assert "joint 4 brake torque (locked)" in name and margin == 0.0  # on the limit (round-off shown as 0)
     assert plan.to_dict()["binding_limit"] == name
     # the segment's ends are the boundary: just inside keeps the limit, just outside breaks it
     (a, b), = plan.motion.k_segments
@@ -204,3 +204,46 @@ def test_prefer_margin_trades_a_little_objective_for_clear_limits(free_halt, _ha
 def test_prefer_margin_is_bounded_and_named():
     with pytest.raises(jl.ScenarioError, match="prefer_margin"):
         plan_halt("halt7", paper_qf=True, prefer_margin=-0.1)
+
+
+# -- review regressions ----------------------------------------------------------------------------
+
+DATA = __import__("pathlib").Path(__file__).resolve().parent / "data"
+
+
+def test_a_urdfs_own_effort_limits_are_reported_not_refused_by_the_ga():
+    arm = jl.lock(jl.read_urdf(DATA / "arm5.urdf"), 2, 0.0)
+    assert jl.halt_limits(arm).torque.tolist() == [100.0, np.inf, 10.0, 10.0]  # <limit effort> (none on one)
+    state = jl.FailureState.from_degrees(arm, [0, 0, 0, 0], [5, 5, 5, 5], [0, 0, 0, 0])
+    plan = plan_halt(arm, state, T=10.0, samples=50, solver="ga", ga=jl.jobs.halt._strategy.GASettings(n_pop=4, n_gen=2))
+    assert not plan.problem.has_torque_limits and plan.limits.torque is not None
+    assert any("the model's motor torque limits are reported, not kept: solver 'ga'" in line for line in plan.summary())
+    assert np.isfinite(plan.margins()["torque"]).tolist() == [True, False, True, True]  # NaN: no limit
+    with pytest.raises(jl.ScenarioError, match="torque limits need solver 'scan'"):
+        plan_halt(arm, state, T=10.0, samples=50, solver="ga", torque_max_Nm=50.0)
+
+
+def test_a_kinematically_infeasible_halt_with_torque_limits_searches_t_with_them():
+    res = plan_halt("halt7", paper_qf=True, torque_max_Nm=1e5, brake_max_Nm=900.0)  # kinematics break at 10 s
+    kinds = {v.kind for v in res.motion.violations}
+    assert not res.feasible and "velocity" in kinds and "brake" in kinds
+    t_min = res.motion.minimum_T
+    assert t_min is None or plan_halt("halt7", paper_qf=True, T=t_min + 0.01, torque_max_Nm=1e5, brake_max_Nm=900.0).feasible
+
+
+def test_fragile_looks_at_the_stretch_that_keeps_the_torques_too(free_halt, _halt):
+    seg_plan = _halt(brake_max_Nm=0.97 * free_halt.actuator_loads().peak_brake[0])
+    a, b = seg_plan.motion.feasible_stretch
+    assert (a, b) in seg_plan.motion.k_segments
+    assert seg_plan.fragile == bool(b - a < 0.01 * abs(seg_plan.motion.k))
+    assert seg_plan.to_dict()["k_torque_stretches_deg"][0] == pytest.approx(np.array([a, b]) / (np.pi / 180))
+
+
+def test_prefer_margin_with_one_k_per_joint_is_refused():
+    with pytest.raises(jl.ScenarioError, match="prefer_margin needs one shared k"):
+        plan_halt("halt7", paper_qf=True, T=12.0, solver="vector", prefer_margin=0.05)
+
+
+def test_a_margin_the_start_state_leaves_no_room_for_is_said_so():
+    with pytest.raises(jl.InfeasibleError, match="no margin can be kept: the state starts at a limit"):
+        plan_halt("halt7", margin=0.001)

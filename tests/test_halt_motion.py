@@ -702,4 +702,4 @@ def test_a_narrow_feasible_interval_is_flagged_fragile():
     lo, hi = narrow.motion.k_interval
     assert narrow.feasible and (hi - lo) < 0.01 * abs(float(narrow.motion.k))
     assert narrow.fragile and narrow.to_dict()["fragile"]
-    assert any(line.startswith("FRAGILE: the feasible k interval is 0.38 % of k* wide") for line in narrow.summary())
+    assert any(line.startswith("FRAGILE: the feasible stretch of k is 0.38 % of k* wide") for line in narrow.summary())

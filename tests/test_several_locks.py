@@ -98,7 +98,8 @@ def test_jobs_with_one_locked_joint_by_method_say_why(tmp_path, job):
     [
         ("{9 = 1.0}", "joint 9 is no joint of halt7 (1..7)"),
         ("{4 = 1.0}", "joint 4 is the failure's own joint"),
-        ('{2 = "x"}', "must be a table {joint number = angle} of finite numbers >= -360 and <= 360 [deg]"),
+        ('{2 = "x"}', "failure.also_locked_deg.2 must be a finite number >= -360 and <= 360 [deg]; got 'x'"),
+        ("{2 = 1.0, 3 = 400.0}", "failure.also_locked_deg.3 must be a finite number >= -360 and <= 360 [deg]; got 400"),
         ("[2, 10.0]", "must be a table {joint number = angle}"),
         ("{x = 1.0}", "key 'x' is no joint number"),
         ("{2 = 300.0}", "failure.also_locked_deg.2: lock angle of joint 2 must lie within its limits"),
@@ -124,3 +125,30 @@ def test_the_workspace_compares_before_and_after_the_failure(tmp_path):
     assert res["already_locked_deg"] == {"2": 10.0} and res["lock"]["joint"] == 4
     code, _, err = cli("workspace", "halt7", "--lock", "4=0", "--lock", "4=10", "--samples", "2000")
     assert code == 2 and "joint 4 given twice" in err
+
+
+def test_a_campaign_can_set_and_sweep_the_earlier_locks(tmp_path):
+    from campaign_helpers import write_campaign
+
+    from jointlock.campaign import expand, load_campaign
+
+    body = '[grid]\n"failure.also_locked_deg" = [{2 = 10.0}, {2 = 20.0, 6 = 0.0}]\n'
+    cases = expand(load_campaign(write_campaign(tmp_path, body)))
+    assert [c["failure.also_locked_deg"] for c in cases] == [{"2": 10.0}, {"2": 20.0, "6": 0.0}]
+
+
+def test_overriding_the_earlier_locks_is_recorded_and_reported(tmp_path):
+    text = 'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0.0\nalso_locked_deg = {2 = 10.0}\n[workspace]\n'
+    path = _write(tmp_path, text)
+    sc = jl.load_scenario(path, {"failure.joint": 4, "failure.angle_deg": 0.0, "failure.also_locked_deg": None})
+    assert sc.failure_overridden() and sc.overrides["failure.also_locked_deg"] == {"file": {"2": 10.0}, "value": None}
+    plain = jl.load_scenario(_write(tmp_path, text.replace("also_locked_deg = {2 = 10.0}\n", ""), "p.toml"),
+                             {"failure.also_locked_deg": None})  # fmt: skip
+    assert "failure.also_locked_deg" not in plain.overrides  # nothing was overridden
+
+
+@pytest.mark.parametrize("table", ['{"02" = 1.0}', '{2 = 1.0, "02" = 5.0}'])
+def test_a_joint_is_named_once_and_in_one_spelling(tmp_path, table):
+    text = f'robot = "halt7"\n[failure]\njoint = 4\nangle_deg = 0.0\nalso_locked_deg = {table}\n[workspace]\n'
+    with pytest.raises(jl.ScenarioError, match="key '02' is no joint number"):
+        jl.load_scenario(_write(tmp_path, text))

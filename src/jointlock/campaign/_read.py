@@ -193,7 +193,7 @@ def _value(value: Any, name: str, where: str, base_dir: Path) -> Any:
     """One value of field ``name`` checked against the scenario schema (a model file named in
     ``robot`` is made absolute against the campaign file's folder)."""
     _, spec = scenario_field(name, where)
-    if isinstance(value, dict):
+    if isinstance(value, dict) and spec.kind != "locks":
         raise CampaignError(f"{where} must be {spec.allowed()}; got a table")
     try:
         checked = _check(value, spec, where)

@@ -166,7 +166,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=field_arg("limits", "brake_max_Nm"),
         nargs="+",
         metavar="NM",
-        help="brake torque limit(s) of the locked joint(s) [N m], one or one per locked joint (default none)",
+        help="brake torque limit(s) of the locked joint(s) [N m], one or one per locked joint in the order of "
+        "--lock (default none)",
     )
     p.add_argument("--solver", choices=("scan", "ga", "vector"), default="scan", help="default scan (exact)")
     p.add_argument(

@@ -57,14 +57,22 @@ def plot_global_torque_vs_k(res: HaltMotion, *, ax: Any | None = None) -> Any:
     lo, hi = res.k_interval
     grid, tau = global_torque_curve(res)
     ax.plot(grid / _K_DEG, tau, label=r"$\bar\tau_b(k)$, shared k")
+    stretches = [(lo, hi)] if res.k_segments is None else list(res.k_segments)
+    if lo <= hi and res.k_segments is not None:  # speed and acceleration keep [lo, hi]; torques less
+        ax.axvspan(lo / _K_DEG, hi / _K_DEG, color="0.5", alpha=0.12, label="speed and acceleration limits kept")
     if lo <= hi:
-        ax.axvspan(
-            lo / _K_DEG,
-            hi / _K_DEG,
-            color="g",
-            alpha=0.15,
-            label=f"feasible k: [{lo / _K_DEG:.4g}, {hi / _K_DEG:.4g}] deg/s$^6$",
-        )
+        for i, (a, b) in enumerate(stretches):
+            ax.axvspan(
+                a / _K_DEG,
+                b / _K_DEG,
+                color="g",
+                alpha=0.15,
+                label=None if i else f"feasible k: [{a / _K_DEG:.4g}, {b / _K_DEG:.4g}] deg/s$^6$"
+                + (f" and {len(stretches) - 1} more" if len(stretches) > 1 else "")
+                + (" (every limit, torques too)" if res.k_segments is not None else ""),
+            )
+        if res.k_segments == ():
+            ax.plot([], [], " ", label="no k keeps the torque limits")
     else:  # a legend line saying so (no band to shade)
         ax.plot([], [], " ", label=f"no feasible k: every k breaks a limit (T = {p.T:g} s)")
     i_min = int(np.argmin(tau))
@@ -73,7 +81,8 @@ def plot_global_torque_vs_k(res: HaltMotion, *, ax: Any | None = None) -> Any:
         star_text = f"{label} (at their mean {k_star / _K_DEG:.4g} deg/s$^6$)"
     ax.plot([k_star / _K_DEG], [res.global_torque], "r*", ms=12, label=star_text)
     if abs(grid[i_min] - k_star) > 1.5 * (grid[1] - grid[0]):  # the curve's own minimum elsewhere
-        where = "feasible" if lo <= grid[i_min] <= hi else "breaks a limit"
+        inside = any(a <= grid[i_min] <= b for a, b in stretches) and lo <= hi
+        where = "feasible" if inside else "breaks a limit"
         ax.plot(
             [grid[i_min] / _K_DEG],
             [tau[i_min]],
@@ -86,7 +95,8 @@ def plot_global_torque_vs_k(res: HaltMotion, *, ax: Any | None = None) -> Any:
     ax.set_xlabel("k [deg/s$^6$]")
     ax.set_ylabel("global base torque [N m]")
     verdict = "" if res.feasible else ", INFEASIBLE"
-    ax.set_title(f"global base disturbance torque vs k ({p.base} base{verdict})")
+    chosen = "" if p.objective == "mean_torque" else f"; k* minimises the {p.objective.replace('_', ' ')}, not this curve"
+    ax.set_title(f"global base disturbance torque vs k ({p.base} base{verdict}{chosen})", fontsize=9)
     ax.legend(fontsize=8)
     return ax
 

@@ -14,7 +14,7 @@ import numpy as np
 
 from ..io.files import save_figure
 from ..jobs._common import scenario_locks
-from ..jobs.halt._result import MOMENT_TEXT
+from ..jobs.halt._text import MOMENT_TEXT
 from ..locking import lock_joints
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
@@ -22,6 +22,7 @@ from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_
 from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
 from ..robots import load_robot
 from ..scenario import JOB_PAPER, Scenario
+from ..scenario._scenario import FAILURE_KEYS
 from ._decisions import _condition_verdict, _decisions_section  # noqa: F401  (re-exported)
 
 #: Row labels of the report's limits table (``[limits]`` field -> words and unit).
@@ -123,7 +124,7 @@ def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         changed = {
             k.split(".", 1)[1]: v["file"]
             for k, v in scenario.overrides.items()
-            if k in ("failure.joint", "failure.angle_deg") and v["file"] != v["value"]
+            if k in FAILURE_KEYS and v["file"] != v["value"]
         }
         ffacts.append(
             (
@@ -187,6 +188,26 @@ def _failure_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
     return sections
 
 
+def _torque_rows(r: dict[str, Any]) -> list[list[Any]]:
+    """The halt's motor and brake torque rows of the limits table (a joint without a limit:
+    its peak, "none", "no limit")."""
+    loads = r.get("actuators")
+    if not loads:
+        return []
+    rows: list[list[Any]] = []
+    for key, peaks, limits in (
+        ("motor torque", loads["peak_motor_torque_Nm"], r.get("torque_limit_Nm")),
+        ("brake torque (locked)", loads["peak_brake_torque_Nm"], r.get("brake_limit_Nm")),
+    ):
+        for i, (joint, peak) in enumerate(peaks.items()):
+            limit = None if limits is None else limits[i]
+            if limit is None:
+                rows.append([int(joint), f"{key} [N m]", peak, "none", "", "no limit"])
+            else:
+                rows += limits_rows([int(joint)], [peak], [limit], key, "N m")
+    return rows
+
+
 def _limits_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any) -> list[Section]:
     """The limits kept or broken by the halt and the jump."""
     sections: list[Section] = []
@@ -199,13 +220,13 @@ def _limits_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked:
         rows += limits_rows(
             nums, r["peak_acceleration_deg_s2"], r["acceleration_limit_deg_s2"], "acceleration", "deg/s^2"
         )
-        ltables.append(
-            (
-                LIMITS_HEADER,
-                rows,
-                "halt motion at k*" if r["feasible"] else "halt motion at the least-violating k",
-            )
-        )
+        rows += _torque_rows(r)
+        caption = "halt motion at k*" if r["feasible"] else "halt motion at the least-violating k"
+        if r["feasible"] and r.get("binding_limit"):
+            caption += f"; binding limit: {r['binding_limit']}"
+        if r.get("fragile"):
+            caption += "; FRAGILE: the feasible stretch of k is under 1 % of k* wide"
+        ltables.append((LIMITS_HEADER, rows, caption))
         if r["violations"]:
             ltables.append(
                 (
@@ -298,7 +319,7 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         )
         images.append(
             (
-                "arm at " + ", ".join(configs) + " (x = link centres of mass, * = end effector)",
+                "arm: " + ", ".join(configs) + " (x = link centres of mass, * = end effector)",
                 save_figure(fig, figdir, "arm"),
             )
         )

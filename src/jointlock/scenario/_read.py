@@ -65,7 +65,8 @@ def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) 
             old = None
             if isinstance(holder, dict):  # the file's value, under whichever name the file uses
                 old = next((holder[k] for k in _spellings(table, name) if k in holder), None)
-            applied[key] = {"file": old, "value": value}
+            if old is not None or value is not None:  # (None for None: nothing overridden)
+                applied[key] = {"file": old, "value": value}
         data = apply_overrides(data, overrides, source=str(path))
     if out_given is not None:  # the file's out is not used: not checked either
         data = {k: v for k, v in data.items() if k != "out"}
@@ -193,9 +194,9 @@ def check_value(value: Any, spec: Field, where: str) -> Any:
             raise bad(f" ({type(value).__name__})" if not isinstance(value, dict) else " (empty)")
         locks = {}
         for key, angle in value.items():
-            if not (isinstance(key, str) and key.isdigit() and len(key) <= 4 and int(key) >= 1):
+            if not (isinstance(key, str) and key.isdigit() and len(key) <= 4 and key == str(int(key)) and int(key) >= 1):
                 raise bad(f" (key {shown(key)} is no joint number >= 1)")
-            locks[str(int(key))] = number(angle)
+            locks[key] = check_value(angle, dataclasses.replace(spec, kind="number"), f"{where}.{key}")
         return locks
     if kind == "numbers":
         if not isinstance(value, list) or not value:

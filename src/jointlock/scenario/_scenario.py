@@ -8,6 +8,9 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+#: The overrides that change the failure (``jointlock run --lock`` sets them all).
+FAILURE_KEYS = ("failure.joint", "failure.angle_deg", "failure.also_locked_deg")
+
 
 @dataclass(frozen=True)
 class Scenario:
@@ -34,9 +37,10 @@ class Scenario:
     overrides: Mapping[str, Any] = field(default_factory=dict)
 
     def failure_overridden(self) -> bool:
-        """Whether an override changed the file's failure (joint or angle)."""
+        """Whether an override changed the file's failure (joint, angle or the joints locked
+        before it)."""
         return any(
-            key in ("failure.joint", "failure.angle_deg") and item["file"] != item["value"]
+            key in FAILURE_KEYS and item["file"] != item["value"]
             for key, item in self.overrides.items()
         )
 

@@ -21,13 +21,15 @@ lines it prints (``summary()``) and the files of ``--out`` (``write()``).
 Modules
 -------
 ``_inputs`` (:class:`FailureState`, :class:`JointLimits`, :func:`halt_limits`, 000's default
-limits), ``_strategy`` (:func:`plan_halt`, its checks and search, :func:`halt_model`,
-:func:`halt_from_scenario`), ``_result`` (:class:`HaltPlan`).  Import from this package, not
+limits), ``_checks`` (the checks before any work, the settings' names), ``_strategy``
+(:func:`plan_halt`, its search, :func:`halt_model`, :func:`halt_from_scenario`), ``_result``
+(:class:`HaltPlan`), ``_text`` (its words).  Import from this package, not
 from them.
 """
 
 from __future__ import annotations
 
+from ._checks import CLI_NAMES, LIBRARY_NAMES, MIN_N_SAMPLES, check_halt_settings
 from ._inputs import (
     CLI_LIMIT_NAMES,
     DEFAULT_AMAX_DEG,
@@ -42,12 +44,8 @@ from ._inputs import (
 )
 from ._result import HaltPlan
 from ._strategy import (
-    CLI_NAMES,
     HCOM_JACOBIAN,
-    LIBRARY_NAMES,
-    MIN_N_SAMPLES,
     Solver,
-    check_halt_settings,
     halt_from_scenario,
     halt_model,
     plan_halt,

@@ -127,17 +127,17 @@ class JointLimits:
         )
 
 
-def _limit_values(values: Any, name: str, n: int) -> np.ndarray | None:
-    """None, or (n,) from one value or n values (finite, > 0)."""
+def _limit_values(values: Any, name: str, n: int, which: str = "") -> np.ndarray | None:
+    """None, or (n,) from one value or n values (finite, > 0); ``which`` says whose (for the
+    error)."""
     if values is None:
         return None
     arr = np.asarray(values, dtype=float).ravel()
     if arr.size == 1:
         arr = np.full(n, arr[0])
     if arr.shape != (n,) or not np.all(np.isfinite(arr) & (arr > 0)):
-        raise ScenarioError(
-            f"{name} needs one value or {n} values, finite and > 0; got {np.ravel(values).tolist()}"
-        )
+        count = f"one value or {n} values" if n > 1 else "one value"
+        raise ScenarioError(f"{name} needs {count}, finite and > 0{which}; got {np.ravel(values).tolist()}")
     return arr
 
 
@@ -165,7 +165,9 @@ def _torque_limits(
             raise ScenarioError(
                 f"{names[1]} is the locked joints' brake limit, but {model.name!r} has no locked joint"
             )
-        brake = _limit_values(brake_max_Nm, names[1], len(model.locked))
+        locked = [lj.number for lj in model.locked]
+        which = f" (the locked joints {locked}, in the order they were locked)"
+        brake = _limit_values(brake_max_Nm, names[1], len(locked), which)
         b_src = (names[1],) * len(model.locked)
     return torque, brake, t_src, b_src
 

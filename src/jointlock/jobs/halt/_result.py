@@ -44,6 +44,22 @@ from ...plots.halt import (
 )
 from .._common import AT_LIMIT, JobResult, locked_deg, locked_text
 from ._inputs import JointLimits, limits_text
+from ._text import (
+    MOMENT_TEXT,
+    OBJECTIVE_TEXT,
+    _change_text,
+    _jacobian_text,
+    _margin_text,
+    _none_for_inf,
+    _none_for_nan,
+    _printed_text,
+    _violation,
+    limits_table,
+)
+
+#: A margin above minus this [-] is round-off of a limit met exactly (the feasibility checks allow
+#: a relative 1e-9): shown as 0.
+MARGIN_ROUNDOFF = 1e-8
 
 #: A feasible k interval narrower than this share of |k*| is fragile.
 FRAGILE_WIDTH = 0.01
@@ -51,19 +67,6 @@ FRAGILE_WIDTH = 0.01
 #: Longest time step of the spacecraft's attitude integration [s] (the objective's grid may be
 #: coarse: 11 samples put 000's 124 deg off by 0.5 deg; 0.02 s keeps it within 1e-3 deg).
 SPACECRAFT_STEP_S = 0.02
-
-#: How the summary names what k minimises (:attr:`HaltProblem.objective`).
-OBJECTIVE_TEXT = {
-    "mean_torque": "time-averaged base torque (000 eq. 32)",
-    "peak_torque": "peak base torque",
-    "attitude_change": "the free spacecraft's attitude change at the end",
-}
-
-#: How the summary names the base torque's point (:attr:`HaltProblem.moment_about`).
-MOMENT_TEXT = {
-    "spacecraft_com": "the spacecraft's centre of mass",
-    "joint1": "joint 1's mount (the root frame's origin)",
-}
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
@@ -92,6 +95,12 @@ class HaltPlan(JobResult):
     seed
         The seed of the halt-configuration search and the GA (:mod:`jointlock._random`; None
         when a numpy Generator was given).
+    state_source
+        Where the state at failure came from, in words.
+    margin
+        Share of each limit kept free (asked; kept when the halt is feasible).
+    notes
+        Plain-language notes on how the halt was planned (printed with the summary).
     """
 
     job: ClassVar[str] = "halt"
@@ -107,6 +116,7 @@ class HaltPlan(JobResult):
     seed: int | None = 0
     state_source: str = "given"
     margin: float = 0.0
+    notes: tuple[str, ...] = ()
 
     @property
     def problem(self) -> HaltProblem:
@@ -161,6 +171,9 @@ class HaltPlan(JobResult):
             "violations": [_violation(v) for v in res.violations],
             "violations_k0": [_violation(v) for v in res.violations_k0],
             "k_interval_deg": res.k_interval / scale,
+            "k_torque_stretches_deg": None
+            if res.k_segments is None
+            else [[a / scale, b / scale] for a, b in res.k_segments],
             **({"joint_k_intervals_deg": res.joint_intervals / scale} if res.per_joint else {}),
             "minimum_T_s": res.minimum_T,
             "q_initial_deg": np.degrees(p.q0),
@@ -247,30 +260,33 @@ class HaltPlan(JobResult):
             if limits is not None and peaks is not None:
                 with np.errstate(divide="ignore", invalid="ignore"):
                     out[key] = np.where(np.isfinite(limits), 1.0 - peaks / limits, np.nan)
-        return out
+        # a limit met within the feasibility check's round-off slack is met: margin 0, not -1e-10
+        return {key: np.where((m < 0) & (m > -MARGIN_ROUNDOFF), 0.0, m) for key, m in out.items()}
 
     def binding_limit(self) -> tuple[str, float]:
-        """The limit with the smallest margin over the halt, in words (``"joint 3 brake
-        torque"``), and that margin [-] (:meth:`margins`)."""
+        """The limit(s) with the smallest margin over the halt, in words (``"joint 3 brake
+        torque (locked)"``; ties within 1e-6 joined by "and"), and that margin [-] (:meth:`margins`)."""
         names = {"velocity": "speed", "acceleration": "acceleration", "torque": "motor torque",
                  "brake": "brake torque (locked)"}  # fmt: skip
         numbers = {"brake": [lj.number for lj in self.problem.model.locked]}
-        best = ("", math.inf)
-        for key, values in self.margins().items():
-            for num, value in zip(numbers.get(key, self.problem.model.joint_numbers), values):
-                if not math.isnan(value) and value < best[1]:
-                    best = (f"joint {num} {names[key]}", float(value))
-        return best
+        found = [
+            (float(value), f"joint {num} {names[key]}")
+            for key, values in self.margins().items()
+            for num, value in zip(numbers.get(key, self.problem.model.joint_numbers), values)
+            if not math.isnan(value)
+        ]
+        smallest = min(value for value, _ in found)
+        return " and ".join(name for value, name in found if value <= smallest + 1e-6), smallest
 
     @property
     def fragile(self) -> bool:
-        """The feasible k interval is narrow next to k* (width < :data:`FRAGILE_WIDTH` of
-        |k*|): a small error in the model or the timing can break a limit."""
-        res = self.motion
-        if not res.feasible or res.per_joint:
+        """The feasible stretch of k holding k* (:attr:`HaltMotion.feasible_stretch`: with
+        torque limits, the stretch that keeps them too) is narrow next to k* (width <
+        :data:`FRAGILE_WIDTH` of |k*|): a small error in the model or the timing can break a limit."""
+        stretch = self.motion.feasible_stretch
+        if stretch is None:
             return False
-        lo, hi = res.k_interval
-        return bool(hi - lo < FRAGILE_WIDTH * max(abs(float(res.k)), 1e-300))
+        return bool(stretch[1] - stretch[0] < FRAGILE_WIDTH * max(abs(float(self.motion.k)), 1e-300))
 
     @property
     def from_rest(self) -> bool:
@@ -319,6 +335,15 @@ class HaltPlan(JobResult):
             f"speed limits: {limits_text(nums, lim.velocity, lim.velocity_source, 'deg/s')}",
             f"acceleration limits: {limits_text(nums, lim.acceleration, lim.acceleration_source, 'deg/s^2')}",
         ]
+        if lim.torque is not None:
+            lines.append(
+                f"motor torque limits: {limits_text(nums, lim.torque, lim.torque_source, 'N m', degrees=False)}"
+            )
+        if lim.brake is not None:
+            locked = [lj.number for lj in p.model.locked]
+            lines.append(
+                f"brake torque limits: {limits_text(locked, lim.brake, lim.brake_source, 'N m', degrees=False)}"
+            )
         scale = K_UNIT_SCALE["deg/s^6"]
         if not res.feasible:
             lines += ["", "INFEASIBLE: " + infeasibility_message(res)]
@@ -372,42 +397,18 @@ class HaltPlan(JobResult):
         v_lim, a_lim = np.degrees(lim.velocity), np.degrees(lim.acceleration)
         m = self.margins()
         if self.fragile:
-            lo, hi = res.k_interval
+            lo, hi = res.feasible_stretch  # type: ignore[misc]
             lines.append(
-                f"FRAGILE: the feasible k interval is {100 * (hi - lo) / abs(float(res.k)):.2g} % of k* wide: a small "
+                f"FRAGILE: the feasible stretch of k is {100 * (hi - lo) / abs(float(res.k)):.2g} % of k* wide: a small "
                 "model or timing error breaks a limit (--margin keeps a share of each limit free)"
             )
         if self.margin:
-            lines.append(f"margin kept: {100 * self.margin:g} % of each speed, acceleration and torque limit")
-        loads = self.actuator_loads()
-        lines += [
-            "",
-            "joint   peak |dq| [deg/s] (limit, margin)   peak |ddq| [deg/s^2] (limit, margin)   "
-            "peak |tau| [N m] (limit, margin)",
-        ]
-        tau_lim = self.limits.torque if self.limits.torque is not None else np.full(p.dof, np.inf)
-        for j, num in enumerate(nums):
-            v_text = f"({v_lim[j]:.6g}, {_margin_text(m['velocity'][j])})"
-            a_text = f"({a_lim[j]:.6g}, {_margin_text(m['acceleration'][j])})"
-            t_text = (
-                ""
-                if loads is None
-                else f"{loads.peak_motor[j]:10.1f} {_torque_limit_text(tau_lim[j], m['torque'][j])}"
-            )
+            verb = "kept" if res.feasible else "asked (not kept: the halt is infeasible)"
             lines.append(
-                f"{num:>5}   {peak_v[j]:10.3f} {v_text:<24}  {peak_a[j]:10.3f} {a_text:<24}  {t_text}"
+                f"margin {verb}: {100 * self.margin:g} % of each speed, acceleration and torque limit"
             )
-        if loads is not None:
-            brake_lim = (
-                self.limits.brake
-                if self.limits.brake is not None
-                else np.full(len(loads.locked_numbers), np.inf)
-            )
-            for j, num in enumerate(loads.locked_numbers):
-                lines.append(
-                    f"{num:>5}   locked: brake holds peak {loads.peak_brake[j]:.1f} N m "
-                    f"{_torque_limit_text(brake_lim[j], m['brake'][j])}"
-                )
+        lines += self.notes
+        lines += limits_table(nums, (peak_v, v_lim), (peak_a, a_lim), m, self.actuator_loads(), self.limits)
         name, value = self.binding_limit()
         if res.feasible:
             lines.append(
@@ -489,67 +490,3 @@ class HaltPlan(JobResult):
             atomic_write_text(out / "spacecraft.csv", csv_text(cols))
             files.append("spacecraft.csv")
         return files
-
-
-def _margin_text(margin: float) -> str:
-    """A limit's margin in words: "12 %" kept, "at the limit" (< :data:`AT_LIMIT`), "broken"."""
-    if margin < -1e-9:
-        return "broken"
-    if margin < AT_LIMIT:
-        return "at the limit"
-    return f"{100 * margin:.0f} %"
-
-
-def _torque_limit_text(limit: float, margin: float) -> str:
-    """``"(no limit)"`` or ``"(300, 12 %)"``."""
-    return "(no limit)" if not math.isfinite(limit) else f"({limit:.6g}, {_margin_text(margin)})"
-
-
-def _none_for_nan(values: np.ndarray) -> list[float | None]:
-    return [None if math.isnan(v) else float(v) for v in values]
-
-
-def _none_for_inf(values: np.ndarray | None) -> list[float | None] | None:
-    return None if values is None else [float(v) if math.isfinite(v) else None for v in values]
-
-
-def _violation(v: Any) -> dict[str, Any]:
-    """A violation in people's units: ``*_deg`` for angles and rates (deg, deg/s, deg/s^2),
-    ``*_Nm`` for motor and brake torques."""
-    value, limit, excess, unit = v.display
-    suffix = "Nm" if unit == "N m" else "deg"
-    return {
-        "joint": v.joint,
-        "limit": v.kind,
-        f"limit_value_{suffix}": limit,
-        f"value_{suffix}": value,
-        f"excess_{suffix}": excess,
-        "time_s": v.time,
-    }
-
-
-def _printed_text() -> str:
-    """000 §5.2's printed results (:data:`jointlock.papers.p000.HALT_RESULTS`) as one line:
-    ``"000 printed: k = 0.0018, 22.25 -> 15.55 N m (30.1 %)"``."""
-    r = p000.HALT_RESULTS
-    return (
-        f"000 printed: k = {r['k']:g}, {r['global_torque_k0_Nm']:g} -> {r['global_torque_Nm']:g} N m "
-        f"({100 * r['reduction']:.1f} %)"
-    )
-
-
-def _jacobian_text(hcom_base: str) -> str:
-    if hcom_base == "fixed":  # a robot without a spacecraft: J_F is the fixed-base one
-        return "generalized Jacobian, which for this fixed-base model is the fixed-base Jacobian"
-    return "free-floating arm's generalized Jacobian J_F (000 §3.1.2)"
-
-
-def _change_text(res: HaltMotion) -> str:
-    """The torque change from k = 0 to the chosen k, in words."""
-    if math.isnan(res.reduction):
-        return "reduction n/a: no torque at k = 0"
-    if res.reduction >= 0:
-        return f"{100 * res.reduction:.1f} % lower"
-    if res.violations_k0:
-        return f"{-100 * res.reduction:.1f} % higher: k = 0 breaks a limit"
-    return f"{-100 * res.reduction:.1f} % higher"

@@ -7,13 +7,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
+from dataclasses import replace
 from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
-from ...analysis.actuators import actuator_torques
 from ...bounds import as_real
 from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
@@ -25,21 +25,21 @@ from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motio
 from ...progress import Progress
 from ...robots import load_robot
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_locks
+from ._checks import (
+    LIBRARY_NAMES,
+    SCENARIO_NAMES,
+    _check_start,
+    _check_start_margin,
+    _check_start_torques,
+    check_halt_settings,
+)
 from ._inputs import (
-    CLI_LIMIT_NAMES,
-    CLI_TORQUE_NAMES,
-    SCENARIO_LIMIT_NAMES,
-    SCENARIO_TORQUE_NAMES,
     FailureState,
     JointLimits,
     halt_limits,
     is_000_failure,
-    limits_text,
 )
 from ._result import HaltPlan
-
-#: Smallest number of time samples of the objective (Simpson's rule, odd).
-MIN_N_SAMPLES = 11
 
 #: Jacobian of the halt-configuration search (CP): 000 §3.1.2's generalized Jacobian J_F of
 #: the free-floating arm, whatever the base of the disturbance torque.
@@ -86,77 +86,6 @@ def _is_paper_state(model: ArmModel, state: FailureState, T: float, limits: Join
     )
 
 
-def _check_start(
-    model: ArmModel, state: FailureState, T: float, limits: JointLimits, state_name: str = "state"
-) -> None:
-    """Refuse a state at failure that itself breaks a limit before any search: every halt
-    starts from it (the k-part vanishes at t = 0 with two derivatives), so no halt
-    configuration, halt time or k helps, and a Monte Carlo search would be pointless."""
-    reach = HaltReachability(state.q, state.dq, state.ddq, T, limits.velocity, limits.acceleration)
-    bad = reach.bind(model).start_violations(model.joint_numbers)
-    if bad:
-        nums = model.joint_numbers
-        raise InfeasibleError(
-            f"the state at failure ({state_name}) already breaks a limit, and every "
-            "halt starts from it, so no halt configuration, halt time or k helps: "
-            + "; ".join(bad)
-            + f" (speed limits: {limits_text(nums, limits.velocity, limits.velocity_source, 'deg/s')}; "
-            f"acceleration limits: "
-            f"{limits_text(nums, limits.acceleration, limits.acceleration_source, 'deg/s^2')}); "
-            "no halt configuration searched"
-        )
-
-
-def _check_start_margin(
-    model: ArmModel, state: FailureState, T: float, kept: JointLimits, margin: float, names: Mapping[str, Any]
-) -> None:
-    """Refuse a margin the state at failure already eats into: every halt starts from that
-    state, so the margin cannot be kept from t = 0."""
-    reach = HaltReachability(state.q, state.dq, state.ddq, T, kept.velocity, kept.acceleration)
-    bad = reach.bind(model).start_violations(model.joint_numbers)
-    if bad:
-        raise InfeasibleError(
-            f"the state at failure ({names['state']}) is already within the {100 * margin:g} % margin of a limit, "
-            f"and every halt starts from it: {'; '.join(bad)} (the limits reduced by the margin); a smaller "
-            f"{names.get('margin', 'margin')} can be kept"
-        )
-
-
-def _check_start_torques(
-    model: ArmModel,
-    state: FailureState,
-    base: str,
-    kept: JointLimits,
-    margin: float,
-    names: Mapping[str, Any],
-) -> None:
-    """Refuse torque limits the state at failure already breaks: the torques at t = 0 depend
-    on that state alone (the k-part and its two derivatives vanish there), whatever the halt
-    configuration, T and k."""
-    if kept.torque is None and kept.brake is None:
-        return
-    motor, brake = actuator_torques(model, state.q, state.dq, state.ddq, base=base)  # type: ignore[arg-type]
-    bad = []
-    for what, values, limits, numbers in (
-        ("motor torque", motor, kept.torque, model.joint_numbers),
-        ("brake torque (locked)", brake, kept.brake, [lj.number for lj in model.locked]),
-    ):
-        if limits is None:
-            continue
-        bad += [
-            f"joint {num} {what} {abs(v):.4g} N m > {lim:.4g} N m"
-            for num, v, lim in zip(numbers, values, limits)
-            if abs(v) > lim * (1 + 1e-9)
-        ]
-    if bad:
-        within = f" (the limits reduced by the {100 * margin:g} % margin)" if margin else ""
-        raise InfeasibleError(
-            f"the state at failure ({names['state']}) already needs more torque than a limit allows{within}, "
-            f"with the {base} base, and every halt starts from it: {'; '.join(bad)}; no halt configuration, "
-            "halt time or k helps"
-        )
-
-
 def _search_halt_configuration(
     model: ArmModel,
     state: FailureState,
@@ -199,53 +128,6 @@ def _search_halt_configuration(
             f"within T = {float(T):g} s under the limits"
         )
     return hc, note
-
-
-#: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
-LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
-                 "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg"),
-                 "margin": "margin", "torques": ("torque_max_Nm", "brake_max_Nm"),
-                 "prefer_margin": "prefer_margin"}  # fmt: skip
-CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",
-             "generations": "--generations", "qf": "--qf-deg", "state": "--q0-deg, --dq0-deg, --ddq0-deg",
-             "limits": CLI_LIMIT_NAMES, "margin": "--margin", "torques": CLI_TORQUE_NAMES,
-             "prefer_margin": "--prefer-margin"}  # fmt: skip
-SCENARIO_NAMES = {"T": "halt.T", "n_samples": "halt.n_samples", "samples": "halt.samples",
-                  "population": "halt.population", "generations": "halt.generations", "qf": "halt.qf_deg",
-                  "state": "state.q0_deg, state.dq0_deg, state.ddq0_deg", "limits": SCENARIO_LIMIT_NAMES,
-                  "margin": "halt.margin", "torques": SCENARIO_TORQUE_NAMES,
-                  "prefer_margin": "halt.prefer_margin"}  # fmt: skip
-
-
-def check_halt_settings(
-    T: float | None,
-    n_samples: int,
-    samples: int,
-    solver: str,
-    ga: GASettings,
-    names: Mapping[str, str] = LIBRARY_NAMES,
-) -> None:
-    """Refuse settings :func:`plan_halt` cannot use, before any work; ``names`` name them in
-    the messages (:data:`LIBRARY_NAMES`, or :data:`CLI_NAMES` for the command line)."""
-    if T is not None and not (math.isfinite(T) and T > 0):
-        raise ScenarioError(f"{names['T']} must be a finite halt time > 0 [s]; got {T:g}")
-    if n_samples < MIN_N_SAMPLES or n_samples % 2 == 0:
-        raise ScenarioError(
-            f"{names['n_samples']} must be an odd integer >= {MIN_N_SAMPLES} (time samples of the objective, "
-            f"Simpson's rule); got {n_samples}"
-        )
-    if samples < 2:
-        raise ScenarioError(
-            f"{names['samples']} must be an integer >= 2 (Monte Carlo samples); got {samples}"
-        )
-    if solver == "ga":
-        bad = []
-        if ga.n_pop < 2:
-            bad.append(f"{names['population']} must be >= 2 (GA population); got {ga.n_pop}")
-        if ga.n_gen < 0:
-            bad.append(f"{names['generations']} must be >= 0 (GA generations); got {ga.n_gen}")
-        if bad:
-            raise ScenarioError("; ".join(bad))
 
 
 def _arm_state_and_time(
@@ -415,6 +297,12 @@ def plan_halt(
         prefer_margin, _names.get("prefer_margin", "prefer_margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError
     )
     kept = limits.scaled(1 - margin)
+    notes: tuple[str, ...] = ()
+    if solver != "scan" and kept.torque is not None and torque_max_Nm is None and brake_max_Nm is None:
+        # the model's own effort limits: kept by the exact scan only; reported, not kept, by the others
+        kept = replace(kept, torque=None)
+        notes = (f"the model's motor torque limits are reported, not kept: solver {solver!r} keeps speed and "
+                 "acceleration limits only (--solver scan keeps torque limits too)",)  # fmt: skip
     _check_start_torques(model, state, base, kept, margin, _names)
     if state_source is None:
         state_source = "given" if state_given and not paper_scenario else "000 §5.2"
@@ -466,6 +354,7 @@ def plan_halt(
         seed=None if isinstance(rng, np.random.Generator) else rng,
         state_source=state_source,
         margin=margin,
+        notes=notes,
     )
 
 

@@ -33,9 +33,9 @@ def infeasibility_message(result: HaltMotion, *, k_unit: str = "deg/s^6") -> str
     if result.minimum_T is not None:
         lines.append(f"smallest halt time with a feasible k: T = {result.minimum_T:.3f} s")
     elif torque:
-        lines.append("no halt time up to the search limit keeps the torque limits")
+        lines.append(f"no halt time up to {max(10 * p.T, 120.0):g} s keeps the torque limits (for this halt configuration)")
     elif _start_breaks_limits(p):
         lines.append("the state at failure already breaks a limit (at t = 0): no halt time or k helps")
     else:
-        lines.append("no halt time up to the search limit has a feasible k")
+        lines.append(f"no halt time up to {max(10 * p.T, 120.0):g} s has a feasible k")
     return "\n".join(lines)

@@ -177,7 +177,7 @@ def _torque_infeasible_result(
         global_torque_k0=k0[0],
         feasible=False,
         violations=torque_violations(problem, k) + constraint_violations(problem, k),
-        violations_k0=torque_violations(problem, 0.0) + k0[1],
+        violations_k0=k0[1],
         k_interval=np.array(interval),
         joint_intervals=per,
         minimum_T=minimum_halt_time_with_torques(problem),
@@ -240,7 +240,10 @@ def _infeasible_result(
     ``k``, its violations and the smallest feasible ``T``; raised when ``on_infeasible="raise"``."""
     k = least_violating_k(problem)
     viol = constraint_violations(problem, k)
-    t_min = minimum_halt_time(problem)
+    torques = problem.has_torque_limits
+    if torques:  # the torque limits are broken too, or not: said, and kept by the smallest T
+        viol = viol + torque_violations(problem, k)
+    t_min = minimum_halt_time_with_torques(problem) if torques else minimum_halt_time(problem)
     result = HaltMotion(
         k=k,
         global_torque=float(global_base_torque(problem, k)),
@@ -382,6 +385,11 @@ def optimal_halt_motion(
     bounds_k = _check_k_bounds(k_bounds)
     rng = resolve_seed(rng)  # None -> a fresh int seed, recorded by the GA
     torques = problem.has_torque_limits
+    if prefer_margin and solver == "vector":
+        raise ScenarioError(
+            "prefer_margin needs one shared k (solver 'scan' or 'ga'): the per-joint vector solver has no "
+            "stretch of k to choose along"
+        )
     if torques and solver != "scan":
         raise ScenarioError(
             f"motor and brake torque limits need solver 'scan' (got {solver!r}): the torques are not affine "
@@ -391,6 +399,8 @@ def optimal_halt_motion(
     lo, hi = _search_interval(per, bounds_k)
     tau0 = float(global_base_torque(problem, 0.0))
     viol0 = constraint_violations(problem, 0.0)
+    if torques:
+        viol0 = viol0 + torque_violations(problem, 0.0)
     settings: dict[str, Any] = {"n_scan": n_scan, "n_samples": problem.n_samples, "n_check": problem.n_check}
     if not lo <= hi:
         return _infeasible_result(problem, solver, per, (lo, hi), (tau0, viol0), settings, on_infeasible)
@@ -403,7 +413,6 @@ def optimal_halt_motion(
         if not segments:
             return _torque_infeasible_result(problem, per, (lo, hi), (tau0, viol0), settings, on_infeasible)
         k: Any = _scan_segments(problem, segments, n_scan)
-        viol0 = torque_violations(problem, 0.0) + viol0
     elif solver == "ga":
         ga_result, settings["ga"] = _solve_ga(problem, lo, hi, ga_settings, ga_precision, rng, progress)
         k = float(ga_result.x[0])
