@@ -42,17 +42,19 @@ def limit_status(value: float, limit: float) -> str:
 def limits_rows(
     joints: Sequence[int], values: Sequence[float], limits: Sequence[float], quantity: str, unit: str
 ) -> list[list[Any]]:
-    """Rows ``[joint, quantity, peak, limit, margin, status]`` for a limits table; status is
-    ``"kept"``, ``"at the limit"`` or ``"BROKEN"`` (coloured by :func:`render_html`)."""
+    """Rows ``[joint, quantity, peak, limit, margin [% of the limit], status]`` for a limits
+    table (the margin ``100 (1 - peak / limit)``, one decimal, as the command prints it); status
+    is ``"kept"``, ``"at the limit"`` or ``"BROKEN"`` (coloured by :func:`render_html`)."""
     rows = []
     for j, v, lim in zip(joints, values, limits):
         v, lim = abs(float(v)), float(lim)
-        rows.append([j, f"{quantity} [{unit}]", v, lim, lim - v, limit_status(v, lim)])
+        margin = round(100.0 * (1.0 - v / lim), 1) + 0.0 if lim > 0 else ""  # + 0.0: no "-0.0"
+        rows.append([j, f"{quantity} [{unit}]", v, lim, margin, limit_status(v, lim)])
     return rows
 
 
 #: Header of :func:`limits_rows` tables.
-LIMITS_HEADER = ["joint", "quantity", "peak |value|", "limit", "margin", "status"]
+LIMITS_HEADER = ["joint", "quantity", "peak |value|", "limit", "margin [% of the limit]", "status"]
 
 
 @dataclass
