@@ -41,11 +41,6 @@ def limit_margins(problem: HaltProblem, k: FloatArray) -> FloatArray:
     return out.reshape(k.shape + (-1,))
 
 
-def smallest_margin(problem: HaltProblem, k: FloatArray) -> FloatArray:
-    """(...) the smallest of :func:`limit_margins`."""
-    return limit_margins(problem, k).min(axis=-1)
-
-
 def prefer_margin(
     problem: HaltProblem, k_best: float, stretch: tuple[float, float], tolerance: float, n_scan: int
 ) -> float:

@@ -160,40 +160,6 @@ def _scan_segments(problem: HaltProblem, segments: Sequence[tuple[float, float]]
     return float(best[int(np.argmin(values))])
 
 
-def _torque_infeasible_result(
-    problem: HaltProblem,
-    per: FloatArray,
-    interval: tuple[float, float],
-    k0: tuple[float, tuple[Violation, ...]],
-    settings: dict[str, Any],
-    on_infeasible: Literal["report", "raise"],
-) -> HaltMotion:
-    """Every ``k`` that keeps the speed and acceleration limits breaks a torque limit: the
-    least-violating of them, its torque violations and the smallest halt time that keeps all."""
-    k = least_torque_violating_k(problem, interval[0], interval[1], settings["n_scan"])
-    result = HaltMotion(
-        k=k,
-        global_torque=float(global_base_torque(problem, k)),
-        global_torque_k0=k0[0],
-        feasible=False,
-        violations=torque_violations(problem, k) + constraint_violations(problem, k),
-        violations_k0=k0[1],
-        k_interval=np.array(interval),
-        joint_intervals=per,
-        minimum_T=minimum_halt_time_with_torques(problem),
-        solver="scan",
-        settings=settings,
-        seed=None,
-        problem=problem,
-        k_segments=(),
-    )
-    msg = infeasibility_message(result)
-    log.info("infeasible halt: %s", msg.splitlines()[0])
-    if on_infeasible == "raise":
-        raise InfeasibleError(msg)
-    return result
-
-
 def _check_k_bounds(k_bounds: Sequence[float] | None) -> tuple[float, float] | None:
     """``k_bounds`` as ``(lo, hi)`` [rad/s^6]: two numbers, not NaN, ``lo <= hi`` (infinite
     ends allowed: one-sided bounds)."""
@@ -235,15 +201,21 @@ def _infeasible_result(
     k0: tuple[float, tuple[Violation, ...]],
     settings: dict[str, Any],
     on_infeasible: Literal["report", "raise"],
+    *,
+    torques_only: bool = False,
 ) -> HaltMotion:
-    """The report of a problem without a feasible ``k`` (``interval`` empty): least-violating
-    ``k``, its violations and the smallest feasible ``T``; raised when ``on_infeasible="raise"``."""
-    k = least_violating_k(problem)
-    viol = constraint_violations(problem, k)
+    """The report of a problem without a feasible ``k``: least-violating ``k``, its violations
+    and the smallest feasible ``T`` (with the torque limits when there are any); raised when
+    ``on_infeasible="raise"``.  ``interval`` is empty, or (``torques_only``) the speed and
+    acceleration limits' interval, every ``k`` of which breaks a torque limit."""
     torques = problem.has_torque_limits
-    if torques:  # the torque limits are broken too, or not: said, and kept by the smallest T
-        viol = viol + torque_violations(problem, k)
-    t_min = minimum_halt_time_with_torques(problem) if torques else minimum_halt_time(problem)
+    if torques_only:
+        k = least_torque_violating_k(problem, interval[0], interval[1], settings["n_scan"])
+    else:
+        k = least_violating_k(problem)
+    viol = constraint_violations(problem, k)
+    if torques:
+        viol = torque_violations(problem, k) + viol if torques_only else viol + torque_violations(problem, k)
     result = HaltMotion(
         k=k,
         global_torque=float(global_base_torque(problem, k)),
@@ -253,11 +225,14 @@ def _infeasible_result(
         violations_k0=k0[1],
         k_interval=np.array(interval),
         joint_intervals=per,
-        minimum_T=t_min,
+        minimum_T=minimum_halt_time_with_torques(problem) if torques else minimum_halt_time(problem),
         solver=solver,
         settings=settings,
         seed=None,
         problem=problem,
+        k_segments=() if torques_only else None,
+        objective_value=float(halt_objective(problem, k)),
+        objective_value_k0=float(halt_objective(problem, 0.0)),
     )
     msg = infeasibility_message(result)
     log.info("infeasible halt: %s", msg.splitlines()[0])
@@ -411,7 +386,9 @@ def optimal_halt_motion(
     if torques:
         segments = tuple(torque_feasible_segments(problem, lo, hi, n_scan))
         if not segments:
-            return _torque_infeasible_result(problem, per, (lo, hi), (tau0, viol0), settings, on_infeasible)
+            return _infeasible_result(
+                problem, solver, per, (lo, hi), (tau0, viol0), settings, on_infeasible, torques_only=True
+            )
         k: Any = _scan_segments(problem, segments, n_scan)
     elif solver == "ga":
         ga_result, settings["ga"] = _solve_ga(problem, lo, hi, ga_settings, ga_precision, rng, progress)
