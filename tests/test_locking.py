@@ -112,3 +112,21 @@ def test_lock_errors_name_the_joint_and_allowed_values():
         jl.lock(model, 2, 4.0)
     with pytest.raises(jl.ModelError, match="finite"):
         jl.lock(model, 2, float("nan"))
+
+
+def test_massless_bodies_keep_their_rotational_inertia_when_merged(rng):
+    """Issue 15, item 3: a body of mass 0 with inertia (a rotor, a URDF link with mass 0) keeps
+    it when merged, whichever order the two bodies come in, and locking stays exact."""
+    rotor = jl.Body(0.0, [0.3, 0.0, 0.0], [0.05, 0.06, 0.03])
+    merged = jl.Body(0.0).merged(rotor)
+    np.testing.assert_allclose(merged.inertia, np.diag([0.05, 0.06, 0.03]))
+    np.testing.assert_allclose(rotor.merged(jl.Body(0.0)).inertia, merged.inertia)
+    # an arm whose joint-2 link is massless but has inertia: locking joint 2 (or 3) is exact
+    bodies = [jl.Body(2.0, [0.4, 0, 0], [0.01, 0.2, 0.2]), jl.Body(0.0, [0.2, 0, 0], [0.05, 0.06, 0.03]),
+              jl.Body(0.0, [0.1, 0, 0], [0.02, 0.02, 0.04]), jl.Body(1.0, [0.2, 0, 0], [0.01, 0.1, 0.1])]  # fmt: skip
+    arm = jl.from_dh("rotors", a=[0.8, 0.4, 0.3, 0.4], alpha=[np.pi / 2, 0, -np.pi / 2, 0], d=[0.1, 0, 0.2, 0],
+                     convention="standard", bodies=bodies)  # fmt: skip
+    for locks in ({2: 0.4}, {3: -0.7}, {2: 0.4, 3: -0.7}):
+        locked, q_full, keep = _frozen_comparison(arm, locks, random_q(arm, rng, (5,))[:, : arm.dof - len(locks)])
+        m_full = jl.mass_matrix(arm, q_full)
+        np.testing.assert_allclose(jl.mass_matrix(locked, locked.healthy(q_full)), m_full[:, keep][:, :, keep], atol=1e-12)

@@ -146,9 +146,9 @@ class Body:
         if pose_other is not None:
             other = other.transformed(pose_other)
         total = self.mass + other.mass
-        if total == 0:
-            return Body(0.0, self.com, np.zeros((3, 3)), name or self.name)
-        com = (self.mass * self.com + other.mass * other.com) / total
+        # two massless bodies may still carry rotational inertia (a rotor, a URDF link with
+        # mass 0): it adds as it is, about any point (the parallel-axis terms vanish)
+        com = self.com if total == 0 else (self.mass * self.com + other.mass * other.com) / total
         inertia = (
             self.inertia
             + _parallel_axis(self.mass, self.com - com)
