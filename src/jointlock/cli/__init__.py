@@ -31,6 +31,7 @@ COMMAND_MODULES: tuple[str, ...] = (
     "replan",
     "workspace",
     "singular",
+    "export_urdf",
     "run",
     "campaign",
     "reproduce",

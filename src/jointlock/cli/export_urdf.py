@@ -1,0 +1,48 @@
+"""``jointlock export-urdf``: the (locked) arm as a URDF file, its locked joints folded in and
+their bodies merged, for simulating the crippled arm elsewhere (a thin shell over
+:func:`jointlock.io.urdf_export.write_urdf`)."""
+
+from __future__ import annotations
+
+import argparse
+import math
+from pathlib import Path
+
+from ..io.urdf_export import write_urdf
+from ._common import add_robot_arguments, model_from_args, print_json
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "export-urdf",
+        help="write the (locked) arm as URDF, locked joints folded in and bodies merged",
+        description=(
+            "Write the arm, with every --lock folded into the chain and the bodies it joins merged, "
+            "as a URDF file that Pinocchio, MuJoCo, Gazebo or Drake load: link 'base' (the spacecraft "
+            "with --base floating), one revolute joint per healthy joint, link 'tool' at the end "
+            "effector. Reading it back (jointlock, Pinocchio) gives the locked model's kinematics and "
+            "dynamics to round-off."
+        ),
+    )
+    add_robot_arguments(p)
+    p.add_argument("--out", type=Path, metavar="FILE", required=True, help="the URDF file to write")
+    p.add_argument("--json", action="store_true", help="print one JSON object (the file, joints, locks)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    model = model_from_args(args)
+    path = write_urdf(model, args.out)
+    facts = {
+        "file": str(path),
+        "robot": model.name,
+        "base": "floating" if model.floating else "fixed",
+        "joint_numbers": list(model.joint_numbers),
+        "locked_deg": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+    }
+    if args.json:
+        print_json(facts)
+        return 0
+    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked_deg"].items()) or "none"
+    print(f"wrote {path}: {model.name}, {facts['base']} base, healthy joints {facts['joint_numbers']}, locked: {locked}")
+    return 0

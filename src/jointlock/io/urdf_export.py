@@ -1,0 +1,103 @@
+"""URDF writer: an :class:`~jointlock.model.ArmModel` -- a crippled arm with its locked joints
+folded in and their bodies merged -- as a URDF file other tools load (Pinocchio, MuJoCo's
+importer, Gazebo, Drake), so that the locked arm can be simulated elsewhere.
+
+The chain is written as it is held: link ``base`` (the root body: the spacecraft of a
+free-floating arm, whose URDF root link :func:`~jointlock.io.urdf.read_urdf` reads as the
+spacecraft with ``base="floating"``), then one ``revolute`` (or ``continuous``, for a joint
+without angle limits) joint per movable joint with its placement as ``<origin>`` (xyz, URDF
+roll-pitch-yaw), its unit axis and its limits, each carrying its body's ``<inertial>`` (mass,
+centre of mass and inertia about it, in the joint's frame), and a ``fixed`` joint to the link
+``tool`` (the end effector).  Numbers are written with 17 significant digits, so that reading
+the file back gives the same model to round-off.  Locked joints appear in an XML comment
+(number, angle); they are no joints of the file.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+import numpy as np
+
+from ..model import ArmModel, Body, FloatArray
+from .files import atomic_write_text
+
+#: Name of the end-effector link and of the root link in the files written.
+TOOL_LINK, BASE_LINK = "tool", "base"
+
+
+def rpy_from_matrix(rotation: FloatArray) -> FloatArray:
+    """URDF roll-pitch-yaw (3,) [rad] of a rotation matrix (3, 3), ``R = Rz(yaw) Ry(pitch)
+    Rx(roll)`` (inverse of :func:`jointlock.spatial.rpy_matrix`; at pitch = +-90 deg, roll 0)."""
+    r = np.asarray(rotation, dtype=float)
+    pitch = math.atan2(-r[2, 0], math.hypot(r[0, 0], r[1, 0]))
+    if math.hypot(r[0, 0], r[1, 0]) < 1e-12:  # gimbal lock: yaw takes the whole in-plane angle
+        return np.array([0.0, pitch, math.atan2(-r[0, 1], r[1, 1])])
+    return np.array([math.atan2(r[2, 1], r[2, 2]), pitch, math.atan2(r[1, 0], r[0, 0])])
+
+
+def _num(value: float) -> str:
+    return repr(float(value) + 0.0)  # + 0.0: no "-0.0"
+
+
+def _vec(values: FloatArray) -> str:
+    return " ".join(_num(v) for v in values)
+
+
+def _origin(transform: FloatArray) -> str:
+    t = np.asarray(transform, dtype=float)
+    return f'<origin xyz="{_vec(t[:3, 3])}" rpy="{_vec(rpy_from_matrix(t[:3, :3]))}"/>'
+
+
+def _inertial(body: Body) -> str:
+    i = body.inertia
+    return (
+        f'<inertial><origin xyz="{_vec(body.com)}" rpy="0 0 0"/><mass value="{_num(body.mass)}"/>'
+        f'<inertia ixx="{_num(i[0, 0])}" ixy="{_num(i[0, 1])}" ixz="{_num(i[0, 2])}" '
+        f'iyy="{_num(i[1, 1])}" iyz="{_num(i[1, 2])}" izz="{_num(i[2, 2])}"/></inertial>'
+    )
+
+
+def urdf_text(model: ArmModel) -> str:
+    """The URDF document of ``model`` (see the module docstring)."""
+    locked = ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):.12g} deg" for lj in model.locked)
+    lines = [
+        '<?xml version="1.0" encoding="utf-8"?>',
+        f"<!-- written by jointlock from {model.name!r}; locked: {locked or 'none'} "
+        f"(folded into the chain, bodies merged); base: {'floating' if model.floating else 'fixed'} -->",
+        f"<robot name={quoteattr(model.name)}>",
+        f"  <link name={quoteattr(BASE_LINK)}>{_inertial(model.root_body)}</link>",
+    ]
+    parent = BASE_LINK
+    for joint, body in zip(model.joints, model.bodies):
+        child = f"link{joint.number}"
+        continuous = math.isinf(joint.lower) and math.isinf(joint.upper)
+        limit = [f'effort="{_num(joint.effort_limit if math.isfinite(joint.effort_limit) else 0.0)}"',
+                 f'velocity="{_num(joint.velocity_limit if math.isfinite(joint.velocity_limit) else 0.0)}"']  # fmt: skip
+        if not continuous:
+            limit = [f'lower="{_num(joint.lower)}"', f'upper="{_num(joint.upper)}"', *limit]
+        lines += [
+            f"  <link name={quoteattr(child)}>{_inertial(body)}</link>",
+            f"  <joint name={quoteattr(joint.name)} type=\"{'continuous' if continuous else 'revolute'}\">",
+            f"    <parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>",
+            f"    {_origin(joint.placement)}<axis xyz=\"{_vec(joint.axis)}\"/>",
+            f"    <limit {' '.join(limit)}/>",
+            "  </joint>",
+        ]
+        parent = child
+    lines += [
+        f"  <link name={quoteattr(TOOL_LINK)}/>",
+        f'  <joint name="tool_fixed" type="fixed"><parent link={quoteattr(parent)}/>'
+        f"<child link={quoteattr(TOOL_LINK)}/>{_origin(model.tool)}</joint>",
+        "</robot>",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def write_urdf(model: ArmModel, path: str | Path) -> Path:
+    """Write :func:`urdf_text` to ``path`` (atomically); returns the path."""
+    path = Path(path)
+    atomic_write_text(path, urdf_text(model))
+    return path
