@@ -88,3 +88,12 @@ def test_every_public_name_resolves():
         assert getattr(jl, name) is not None, name
     with pytest.raises(AttributeError):
         jl.no_such_function  # noqa: B018
+
+
+def test_a_model_prints_in_one_short_line():
+    """Issue 16, item 3: a model's repr is one line, not its nested arrays."""
+    for name in ("halt7", "canadarm7", "puma6"):
+        for model in (jl.load_robot(name), jl.lock_joints(jl.load_robot(name, base="floating"), {2: 0.3, 4: 0.0})):
+            text = repr(model)
+            assert "\n" not in text and len(text) < 200 and text.startswith(f"ArmModel({name!r}")
+    assert "locked {2: 17.1887 deg, 4: 0 deg}" in repr(jl.lock_joints(jl.load_robot("halt7"), {2: 0.3, 4: 0.0}))
