@@ -325,6 +325,18 @@ class ArmModel:
         """(n,) upper position limits [rad]."""
         return _readonly([j.upper for j in self.joints])
 
+    def angle_range(self) -> tuple[FloatArray, FloatArray]:
+        """(n,) lower and upper angles [rad] that cover every angle each joint can take once:
+        its limits as given (past +-pi too: a multi-turn joint is sampled over all its turns); a
+        side without a limit one turn from the other; a joint without limits (continuous) one
+        turn, [-pi, pi].  What sampling and search starts draw from."""
+        lo, hi = np.array(self.lower), np.array(self.upper)
+        free = ~np.isfinite(lo) & ~np.isfinite(hi)
+        lo[free], hi[free] = -math.pi, math.pi
+        lo = np.where(np.isfinite(lo), lo, hi - 2.0 * math.pi)
+        hi = np.where(np.isfinite(hi), hi, lo + 2.0 * math.pi)
+        return _readonly(lo), _readonly(hi)
+
     @property
     def masses(self) -> FloatArray:
         """(n,) link masses [kg] (root body excluded)."""

@@ -63,7 +63,8 @@ OUTSIDE_TOL = 0.03
 def sample_configurations(
     model: ArmModel, samples: int, rng: int | np.random.Generator | None = None
 ) -> FloatArray:
-    """(samples, n) joint angles uniform within the limits (capped to +-pi) [rad].
+    """(samples, n) joint angles uniform within the limits as given [rad]
+    (:meth:`ArmModel.angle_range`: past +-pi too; one turn for a joint without limits).
 
     ``rng``: seed (int >= 0) or ``numpy.random.Generator`` (:mod:`jointlock._random`); ``None``
     draws a fresh seed, which is not returned (pass a seed or a Generator to repeat the draw;
@@ -72,8 +73,7 @@ def sample_configurations(
     if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 1:
         raise ConfigurationError(f"samples must be an integer >= 1; got {samples!r}")
     gen, _ = resolve_rng(rng)
-    lo = np.maximum(model.lower, -math.pi)
-    hi = np.minimum(model.upper, math.pi)
+    lo, hi = model.angle_range()
     return gen.uniform(lo, hi, (int(samples), model.dof))
 
 

@@ -15,7 +15,7 @@ from ..errors import ConfigurationError
 from ..kinematics import ChainState, chain_state, ee_pose, jacobian
 from ..model import ArmModel, FloatArray
 from ..spatial import pose_error, rot_x, rotation_log
-from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, wrap_angle
+from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, turns_into_limits
 
 
 @dataclass(frozen=True)
@@ -110,7 +110,7 @@ def ik_numeric(
         return tgt @ rot_x(g) if free_tool_x else tgt
 
     def clamp(qq: FloatArray) -> FloatArray:
-        return np.clip(wrap_angle(qq), model.lower, model.upper)
+        return np.clip(turns_into_limits(qq, model.lower, model.upper), model.lower, model.upper)
 
     q = clamp(q)
     e, state = _residual(model, q, target_of(gamma), length_scale)
@@ -153,10 +153,9 @@ def _initial_q(
     model: ArmModel, batch: tuple[int, ...], q0: ArrayLike | None, starts: int, gen: np.random.Generator
 ) -> FloatArray:
     """(*batch, S, n) starts [rad]: ``q0`` (broadcast) followed by ``starts`` uniform ones
-    within the limits (clipped to [-pi, pi]) drawn from ``gen``."""
+    within the limits as given (:meth:`ArmModel.angle_range`) drawn from ``gen``."""
     n = model.dof
-    lo = np.maximum(model.lower, -math.pi)
-    hi = np.minimum(model.upper, math.pi)
+    lo, hi = model.angle_range()
     parts = []
     if q0 is not None:
         q0a = np.asarray(q0, dtype=float)

@@ -13,7 +13,7 @@ from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z
-from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, wrap_angle
+from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, turns_into_limits, wrap_angle
 
 #: Largest residual accepted when fitting the puma6 family to a model [m or rad].
 FAMILY_FIT_TOL = 1e-9
@@ -301,7 +301,8 @@ def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:
     geom = puma6_geometry(model)
     t = _as_poses(target)
     q_full, valid = puma6_branches(geom, t @ invert(geom.tool))
-    q = model.healthy(q_full)
+    q = turns_into_limits(model.healthy(q_full), model.lower, model.upper)  # limits past +-pi kept
+    q_full = np.where(valid[..., None], model.expand(np.nan_to_num(q)), np.nan)
     actual = ee_pose(model, np.where(valid[..., None], q, 0.0))
     dp, dr = pose_error(t[..., None, :, :], actual)
     dp = np.where(valid, dp, np.inf)

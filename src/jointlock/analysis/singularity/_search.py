@@ -192,8 +192,7 @@ def find_singularities(
         raise ScenarioError(f"max_iter must be >= 1; got {max_iter}")
     gen, seed = resolve_rng(rng)
     if q_start is None:
-        lo = np.maximum(model.lower, -np.pi)
-        hi = np.minimum(model.upper, np.pi)
+        lo, hi = model.angle_range()  # the limits as given, past +-pi too
         q0 = gen.uniform(lo, hi, size=(samples, model.dof))
     else:
         q0 = as_joint_array(model, q_start, "q_start").reshape(-1, model.dof)

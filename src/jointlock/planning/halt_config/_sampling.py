@@ -27,8 +27,9 @@ def _sampling_box(
     reachability: ReachabilityBound | None,
 ) -> tuple[FloatArray, FloatArray]:
     n = model.dof
-    lo = np.maximum(model.lower, -math.pi) if lower is None else np.asarray(lower, dtype=float)
-    hi = np.minimum(model.upper, math.pi) if upper is None else np.asarray(upper, dtype=float)
+    box = model.angle_range()  # the limits as given, past +-pi too
+    lo = box[0] if lower is None else np.asarray(lower, dtype=float)
+    hi = box[1] if upper is None else np.asarray(upper, dtype=float)
     for name, arr in (("lower", lo), ("upper", hi)):
         if arr.shape != (n,) or not np.all(np.isfinite(arr)):
             raise ConfigurationError(
