@@ -9,7 +9,7 @@ import numpy as np
 
 from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M
 from ..errors import ScenarioError
-from ..ik import pose_from_zyx
+from ..ik import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, pose_from_zyx
 from ..jobs.ik import inverse_kinematics
 from ._common import add_robot_arguments, model_from_args, number_arg, print_json, seed_arg
 
@@ -56,6 +56,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="M",
         help="L [m] of the nearest-pose metric (> 0)",
     )
+    p.add_argument(
+        "--tol-mm",
+        type=number_arg(0.0, MAX_LENGTH_M * 1e3, unit="mm"),
+        default=None,
+        metavar="MM",
+        help="accept a target reached within this distance [mm] when no exact solution exists (a pose "
+        "typed with rounded numbers); default: exact only (1e-4 mm)",
+    )
+    p.add_argument(
+        "--tol-deg",
+        type=number_arg(0.0, 180.0, unit="deg"),
+        default=None,
+        metavar="DEG",
+        help="the same for the orientation [deg]; default: exact only (5.7e-6 deg)",
+    )
     p.add_argument("--seed", type=seed_arg, default=0, help="seed of the numerical starts (integer >= 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
@@ -83,8 +98,14 @@ def _target(args: argparse.Namespace) -> np.ndarray:
 
 def run(args: argparse.Namespace) -> int:
     model = model_from_args(args)
+    tolerance = None
+    if args.tol_mm is not None or args.tol_deg is not None:  # the one not given: exact
+        tolerance = (
+            max(1e-3 * (args.tol_mm or 0.0), EXACT_POSITION_TOL),
+            max(np.radians(args.tol_deg or 0.0), EXACT_ROTATION_TOL),
+        )
     report = inverse_kinematics(
-        model, _target(args), method=args.method, rng=args.seed, length_scale=args.length_scale
+        model, _target(args), method=args.method, rng=args.seed, length_scale=args.length_scale, tolerance=tolerance
     )
     if args.json:
         print_json(report.to_dict())

@@ -77,6 +77,10 @@ class IKResult:
         The seed of the numerical method's random starts (``rng`` an int, or the fresh seed
         drawn for ``rng=None``); None when ``rng`` was a Generator (see
         :mod:`jointlock._random`).
+    tolerance
+        ``(position [m], rotation [rad])`` within which a pose counts as reached when no exact
+        solution exists (a target typed with rounded numbers); ``solutions`` then lists the
+        distinct nearest configurations within it (``exact`` False).  None: exact only.
     """
 
     target: FloatArray
@@ -87,11 +91,17 @@ class IKResult:
     nearest_pose: FloatArray | None
     length_scale: float
     seed: int | None = None
+    tolerance: tuple[float, float] | None = None
 
     @property
     def reachable(self) -> bool:
-        """True when at least one exact solution exists."""
+        """True when at least one solution exists (exact, or within :attr:`tolerance`)."""
         return bool(self.solutions)
+
+    @property
+    def within_tolerance(self) -> bool:
+        """Reached within :attr:`tolerance` only: no exact solution, some within it."""
+        return bool(self.solutions) and not any(s.exact for s in self.solutions)
 
 
 def _distinct(solutions: list[IKSolution]) -> list[IKSolution]:
@@ -110,6 +120,7 @@ def solve_ik(
     starts: int = 16,
     rng: int | np.random.Generator | None = 0,
     length_scale: float = 1.0,
+    tolerance: tuple[float, float] | None = None,
 ) -> IKResult:
     """Every IK solution of one target, and the nearest reachable pose when there is none.
 
@@ -126,6 +137,11 @@ def solve_ik(
         from the same seed), the seed used is ``IKResult.seed``.
     length_scale
         ``L`` [m] of the nearest-pose metric ``sqrt(|dp|^2 + (L dtheta)^2)``.
+    tolerance
+        ``(position [m], rotation [rad])``, each >= 0: when no exact solution exists, the
+        distinct nearest configurations (from every candidate and start) within both are the
+        solutions -- a target typed with rounded numbers (002's eq. (21) pose, printed to four
+        decimals) is reached.  None (default): exact solutions only (1e-7 m, 1e-7 rad).
 
     Returns
     -------
@@ -145,6 +161,13 @@ def solve_ik(
             use_closed = True
         except ModelError:
             use_closed = False
+    if tolerance is not None:
+        tol = np.asarray(tolerance, dtype=float)
+        if tol.shape != (2,) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
+            raise ConfigurationError(
+                f"tolerance must be (position [m], rotation [rad]), two finite numbers >= 0; got {tolerance!r}"
+            )
+        tolerance = (float(tol[0]), float(tol[1]))
     source = resolve_seed(rng)  # an int seed (fresh for None) or the caller's Generator
     seed = None if isinstance(source, np.random.Generator) else source
     cands, kind = _candidates(model, t, use_closed, starts, source, length_scale)
@@ -175,7 +198,20 @@ def solve_ik(
         if nearest.exact:  # the closed form missed it (singular target): report as a solution
             exact = [nearest]
             nearest, nearest_pose = None, None
-    return IKResult(t, kind, tuple(exact), tuple(cands), nearest, nearest_pose, float(length_scale), seed)
+        elif tolerance is not None:
+            within = (refined.position_error <= tolerance[0]) & (refined.rotation_error <= tolerance[1])
+            order = np.argsort(metric)
+            exact = _distinct(
+                [
+                    IKSolution(refined.q[k], model.expand(refined.q[k]), int(k), float(refined.position_error[k]),
+                               float(refined.rotation_error[k]), False)  # fmt: skip
+                    for k in order
+                    if within[k]
+                ]
+            )
+    return IKResult(
+        t, kind, tuple(exact), tuple(cands), nearest, nearest_pose, float(length_scale), seed, tolerance
+    )
 
 
 def _candidates(

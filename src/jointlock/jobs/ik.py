@@ -58,6 +58,10 @@ class InverseKinematicsReport(JobResult):
             "target_position_m": target[:3, 3],
             "target_zyx_deg": np.degrees(zyx_angles(target[:3, :3])),
             "reachable": res.reachable,
+            "within_tolerance": res.within_tolerance,
+            "tolerance": None
+            if res.tolerance is None
+            else {"position_m": res.tolerance[0], "rotation_deg": math.degrees(res.tolerance[1])},
             "solutions": [_solution(s) for s in res.solutions],
             "candidates": [_solution(s) for s in res.candidates],
             "nearest": None,
@@ -84,8 +88,15 @@ class InverseKinematicsReport(JobResult):
             format_matrix(self.target, "{:>11.6f}"),
         ]
         if res.reachable:
+            within = ""
+            if res.within_tolerance and res.tolerance is not None:
+                within = (
+                    f" within {1e3 * res.tolerance[0]:g} mm and {math.degrees(res.tolerance[1]):g} deg "
+                    "(no exact one)"
+                )
             lines.append(
-                f"\n{len(res.solutions)} solution(s), q [deg] (all joints), position error [m], rotation error [deg]:"
+                f"\n{len(res.solutions)} solution(s){within}, q [deg] (all joints), position error [m], "
+                "rotation error [deg]:"
             )
             for s in res.solutions:
                 q = " ".join(f"{v:9.4f}" for v in np.degrees(s.q_full))
@@ -117,11 +128,13 @@ def inverse_kinematics(
     method: Literal["auto", "closed-form", "numeric"] = "auto",
     rng: int | np.random.Generator | None = 0,
     length_scale: float = 1.0,
+    tolerance: tuple[float, float] | None = None,
 ) -> InverseKinematicsReport:
     """Every IK branch of ``model`` for the pose ``target`` (4, 4) [m]
     (:func:`jointlock.ik.solve_ik`: 002's closed form for the puma6 family, Levenberg-Marquardt
     from several seeded starts otherwise), or the nearest reachable pose, with ``length_scale``
-    [m] weighing rotation against position in the distance."""
+    [m] weighing rotation against position in the distance; ``tolerance`` ``(position [m],
+    rotation [rad])`` accepts a target reached within it (see :func:`~jointlock.ik.solve_ik`)."""
     target = np.asarray(target, dtype=float)
-    res = solve_ik(model, target, method=method, rng=rng, length_scale=length_scale)
+    res = solve_ik(model, target, method=method, rng=rng, length_scale=length_scale, tolerance=tolerance)
     return InverseKinematicsReport(model, target, res)
