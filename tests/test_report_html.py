@@ -89,3 +89,23 @@ def test_a_limit_met_with_no_margin_is_at_the_limit_not_kept():
     assert limit_status(39.0, 40.0) == "kept"
     assert limit_status(40.0, 40.0) == limit_status(39.8, 40.0) == "at the limit"
     assert limit_status(40.1, 40.0) == "BROKEN"
+
+
+def test_the_report_and_the_docs_cite_the_papers(tmp_path):
+    """Issue 16, item 6: each seed's title and authors in docs/references.md and in the run
+    report of its jobs; 001's reconstruction is in the project's docs."""
+    from pathlib import Path
+
+    from jointlock.papers import REFERENCES
+    from jointlock.run import run_scenario
+    from jointlock.scenario import scenario_from_dict
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    refs = (docs / "references.md").read_text()
+    for seed, text in REFERENCES.items():
+        assert text in refs and f"## {seed}" in refs
+    assert "global compensation" in (docs / "reconstruction-001.md").read_text()
+    sc = scenario_from_dict({"robot": "puma6", "failure": {"joint": 2, "angle_deg": 59.4}, "workspace": {"samples": 2000}})
+    run_scenario(sc).write(tmp_path / "o")
+    html = (tmp_path / "o" / "report.html").read_text()
+    assert "Kinematic Analysis and Fault-Tolerant Trajectory Planning" in html and "Halt Optimization" not in html

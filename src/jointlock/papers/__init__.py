@@ -15,8 +15,10 @@ lowest layer); the arms' own tables are the robot factories of :mod:`jointlock.r
   example A (Figs. 5-8: absorbable ranges, gamma, q at gamma) and example B (eqs. 21-22).
 - :mod:`jointlock.papers.p004`: singularities of canadarm7 (004): the virtual link lengths
   and Table 3 (configurations and det(J Jᵀ)).
+- :data:`REFERENCES`: each seed's authors, title, venue and DOI.
 """
 
 from . import p000, p001, p002, p004
+from .references import REFERENCES
 
-__all__ = ["p000", "p001", "p002", "p004"]
+__all__ = ["REFERENCES", "p000", "p001", "p002", "p004"]

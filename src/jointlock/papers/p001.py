@@ -2,7 +2,7 @@
 survived.
 
 001's equations, its arm's table and its results were lost; the method implemented is the
-reconstruction in ``NOTES-001.md`` (docs/jump.md), on ``canadarm7`` (004's arm, the
+reconstruction in ``docs/reconstruction-001.md`` (docs/jump.md), on ``canadarm7`` (004's arm, the
 SSRMS-type structure of 001).  What is left to type once is NOTES-001's task, the study
 ``jointlock reproduce`` runs and reports as "ours only".
 """

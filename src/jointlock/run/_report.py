@@ -16,6 +16,7 @@ from ..io.files import save_figure
 from ..jobs._common import scenario_locks
 from ..jobs.halt._text import MOMENT_TEXT
 from ..locking import lock_joints
+from ..papers import REFERENCES
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
 from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_replan_error
@@ -76,7 +77,14 @@ def report_sections(
         *_limits_section(scenario, jobs, full, locked),
         *_figure_sections(scenario, jobs, full, locked, typed, out),
         Section("Assumptions and readings", notes=assumptions(scenario, full)),
+        _references_section(scenario),
     ]
+
+
+def _references_section(scenario: Scenario) -> Section:
+    """The seed papers behind the jobs run (docs/references.md)."""
+    seeds = sorted({JOB_PAPER[job][:3] for job in scenario.jobs})
+    return Section("References", notes=[f"{seed}: {REFERENCES[seed]}" for seed in seeds])
 
 
 def _scenario_section(scenario: Scenario, jobs: dict[str, Any], full: Any, locked: Any, versions: dict[str, str]) -> list[Section]:

@@ -1,5 +1,5 @@
 """Keep following the path through an unexpected lock: null-space "global compensation"
-(seed 001, method as reconstructed in ``NOTES-001.md``).
+(seed 001, method as reconstructed in ``docs/reconstruction-001.md``).
 
 Pipeline
 --------
