@@ -88,7 +88,7 @@ def test_the_command_writes_the_file_and_says_what_it_holds(tmp_path, capsys):
     out = tmp_path / "h.urdf"
     assert main(["export-urdf", "halt7", "--lock", "4=0", "--lock", "2=10", "--base", "floating", "--out", str(out), "--json"]) == 0
     facts = json.loads(capsys.readouterr().out)
-    assert facts["joint_numbers"] == [1, 3, 5, 6, 7] and facts["locked_deg"] == {"4": 0.0, "2": pytest.approx(10.0)}
+    assert facts["joint_numbers"] == [1, 3, 5, 6, 7] and facts["locked"] == {"4": 0.0, "2": pytest.approx(10.0)}
     text = out.read_text()
     assert "locked: joint 4 at 0 deg, joint 2 at 10 deg" in text and text.count('type="revolute"') == 5
     assert main(["export-urdf", "halt7", "--lock", "9=0", "--out", str(out)]) == 2

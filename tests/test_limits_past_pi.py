@@ -64,3 +64,13 @@ def test_the_closed_form_keeps_branches_within_limits_past_pi():
     q6 = br.q[br.exact][:, 5]
     assert np.all((q6 >= 0) & (q6 <= TURN)) and np.any(np.isclose(q6, q_true[5]))
     np.testing.assert_allclose(jl.ee_pose(shifted, br.q[br.exact]), np.broadcast_to(target, (int(br.exact.sum()), 4, 4)), atol=1e-9)
+
+
+def test_from_dh_takes_a_continuous_joint():
+    arm = jl.from_dh("two", a=[1.0, 0.8], alpha=[0, 0], d=[0, 0], convention="standard",
+                     lower=[-np.inf, 0.5], upper=[np.inf, 5.5])  # fmt: skip
+    assert arm.angle_range()[0].tolist() == [-np.pi, 0.5]
+    result = jl.solve_ik(arm, jl.ee_pose(arm, [3.0 + TURN, 4.0]))
+    np.testing.assert_allclose(result.solutions[0].q, [3.0, 4.0], atol=1e-9)  # one turn is one pose
+    with pytest.raises(jl.ModelError, match=r"lower must hold 2 finite numbers \(or -inf for no limit\)"):
+        jl.from_dh("two", a=[1.0, 0.8], alpha=[0, 0], d=[0, 0], convention="standard", lower=[np.nan, 0.5])

@@ -32,13 +32,18 @@ from .spatial import rot_x, rot_z, translation
 DHConvention = Literal["standard", "modified"]
 
 
-def _column(values: ArrayLike | None, n: int, name: str, default: float = 0.0) -> np.ndarray:
+def _column(
+    values: ArrayLike | None, n: int, name: str, default: float = 0.0, *, unbounded: float = 0.0
+) -> np.ndarray:
+    """(n,) finite numbers; ``unbounded`` (-inf or +inf) is allowed too (a limit without a
+    bound: a continuous joint)."""
     if values is None:
         return np.full(n, default)
     arr = np.asarray(values, dtype=float)
-    if arr.shape != (n,) or not np.all(np.isfinite(arr)):
+    if arr.shape != (n,) or not np.all(np.isfinite(arr) | (arr == unbounded if unbounded else False)):
+        also = f" (or {unbounded:g} for no limit)" if unbounded else ""
         raise ModelError(
-            f"DH column {name} must hold {n} finite numbers; got {shown(np.asarray(values).tolist())}"
+            f"DH column {name} must hold {n} finite numbers{also}; got {shown(np.asarray(values).tolist())}"
         )
     return arr
 
@@ -77,7 +82,8 @@ def from_dh(
     tool
         (4, 4) pose of the end-effector frame in DH frame ``n`` [m]; identity when omitted.
     lower, upper, velocity_limit
-        (n,) joint limits [rad], [rad/s]; +-pi and unlimited speed when omitted.
+        (n,) joint limits [rad], [rad/s]; +-pi and unlimited speed when omitted; ``-inf`` /
+        ``inf`` for a joint without angle limits (continuous), and limits past +-pi as given.
     effort_limit
         (n,) motor torque limits [N m]; unlimited when omitted.
     spacecraft
@@ -96,8 +102,8 @@ def from_dh(
     alpha_arr = _column(alpha, n, "alpha")
     d_arr = _column(d, n, "d")
     theta_arr = _column(theta, n, "theta")
-    lo = _column(lower, n, "lower", -math.pi)
-    hi = _column(upper, n, "upper", math.pi)
+    lo = _column(lower, n, "lower", -math.pi, unbounded=-math.inf)
+    hi = _column(upper, n, "upper", math.pi, unbounded=math.inf)
     vmax = np.full(n, math.inf) if velocity_limit is None else np.asarray(velocity_limit, dtype=float)
     if vmax.shape != (n,) or not np.all(vmax > 0):
         raise ModelError(

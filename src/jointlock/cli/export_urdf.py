@@ -21,7 +21,9 @@ def register(sub: argparse._SubParsersAction) -> None:
             "as a URDF file that Pinocchio, MuJoCo, Gazebo or Drake load: link 'base' (the spacecraft "
             "with --base floating), one revolute joint per healthy joint, link 'tool' at the end "
             "effector. Reading it back (jointlock, Pinocchio) gives the locked model's kinematics and "
-            "dynamics to round-off."
+            "dynamics to round-off. Read back, the healthy joints are numbered 1..n in chain order (their "
+            "names keep the arm's numbers), the base is the one asked for (--base floating: the root "
+            "link is the spacecraft), and velocity=\"0\" / effort=\"0\" mean no limit."
         ),
     )
     add_robot_arguments(p)
@@ -38,11 +40,11 @@ def run(args: argparse.Namespace) -> int:
         "robot": model.name,
         "base": "floating" if model.floating else "fixed",
         "joint_numbers": list(model.joint_numbers),
-        "locked_deg": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
     }
     if args.json:
         print_json(facts)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked_deg"].items()) or "none"
+    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked"].items()) or "none"
     print(f"wrote {path}: {model.name}, {facts['base']} base, healthy joints {facts['joint_numbers']}, locked: {locked}")
     return 0

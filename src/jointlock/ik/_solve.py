@@ -18,7 +18,8 @@ from ._numeric import ik_numeric
 from ._pose import _as_poses, wrap_angle
 from ._puma6 import ik_closed_form, puma6_geometry
 
-#: Two solutions closer than this (max wrapped joint difference) [rad] are the same.
+#: Two solutions closer than this (max wrapped joint difference) [rad] are the same: angles a
+#: whole turn apart (a joint allowed more than one turn) give one pose and count once.
 DUPLICATE_TOL = 1e-6
 
 

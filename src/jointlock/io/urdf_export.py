@@ -11,6 +11,15 @@ centre of mass and inertia about it, in the joint's frame), and a ``fixed`` join
 ``tool`` (the end effector).  Numbers are written with 17 significant digits, so that reading
 the file back gives the same model to round-off.  Locked joints appear in an XML comment
 (number, angle); they are no joints of the file.
+
+Conventions a reader of the file needs:
+
+- A joint without a speed or torque limit is written ``velocity="0"`` / ``effort="0"``, URDF's
+  common "not given" (jointlock reads 0 as no limit; Pinocchio stores the 0 as it is).
+- Read back, the movable joints are numbered 1..n in chain order (a locked joint is gone); the
+  names keep the original numbers (``joint5`` is the arm's joint 5).
+- The base is whatever the reader is asked for (``read_urdf(..., base="floating")``,
+  ``--base floating``): the root link's inertial is the spacecraft either way.
 """
 
 from __future__ import annotations
