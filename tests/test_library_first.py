@@ -221,3 +221,23 @@ def test_a_job_error_with_its_own_arguments_keeps_the_scenario_context(tmp_path)
     path.write_text('robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 10\n[workspace]\nvoxel = 1e-5\nsamples = 2000\n')
     with pytest.raises(jl.ScenarioError, match=r"voxel\.toml: job \[workspace\]: voxel 1e-05 m is too small"):
         jl.run_scenario(path)
+
+
+def test_results_print_in_one_line_and_show_their_summary_in_a_notebook():
+    """Issue 16, item 3: a result's repr is one line (not its arrays); _repr_html_ is its summary."""
+    from jointlock.jobs.ik import inverse_kinematics
+    from jointlock.jobs.kinematics import describe_configuration
+    from jointlock.jobs.workspace import study_workspace
+
+    puma = jl.load_robot("puma6")
+    results = [
+        jl.plan_halt("halt7", paper_qf=True, n_samples=101),
+        describe_configuration(puma, [0.1] * 6),
+        inverse_kinematics(puma, jl.ee_pose(puma, [0.1] * 6)),
+        study_workspace(puma, (2, 1.0), samples=1000),
+    ]
+    for res in results:
+        text = repr(res)
+        assert "\n" not in text and len(text) < 300 and text.startswith(f"<{type(res).__name__}: ")
+        page = res._repr_html_()
+        assert page.startswith("<pre>") and res.summary()[0].split(":")[0] in page

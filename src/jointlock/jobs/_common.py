@@ -16,6 +16,7 @@ and plots through :mod:`jointlock.plots`.
 from __future__ import annotations
 
 import functools
+import html
 import math
 from collections.abc import Mapping
 from pathlib import Path
@@ -42,6 +43,8 @@ class JobResult:
 
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
+        if "__repr__" not in cls.__dict__:  # set before @dataclass, which then keeps it
+            cls.__repr__ = JobResult._short_repr  # type: ignore[method-assign]
         raw = cls.__dict__.get("to_dict")
         if raw is None or getattr(raw, "_returns_plain", False):
             return
@@ -58,6 +61,19 @@ class JobResult:
 
     def summary(self) -> list[str]:  # pragma: no cover - every result overrides it
         raise NotImplementedError
+
+    def _short_repr(self) -> str:
+        """One line: the class and the first line of :meth:`summary` (the fields hold arrays:
+        ``to_dict()`` has every number)."""
+        try:
+            head = self.summary()[0]
+        except Exception:  # noqa: BLE001 - a repr must not raise
+            head = "..."
+        return f"<{type(self).__name__}: {head}>"
+
+    def _repr_html_(self) -> str:
+        """What a notebook shows: the lines the command prints, in a ``<pre>`` block."""
+        return "<pre>" + html.escape("\n".join(self.summary())) + "</pre>"
 
     def write(self, out: str | Path) -> list[str]:  # pragma: no cover - every result overrides it
         raise NotImplementedError
