@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=p000.SAMPLES,
         help=f"Monte Carlo samples K (default {p000.SAMPLES}, as 000)",
     )
-    p.add_argument("--seed", type=seed_arg, default=None, help="random seed (default: fresh, printed)")
+    p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0, as every command)")
     p.add_argument(
         "--jacobian",
         choices=("generalized", "fixed"),
