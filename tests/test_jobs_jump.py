@@ -210,3 +210,19 @@ def test_uncompensated_violations_is_empty_for_a_task_within_the_limits():
     from jointlock.planning.jump._simulate import uncompensated_violations
 
     assert uncompensated_violations(jl.load_robot("canadarm7"), JumpScenario()) == []
+
+
+def test_jump_spells_the_lock_as_every_command_does(capsys):
+    """Issue 16, item 8: ``--lock J`` (the former ``--lock-joint J`` still works); the jump study
+    locks the joint where it is, so ``J=DEG`` is refused in one line."""
+    from jointlock.cli import main
+
+    args = ["jump", "canadarm7", "--fail-at", "5", "--kappa", "0", "--json"]
+    assert main([*args, "--lock", "3"]) == 0
+    new = capsys.readouterr().out
+    assert main([*args, "--lock-joint", "3"]) == 0
+    assert capsys.readouterr().out == new and '"lock_joint": 3' in new
+    with pytest.raises(SystemExit) as exit_:
+        main([*args, "--lock", "3=20"])
+    assert exit_.value.code == 2
+    assert "locks the joint at the angle it has when it fails" in capsys.readouterr().err

@@ -39,6 +39,19 @@ from ._common import add_robot_arguments, check_out_dir, field_arg, number_arg, 
 _EXAMPLE_Q0 = p001.TASK["q0_deg"]
 
 
+def _lock_joint(text: str) -> int:
+    """``--lock J``: a joint number; ``J=DEG`` is refused (the joint locks where it is)."""
+    if "=" in text:
+        raise argparse.ArgumentTypeError(
+            f"{text!r}: the jump study locks the joint at the angle it has when it fails; give the joint "
+            "number only (e.g. --lock 2)"
+        )
+    return _JOINT_NUMBER(text)
+
+
+_JOINT_NUMBER = number_arg(1, 10_000, integer=True)
+
+
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "jump",
@@ -67,10 +80,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(needed for any robot but canadarm7; a `jointlock run` scenario file is run with `jointlock run`)",
     )
     p.add_argument(
+        "--lock",
         "--lock-joint",
-        type=number_arg(1, 10_000, integer=True),
+        dest="lock_joint",
+        type=_lock_joint,
         metavar="J",
-        help="joint that locks (from 1; default 2)",
+        help="joint that locks (from 1; default 2), at the angle it has when it fails: no =DEG here "
+        "(--lock-joint is the former spelling)",
     )
     when = p.add_mutually_exclusive_group()
     when.add_argument(

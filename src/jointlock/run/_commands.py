@@ -100,7 +100,7 @@ def job_argv(
         task = out / "jump" / "task.toml"
         argv += ["--base", fields["base"], "--scenario", str(task)]
         if "lock_joint" in fields:
-            argv += ["--lock-joint", str(fields["lock_joint"])]
+            argv += ["--lock", str(fields["lock_joint"])]
         # only the options the mode uses (the command warns about the others)
         if t["fail_at"] is not None:
             argv += ["--fail-at", _num(t["fail_at"])]
