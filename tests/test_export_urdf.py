@@ -93,3 +93,15 @@ def test_the_command_writes_the_file_and_says_what_it_holds(tmp_path, capsys):
     assert "locked: joint 4 at 0 deg, joint 2 at 10 deg" in text and text.count('type="revolute"') == 5
     assert main(["export-urdf", "halt7", "--lock", "9=0", "--out", str(out)]) == 2
     assert "joint must be one of the movable joints" in capsys.readouterr().err
+
+
+def test_odd_names_and_one_sided_limits_still_give_a_valid_file(tmp_path):
+    pin = pytest.importorskip("pinocchio")
+    arm = jl.from_dh('arm--"x"&<y>', a=[0.3, 0.2], alpha=[0, 0], d=[0, 0], convention="standard",
+                     lower=[-np.inf, 0.5], upper=[1.0, 5.5],
+                     bodies=[jl.Body(1.0, [0.1, 0, 0], [0.01] * 3)] * 2)  # fmt: skip
+    path = write_urdf(arm, tmp_path / "odd.urdf")
+    back = jl.read_urdf(path)
+    assert back.name == arm.name and back.lower[0] == pytest.approx(1.0 - 2 * np.pi)  # one turn below
+    model = pin.buildModelFromUrdf(str(path))
+    assert model.nq == 2 and model.lowerPositionLimit[0] == pytest.approx(1.0 - 2 * np.pi)

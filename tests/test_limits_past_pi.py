@@ -10,7 +10,7 @@ import pytest
 
 import jointlock as jl
 from jointlock.analysis.workspace import sample_configurations
-from jointlock.ik._pose import turns_into_limits
+from jointlock.spatial import turns_into_limits
 
 TURN = 2 * np.pi
 
@@ -74,3 +74,15 @@ def test_from_dh_takes_a_continuous_joint():
     np.testing.assert_allclose(result.solutions[0].q, [3.0, 4.0], atol=1e-9)  # one turn is one pose
     with pytest.raises(jl.ModelError, match=r"lower must hold 2 finite numbers \(or -inf for no limit\)"):
         jl.from_dh("two", a=[1.0, 0.8], alpha=[0, 0], d=[0, 0], convention="standard", lower=[np.nan, 0.5])
+
+
+def test_the_singularity_search_projects_into_limits_past_pi():
+    from jointlock.analysis.singularity._search import _project
+
+    arm = jl.from_dh("a", a=[0.3, 0.2, 0.1], alpha=[0, 0, 0], d=[0, 0, 0], convention="standard",
+                     lower=[-np.pi, 0.5, -np.pi], upper=[np.pi, 0.5 + TURN, np.pi])  # fmt: skip
+    out = _project(arm, np.array([[0.0, 4.0, 0.0], [0.0, 6.5, 0.0], [4.0, 0.2, 0.0]]))
+    np.testing.assert_allclose(out[:, 1], [4.0, 6.5, 0.2 + TURN])  # q2 stays in [0.5, 0.5 + 2 pi]
+    assert out[2, 0] == pytest.approx(4.0 - TURN)  # a [-pi, pi] joint still wraps
+    with pytest.raises(jl.ModelError, match="lower < inf, upper > -inf"):
+        jl.Joint(np.eye(4), lower=np.inf, upper=np.inf)

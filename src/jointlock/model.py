@@ -202,8 +202,10 @@ class Joint:
         if not 1e-100 < np.max(np.abs(axis)) < 1e100:  # a direction: rescaled, so that its norm cannot overflow
             axis = axis / np.max(np.abs(axis))
         lower, upper = float(self.lower), float(self.upper)
-        if math.isnan(lower) or math.isnan(upper) or lower > upper:
-            raise ModelError(f"{label}: limits must satisfy lower <= upper [rad]; got [{lower}, {upper}]")
+        if math.isnan(lower) or math.isnan(upper) or lower > upper or lower == math.inf or upper == -math.inf:
+            raise ModelError(
+                f"{label}: limits must satisfy lower <= upper [rad], lower < inf, upper > -inf; got [{lower}, {upper}]"
+            )
         if not (self.velocity_limit > 0):
             raise ModelError(f"{label}: velocity_limit must be > 0 [rad/s]; got {self.velocity_limit}")
         object.__setattr__(self, "placement", _readonly(placement))

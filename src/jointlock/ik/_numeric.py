@@ -14,8 +14,8 @@ from .._random import resolve_rng
 from ..errors import ConfigurationError
 from ..kinematics import ChainState, chain_state, ee_pose, jacobian
 from ..model import ArmModel, FloatArray
-from ..spatial import pose_error, rot_x, rotation_log
-from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, turns_into_limits
+from ..spatial import pose_error, rot_x, rotation_log, turns_into_limits
+from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses
 
 
 @dataclass(frozen=True)

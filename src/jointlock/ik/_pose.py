@@ -60,28 +60,6 @@ def wrap_angle(angle: ArrayLike) -> FloatArray:
     return (np.asarray(angle, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def turns_into_limits(angle: ArrayLike, lower: ArrayLike, upper: ArrayLike) -> FloatArray:
-    """Angles (..., n) [rad] moved by whole turns into their limits ``[lower, upper]`` (n,),
-    which may lie past +-pi: an angle inside stays as it is, one outside takes the smallest
-    move that lands it inside; where no move does (a range under one turn), the angle is
-    wrapped to the turn centred on its range.  A joint without limits is wrapped to
-    [-pi, pi) (one representative; nothing bounds it).  Nothing is clipped: the pose is kept."""
-    q = np.asarray(angle, dtype=float)
-    lo = np.broadcast_to(np.asarray(lower, dtype=float), q.shape)
-    hi = np.broadcast_to(np.asarray(upper, dtype=float), q.shape)
-    turn = 2.0 * math.pi
-    with np.errstate(invalid="ignore"):  # NaN angles (invalid IK branches) stay NaN
-        up = np.where(np.isfinite(lo), q + turn * np.ceil((lo - q) / turn), q)  # smallest >= lo
-        down = np.where(np.isfinite(hi), q - turn * np.ceil((q - hi) / turn), q)  # largest <= hi
-    moved = np.where(q < lo, up, down)
-    fits = (moved >= lo) & (moved <= hi)
-    both, free = np.isfinite(lo) & np.isfinite(hi), ~np.isfinite(lo) & ~np.isfinite(hi)
-    lo_f, hi_f = np.where(np.isfinite(lo), lo, 0.0), np.where(np.isfinite(hi), hi, 0.0)
-    mid = np.where(both, 0.5 * (lo_f + hi_f), np.where(np.isfinite(lo), lo_f + math.pi, np.where(free, 0.0, hi_f - math.pi)))
-    inside = (q >= lo) & (q <= hi) & ~free
-    return np.where(inside, q, np.where(fits & ~free, moved, wrap_angle(q - mid) + mid))
-
-
 def _as_poses(target: ArrayLike, name: str = "target") -> FloatArray:
     t = np.asarray(target, dtype=float)
     if t.ndim < 2 or t.shape[-2:] != (4, 4):

@@ -12,8 +12,8 @@ from numpy.typing import ArrayLike
 from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
-from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z
-from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, turns_into_limits, wrap_angle
+from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, turns_into_limits
+from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, wrap_angle
 
 #: Largest residual accepted when fitting the puma6 family to a model [m or rad].
 FAMILY_FIT_TOL = 1e-9

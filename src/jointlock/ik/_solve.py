@@ -163,7 +163,10 @@ def solve_ik(
         except ModelError:
             use_closed = False
     if tolerance is not None:
-        tol = np.asarray(tolerance, dtype=float)
+        try:
+            tol = np.asarray(tolerance, dtype=float)
+        except (TypeError, ValueError):
+            tol = np.full(3, np.nan)  # refused just below
         if tol.shape != (2,) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
             raise ConfigurationError(
                 f"tolerance must be (position [m], rotation [rad]), two finite numbers >= 0; got {tolerance!r}"

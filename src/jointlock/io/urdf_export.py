@@ -18,6 +18,8 @@ Conventions a reader of the file needs:
   common "not given" (jointlock reads 0 as no limit; Pinocchio stores the 0 as it is).
 - Read back, the movable joints are numbered 1..n in chain order (a locked joint is gone); the
   names keep the original numbers (``joint5`` is the arm's joint 5).
+- URDF has no one-sided angle limit: a joint limited on one side only is written one turn from
+  its finite side (:meth:`ArmModel.angle_range`), every angle it can take once.
 - The base is whatever the reader is asked for (``read_urdf(..., base="floating")``,
   ``--base floating``): the root link's inertial is the spacecraft either way.
 """
@@ -74,19 +76,20 @@ def urdf_text(model: ArmModel) -> str:
     locked = ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):.12g} deg" for lj in model.locked)
     lines = [
         '<?xml version="1.0" encoding="utf-8"?>',
-        f"<!-- written by jointlock from {model.name!r}; locked: {locked or 'none'} "
+        f"<!-- written by jointlock; locked: {locked or 'none'} "
         f"(folded into the chain, bodies merged); base: {'floating' if model.floating else 'fixed'} -->",
         f"<robot name={quoteattr(model.name)}>",
         f"  <link name={quoteattr(BASE_LINK)}>{_inertial(model.root_body)}</link>",
     ]
     parent = BASE_LINK
-    for joint, body in zip(model.joints, model.bodies):
+    lows, highs = model.angle_range()  # a one-sided limit: one turn from its finite side
+    for joint, body, low, high in zip(model.joints, model.bodies, lows, highs):
         child = f"link{joint.number}"
         continuous = math.isinf(joint.lower) and math.isinf(joint.upper)
         limit = [f'effort="{_num(joint.effort_limit if math.isfinite(joint.effort_limit) else 0.0)}"',
                  f'velocity="{_num(joint.velocity_limit if math.isfinite(joint.velocity_limit) else 0.0)}"']  # fmt: skip
         if not continuous:
-            limit = [f'lower="{_num(joint.lower)}"', f'upper="{_num(joint.upper)}"', *limit]
+            limit = [f'lower="{_num(low)}"', f'upper="{_num(high)}"', *limit]
         lines += [
             f"  <link name={quoteattr(child)}>{_inertial(body)}</link>",
             f"  <joint name={quoteattr(joint.name)} type=\"{'continuous' if continuous else 'revolute'}\">",

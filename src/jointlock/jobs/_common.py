@@ -73,7 +73,11 @@ class JobResult:
 
     def _repr_html_(self) -> str:
         """What a notebook shows: the lines the command prints, in a ``<pre>`` block."""
-        return "<pre>" + html.escape("\n".join(self.summary())) + "</pre>"
+        try:
+            text = "\n".join(self.summary())
+        except Exception as exc:  # noqa: BLE001 - a notebook display must not raise
+            text = f"{type(self).__name__}: summary unavailable ({type(exc).__name__}: {exc})"
+        return "<pre>" + html.escape(text) + "</pre>"
 
     def write(self, out: str | Path) -> list[str]:  # pragma: no cover - every result overrides it
         raise NotImplementedError

@@ -36,7 +36,7 @@ JOB_ORDER: tuple[str, ...] = (
 JOB_PAPER: dict[str, str] = {
     "halt_config": "000 §3 (HCOM)",
     "halt": "000 §4 (HMOM)",
-    "jump": "001 (NOTES-001)",
+    "jump": "001 (reconstructed: docs/reconstruction-001.md)",
     "tolerance_angle": "002 (tolerance angle)",
     "replan": "002 (re-planning)",
     "workspace": "002 (workspace)",

@@ -15,6 +15,7 @@ from ..._random import resolve_rng
 from ...errors import ScenarioError
 from ...kinematics import VMWeighting, chain_state
 from ...model import ArmModel, FloatArray, as_joint_array
+from ...spatial import turns_into_limits
 from ._general import TaskJacobianKind, task_jacobian
 
 log = logging.getLogger(__package__)
@@ -51,11 +52,12 @@ def _sigma_min(fun: Callable[[FloatArray], FloatArray], q: FloatArray) -> FloatA
 
 
 def _project(model: ArmModel, q: FloatArray) -> FloatArray:
-    """Joints with a range of a full turn or more wrap into [-pi, pi); others clip."""
+    """Back into the limits: joints whose range holds [-pi, pi] wrap into [-pi, pi); others
+    move by whole turns into their limits (past +-pi too), then clip."""
     lo, hi = np.asarray(model.lower, float), np.asarray(model.upper, float)
-    wrap = (hi - lo) >= 2.0 * np.pi - 1e-12
+    wrap = (lo <= -np.pi + 1e-12) & (hi >= np.pi - 1e-12)
     wrapped = np.mod(q + np.pi, 2.0 * np.pi) - np.pi
-    return np.where(wrap, wrapped, np.clip(q, lo, hi))
+    return np.where(wrap, wrapped, np.clip(turns_into_limits(q, lo, hi), lo, hi))
 
 
 @dataclass(frozen=True)
