@@ -299,3 +299,20 @@ def test_plots_draw_on_the_given_axes():
     assert plot_search_sigma_min(result.model, result.search, ax=ax) is ax
     fig = offscreen_figure((9.0, 4.0))
     assert plot_singular_families(result.model, result.search, fig=fig) is fig
+
+
+def test_the_docs_completeness_counts_are_the_commands():
+    """Issue 15, item 8: docs/singularity.md's completeness figures come from the code."""
+    out = io.StringIO()
+    with contextlib.redirect_stdout(out):
+        assert cli_main(["singular", "canadarm7", "--verify-conditions", "--json"]) == 0
+    c = json.loads(out.getvalue())["completeness"]
+    n, per = c["found"], c["per_condition"]
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "singularity.md").read_text()
+    assert f"- {n} of the {c['starts']} search starts converged" in doc
+    assert f"- All {c['explained']} satisfy one of Cond1–Cond5, and all {c['explained_refined']} also" in doc
+    assert (
+        f"- Per condition: Cond1 {per['cond1']} (all of them also cond1f), Cond2 {per['cond2']}, "
+        f"Cond3 {per['cond3']}, Cond4 {per['cond4']}, Cond5 {per['cond5']}." in doc
+    )
+    assert per["cond1f"] == per["cond1"]

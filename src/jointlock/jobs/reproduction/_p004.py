@@ -74,17 +74,31 @@ def rows_004() -> list[ReproductionRow]:
     )
     for name in sg.CONDITIONS:
         qs = solve_table3(name, lengths)
+        printed_q = np.radians(np.array(p004.TABLE3_DEG[name], dtype=float))
+        resolved = not np.allclose(qs, printed_q, rtol=0, atol=1e-12)
         det = float(sg.analyse_singularity(arm, qs, jacobian="virtual").det_jjt)
+        det_printed = float(sg.analyse_singularity(arm, printed_q, jacobian="virtual").det_jjt)
         ok = abs(det) < DET_SINGULAR
+        where = (
+            f"at 004's angles re-solved unrounded ({_list(np.degrees(qs).round(4).tolist())} deg; printed "
+            f"{_list(p004.TABLE3_DEG[name])})"
+            if resolved
+            else f"at {_list(p004.TABLE3_DEG[name])} deg"
+        )
         rows.append(
             ReproductionRow(
                 "004",
                 f"table3_{name}",
-                f"Table 3 {name.capitalize()}: det(J J^T) at {_list(p004.TABLE3_DEG[name])} deg",
+                f"Table 3 {name.capitalize()}: det(J J^T) {where}",
                 f"{p004.TABLE3_DET[name]:g}",
-                f"{det:.3g}",
+                f"{det:.3g}" + (f" (at the printed angles: {det_printed:.3g})" if resolved else ""),
                 REPRODUCED if ok else NOT_REPRODUCED,
-                "both round-off zero (random q: >= 2e-5); Cond3-5 angles re-solved unrounded"
+                (
+                    "both round-off zero (random q: >= 2e-5); the printed angles, rounded to 0.1 deg, are only "
+                    "near-singular"
+                    if resolved
+                    else "both round-off zero (random q: >= 2e-5)"
+                )
                 if ok
                 else "not singular",
             )

@@ -129,6 +129,12 @@ class ReproductionReport(JobResult):
         return ["result.json"]
 
 
+def within_printed(value: float, printed: float, decimals: int) -> bool:
+    """The one rule of every ``reproduce`` row: ``value`` is within half a unit of the paper's
+    last printed digit of ``printed`` (``decimals`` after the point; 0 for an integer)."""
+    return abs(value - printed) <= 0.5 * 10.0 ** (-decimals) * (1 + 1e-9)
+
+
 def _g(x: float, digits: int = 4) -> str:
     return f"{x:.{digits}g}"
 
