@@ -1,6 +1,6 @@
 """Monte Carlo workspace of an arm before and after a joint locks (002 Figs. 2-3).
 
-Joint angles are drawn uniformly within the limits (capped to +-pi), the end-effector
+Joint angles are drawn uniformly within the limits as given (:meth:`ArmModel.angle_range`), the end-effector
 positions computed in one batched pass, and the volume estimated by voxel occupancy: the
 number of cubes of side ``voxel`` [m] holding at least one sample, times ``voxel^3``.  The
 share of the full workspace that the locked arm keeps is the ratio of the two occupancies
