@@ -300,11 +300,8 @@ class ArmModel:
         """One line (the arrays stay in the fields): name, joints, locks, base and mass."""
         locked = ", ".join(f"{lj.number}: {math.degrees(lj.angle):.6g} deg" for lj in self.locked)
         base = f"floating on a {self.root_body.mass:.6g} kg spacecraft" if self.floating else "fixed base"
-        return (
-            f"ArmModel({self.name!r}, {self.dof} movable joints {list(self.joint_numbers)}"
-            + (f", locked {{{locked}}}" if locked else "")
-            + f", {base}, links {float(sum(b.mass for b in self.bodies)):.6g} kg)"
-        )
+        locks = f", locked {{{locked}}}" if locked else ""
+        return f"ArmModel({self.name!r}, {self.dof} movable joints {list(self.joint_numbers)}{locks}, {base}, links {float(self.masses.sum()):.6g} kg)"
 
     # -- sizes and limits -------------------------------------------------------------
     @property
