@@ -44,7 +44,7 @@ TOLERANCE_FILES = [
     "locked_joint_vs_gamma.png",
     "sweep.json",
 ]
-REPLAN_FILES = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json"]
+REPLAN_FILES = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json", "motion.json"]
 WORKSPACE_FILES = ["projections.png", "clouds.png", "points.npz", "workspace.json"]
 
 

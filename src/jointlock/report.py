@@ -1,8 +1,10 @@
 """A self-contained HTML page of results (sections, facts, tables, figures).
 
 Library code here never prints.  Images are embedded as base64 PNG so a report is a single
-file that opens without a network: inline CSS, no scripts, no external resources (a test
-renders it in headless Chromium and checks the console stays clean).
+file that opens without a network: inline CSS, no external resources; the only script is the
+interactive 3-D view's (plotly.js, vendored, inline, once per page, only when a section has
+one).  A test renders every example's report in headless Chromium, checks the console stays
+clean, the 3-D view is drawn and its animation advances.
 
 A report is a list of :class:`Section` objects rendered by :func:`render_html`: headings,
 paragraphs, key/value facts, tables (with kept/broken cells coloured), preformatted blocks
@@ -28,6 +30,7 @@ from .io.files import (  # noqa: F401  (re-exported: the writers used to live he
     save_figure,
 )
 from .jobs._common import AT_LIMIT
+from .plots.animation import animation_html, plotly_js
 from .plots.arm import arm_figure, arm_points, draw_arm, set_equal_3d  # noqa: F401  (re-exported)
 
 
@@ -63,7 +66,8 @@ class Section:
     tables, preformatted blocks, notes (assumptions, readings) and images (PNG bytes).
 
     A table is ``(header, rows)`` or ``(header, rows, caption)``; a cell reading ``"kept"``,
-    ``"BROKEN"``, ``"reproduced"`` or ``"not reproduced"`` is coloured.
+    ``"BROKEN"``, ``"reproduced"`` or ``"not reproduced"`` is coloured.  ``animations`` are
+    ``(caption, plotly figure)`` pairs (:func:`jointlock.plots.animation.animation_figure`).
     """
 
     title: str
@@ -74,6 +78,7 @@ class Section:
     code: list[str] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     level: int = 2
+    animations: list[tuple[str, dict[str, Any]]] = field(default_factory=list)
 
 
 _CSS = """
@@ -135,7 +140,8 @@ def render_html(
     toc: bool = False,
     footer: str = "",
 ) -> str:
-    """A self-contained HTML page (inline CSS, images as data URIs, no scripts).
+    """A self-contained HTML page (inline CSS, images as data URIs, plotly.js inline when a
+    section has an animation).
 
     ``intro`` and paragraphs may hold HTML; everything else is escaped.  ``toc`` adds a list
     of the sections at the top.
@@ -144,7 +150,9 @@ def render_html(
         "<!DOCTYPE html>",
         '<html lang="en"><head><meta charset="utf-8">',
         '<meta name="viewport" content="width=device-width, initial-scale=1">',
-        f"<title>{html.escape(title)}</title><style>{_CSS}</style></head><body>",
+        f"<title>{html.escape(title)}</title><style>{_CSS}</style>",
+        f"<script>{plotly_js()}</script>" if any(sec.animations for sec in sections) else "",
+        "</head><body>",
         f"<h1>{html.escape(title)}</h1>",
     ]
     if intro:
@@ -178,6 +186,10 @@ def render_html(
             parts.append('<div class="notes"><ul>')
             parts.extend(f"<li>{html.escape(n)}</li>" for n in sec.notes)
             parts.append("</ul></div>")
+        for caption, figure in sec.animations:
+            parts.append(
+                f"<figure>{animation_html(figure)}<figcaption>{html.escape(caption)}</figcaption></figure>"
+            )
         for caption, png in sec.images:
             uri = "data:image/png;base64," + base64.b64encode(png).decode("ascii")
             parts.append(

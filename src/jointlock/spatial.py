@@ -70,6 +70,19 @@ def axis_angle_rotation(axis: ArrayLike, angle: ArrayLike) -> FloatArray:
     return np.eye(3) + np.sin(angle) * k + (1.0 - np.cos(angle)) * (k @ k)
 
 
+def quaternion_matrix(quaternion: ArrayLike) -> FloatArray:
+    """(..., 3, 3) rotation of unit quaternions (..., 4) ``(w, x, y, z)`` (Hamilton, active)."""
+    qt = np.asarray(quaternion, dtype=float)
+    qt = qt / np.linalg.norm(qt, axis=-1, keepdims=True)
+    w, x, y, z = np.moveaxis(qt, -1, 0)
+    rows = [
+        [1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+        [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+        [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)],
+    ]
+    return np.stack([np.stack(r, axis=-1) for r in rows], axis=-2)
+
+
 def rpy_matrix(rpy: ArrayLike) -> FloatArray:
     """URDF roll-pitch-yaw (fixed axes x, y, z): ``R = Rz(yaw) Ry(pitch) Rx(roll)``, (..., 3, 3)."""
     rpy = np.asarray(rpy, dtype=float)

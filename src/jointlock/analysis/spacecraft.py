@@ -26,6 +26,7 @@ from numpy.typing import ArrayLike
 from ..dynamics import rnea
 from ..errors import ModelError
 from ..model import ArmModel, FloatArray
+from ..spatial import quaternion_matrix
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
@@ -78,6 +79,13 @@ class SpacecraftResponse:
     def com_drift_m(self) -> float:
         """Distance of the spacecraft's centre of mass from where it started, at the end [m]."""
         return float(np.linalg.norm(self.com_displacement[-1]))
+
+    def root_positions(self, com: ArrayLike) -> FloatArray:
+        """(m, 3) origin of the root (spacecraft) frame [m], in the first frame, for the
+        spacecraft's centre of mass at ``com`` (3,) [m] in its own frame: ``c + d(t) - R(t) c``
+        (the root frame starts at the origin of the first frame)."""
+        c = np.asarray(com, dtype=float)
+        return c + self.com_displacement - quaternion_matrix(self.attitude) @ c
 
     def summary(self, label: str = "spacecraft (free)") -> list[str]:
         """One line: final attitude change, peak rate, centre-of-mass drift."""

@@ -25,8 +25,10 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import ScenarioError
-from ..io.files import json_text, to_plain
+from ..io.files import atomic_write_json, json_text, to_plain
 from ..model import ArmModel
+from ..plots.animation import animation_figure
+from ..plots.motion import ArmMotion
 
 
 class JobResult:
@@ -81,6 +83,28 @@ class JobResult:
 
     def write(self, out: str | Path) -> list[str]:  # pragma: no cover - every result overrides it
         raise NotImplementedError
+
+    def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]] | None:
+        """The arm and its motions in this result (halt, jump, re-plan), for the 3-D animation
+        and ``motion.json``; None for a result without a motion."""
+        return None
+
+    def animation(self, *, title: str = "", max_frames: int = 120) -> dict[str, Any] | None:
+        """The interactive 3-D view of :meth:`arm_motions` as a plotly figure
+        (:func:`~jointlock.plots.animation.animation_figure`; write it with
+        :func:`~jointlock.plots.animation.standalone_html`); None without a motion."""
+        got = self.arm_motions()
+        if got is None:
+            return None
+        return animation_figure(got[0], got[1], title=title or f"{got[0].name}: {self.job}", max_frames=max_frames)
+
+    def _write_motions(self, out: Path) -> list[str]:
+        """``motion.json`` (:meth:`arm_motions`, what the animation reads) in ``out``."""
+        got = self.arm_motions()
+        if got is None:
+            return []
+        atomic_write_json(out / "motion.json", {"robot": got[0].name, "motions": [m.to_dict() for m in got[1]]})
+        return ["motion.json"]
 
     def to_json(self) -> str:
         """:meth:`to_dict` as JSON text (non-finite numbers as null)."""

@@ -25,9 +25,11 @@ from ..kinematics import ee_pose
 from ..locking import lock
 from ..model import ArmModel
 from ..planning.replan import DEFAULT_STEP_WEIGHT, ReplanResult, StepFlag, replan_line
+from ..plots.motion import ArmMotion
 from ..progress import Progress
 from ..robots import load_robot
 from ._common import JobResult, scenario_lock
+from ._motions import replan_motions
 
 #: Size of each figure [inch]: the joints, then the two-panel pose, error and velocity figures.
 JOINTS_FIGSIZE = (7.0, 4.0)
@@ -193,7 +195,13 @@ class ReplanJobResult(JobResult):
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (its JSON lists them as paths)."""
         names = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json"]
+        names += ["motion.json"] if self.model is not None else []
         return names + (["spacecraft_attitude.png"] if self.spacecraft_response() is not None else [])
+
+    def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]] | None:
+        """The re-planned path to animate (:func:`~jointlock.jobs._motions.replan_motions`);
+        None for a result built without its model."""
+        return None if self.model is None else replan_motions(self)
 
     def write(self, out: str | Path) -> list[str]:
         """Write ``joints.png`` (002 Figs. 11/17), ``pose.png`` (Figs. 12/18), ``error.png``
@@ -227,6 +235,7 @@ class ReplanJobResult(JobResult):
 
             fig = plot_spacecraft_responses({"re-planned path": sc}, fig=offscreen_figure((7, 5)))
             write_png(fig, folder / "spacecraft_attitude.png", dpi=110)
+        self._write_motions(folder)
         return self.file_names()
 
 

@@ -4,8 +4,9 @@ Each function takes ``ax=None`` (``fig=None`` for a figure of several axes), dra
 (making a new pyplot figure when none is given) and returns what it drew.  Nothing here
 chooses a plotting backend.  One module per job (``jl.plots.halt``, ``.halt_config``,
 ``.jump``, ``.tolerance_angle``, ``.replan``, ``.workspace``, ``.singular``), the arm in 3-D
-(``.arm``), a run report's summary figures (``.summary``) and a failure campaign's heatmaps
-and distributions (``.campaign``); the functions are also reachable
+(``.arm``), the interactive animated 3-D view (``.animation``, plotly.js, of
+``.motion.ArmMotion``), a run report's summary figures (``.summary``) and a failure campaign's
+heatmaps and distributions (``.campaign``); the functions are also reachable
 from here (``jl.plots.plot_global_torque_vs_k``).  Modules are imported on first use.
 """
 
@@ -37,6 +38,8 @@ _FUNCTIONS: dict[str, tuple[str, ...]] = {
     "singular": ("plot_search_sigma_min", "plot_singular_families", "plot_family_joint_angles"),
     "summary": ("plot_jump_before_after", "plot_halt_base_torque", "plot_replan_error"),
     "campaign": ("plot_heatmap", "plot_distribution"),
+    "animation": ("animation_figure", "animation_html", "standalone_html", "write_animation_html"),
+    "motion": ("ArmMotion", "motion_points"),
 }
 _WHERE = {name: module for module, names in _FUNCTIONS.items() for name in names}
 _MODULES = (*_FUNCTIONS, "arm")

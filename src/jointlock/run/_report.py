@@ -357,12 +357,38 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
             plot_replan_error(tr["time_s"], tr["position_error_m"], tr["gamma_deg"], ax=fig.add_subplot())
             images.append(("re-plan: tracking error and gamma", save_figure(fig, figdir, "replan_error")))
     sections.append(Section("The arm and summary figures", images=images))
+    animations = [
+        (caption, figure)
+        for job, caption in _ANIMATED.items()
+        if job in typed and (figure := typed[job].animation(title=f"{full.name}: {job}")) is not None
+    ]
+    if animations:
+        sections.append(
+            Section(
+                "The arm in motion (interactive 3-D)",
+                paragraphs=[
+                    "Drag to orbit, scroll to zoom; Play / Pause and the slider step through time. The "
+                    "locked joint is the red diamond from the instant it locks; with a free base the "
+                    "spacecraft (box of its mass and inertia) turns and drifts as the arm moves. Every "
+                    "motion is also in the job's motion.json."
+                ],
+                animations=animations,
+            )
+        )
     # paper-style figures of each job
     for job in scenario.jobs:
         imgs = _job_images(out / job)
         if imgs:
             sections.append(Section(f"Figures: {job} ({JOB_PAPER[job]})", images=imgs, level=3))
     return sections
+
+
+#: Jobs whose motion the report animates, with the caption.
+_ANIMATED = {
+    "halt": "halt: from the failure state to rest at the halt configuration",
+    "jump": "jump: the task without (kappa = 0) and with compensation, the joint locking at the failure instant",
+    "replan": "re-plan: the locked arm along the re-planned path, the target path dashed",
+}
 
 
 def _floats(values: Any) -> np.ndarray:

@@ -21,6 +21,7 @@ from ...io.files import (
     figure_png,
     npz_bytes,
 )
+from ...model import ArmModel
 from ...papers import p000
 from ...planning.halt_config import HaltConfiguration
 from ...planning.halt_motion import (
@@ -42,7 +43,9 @@ from ...plots.halt import (
     plot_joint_profiles,
     plot_spacecraft_response,
 )
+from ...plots.motion import ArmMotion
 from .._common import AT_LIMIT, JobResult, locked_deg, locked_text
+from .._motions import halt_motions
 from ._inputs import JointLimits, limits_text
 from ._text import (
     MOMENT_TEXT,
@@ -225,6 +228,10 @@ class HaltPlan(JobResult):
         t = p.times(n if n is not None else max(p.n_samples, math.ceil(p.T / SPACECRAFT_STEP_S) + 1))
         q, dq, _ = self.motion.trajectory(t)
         return spacecraft_response(p.model, t, q, dq)
+
+    def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]]:
+        """The halt to animate (:func:`~jointlock.jobs._motions.halt_motions`)."""
+        return halt_motions(self)
 
     def actuator_loads(self) -> ActuatorLoads | None:
         """Motor torques of the healthy joints and brake torques of the locked joints over the
@@ -476,7 +483,7 @@ class HaltPlan(JobResult):
         atomic_write_text(out / "halt_motion.csv", csv_text(cols))
         atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**ts, k_grid=grid, global_torque_grid=tau))
         atomic_write_json(out / "result.json", self.to_dict())
-        files = written + ["halt_motion.csv", "halt_motion.npz", "result.json"]
+        files = written + ["halt_motion.csv", "halt_motion.npz", "result.json", *self._write_motions(out)]
         if loads is not None:
             atomic_write_text(out / "actuators.csv", csv_text({"t_s": loads.t, **loads.columns()}))
             files.append("actuators.csv")

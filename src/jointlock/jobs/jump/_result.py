@@ -32,8 +32,10 @@ from ...plots.jump import (
     plot_objective_vs_kappa,
     plot_position_deviation,
 )
+from ...plots.motion import ArmMotion
 from ...plots.spacecraft import plot_spacecraft_responses
 from .._common import JobResult
+from .._motions import jump_motions
 from ._text import summary_lines
 
 Mode = Literal["fail_at", "sweep", "constant"]
@@ -132,6 +134,10 @@ class JumpJobResult(JobResult):
 
         return {"uncompensated": response(r0), "compensated": response(r1)}
 
+    def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]]:
+        """The two runs of :meth:`runs` to animate (:func:`~jointlock.jobs._motions.jump_motions`)."""
+        return jump_motions(self)
+
     def runs(self) -> tuple[Trajectory, Trajectory, float]:
         """The runs of the figures: the failure with kappa = 0 and with the compensation, and
         the failure time [s] (``fail_at``: the failure time and kappa used; otherwise the
@@ -194,7 +200,7 @@ class JumpJobResult(JobResult):
         if responses is not None:
             title = f"spacecraft (free), joint {self.task.lock_joint} locks at {t_fail:g} s"
             names.append(_save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title)))
-        return names
+        return names + self._write_motions(out)
 
 
 # -- JSON ----------------------------------------------------------------------------------------
