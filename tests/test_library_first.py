@@ -241,3 +241,39 @@ def test_results_print_in_one_line_and_show_their_summary_in_a_notebook():
         assert "\n" not in text and len(text) < 300 and text.startswith(f"<{type(res).__name__}: ")
         page = res._repr_html_()
         assert page.startswith("<pre>") and res.summary()[0].split(":")[0] in page
+        has_figure = type(res).__name__ in {"HaltPlan", "WorkspaceStudy"}  # kinematics, ik: none
+        assert ('<img src="data:image/png;base64,' in page) == has_figure
+        assert (res.main_figure() is not None) == has_figure
+
+
+QUICK_EXAMPLES = {
+    "halt_000": {"halt_config.samples": 2000, "halt.n_samples": 101},
+    "jump_001": {"jump.sweep": 6},
+    "replan_002": {"workspace.samples": 2000},
+}
+
+
+@pytest.mark.parametrize("example", sorted(QUICK_EXAMPLES))
+def test_every_job_with_figures_has_a_main_figure_for_notebooks(example):
+    """Issue 16, item 3: _repr_html_ shows the summary and the main figure, with data drawn."""
+    import base64
+    import io
+    import re
+
+    import matplotlib.image as mpimg
+
+    from jointlock.scenario import load_scenario
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    run = jl.run_scenario(load_scenario(examples / f"{example}.toml", QUICK_EXAMPLES[example]))
+    for job in run.scenario.jobs:
+        res = run[job]
+        fig = res.main_figure()
+        assert fig is not None, job
+        assert any(ax.has_data() for ax in fig.axes), job
+        page = res._repr_html_()
+        png = re.search(r'src="data:image/png;base64,([^"]+)"', page)
+        assert png is not None, job
+        pixels = mpimg.imread(io.BytesIO(base64.b64decode(png.group(1))))
+        assert pixels.std() > 0.05, job  # not a blank image
+

@@ -15,6 +15,7 @@ and plots through :mod:`jointlock.plots`.
 
 from __future__ import annotations
 
+import base64
 import functools
 import html
 import math
@@ -25,7 +26,7 @@ from typing import Any, ClassVar
 import numpy as np
 
 from ..errors import ScenarioError
-from ..io.files import atomic_write_json, json_text, to_plain
+from ..io.files import atomic_write_json, figure_png, json_text, to_plain
 from ..model import ArmModel
 from ..plots.animation import animation_figure
 from ..plots.motion import ArmMotion
@@ -73,13 +74,29 @@ class JobResult:
             head = "..."
         return f"<{type(self).__name__}: {head}>"
 
+    def main_figure(self) -> Any | None:
+        """The job's main figure (a matplotlib Figure outside pyplot: ``fig.savefig(...)``), or
+        None for a result without one (:func:`jointlock.jobs._figures.main_figure`)."""
+        from ._figures import main_figure
+
+        return main_figure(self)
+
     def _repr_html_(self) -> str:
-        """What a notebook shows: the lines the command prints, in a ``<pre>`` block."""
+        """What a notebook shows: the lines the command prints, in a ``<pre>`` block, and the
+        main figure (:meth:`main_figure`, PNG)."""
         try:
             text = "\n".join(self.summary())
         except Exception as exc:  # noqa: BLE001 - a notebook display must not raise
             text = f"{type(self).__name__}: summary unavailable ({type(exc).__name__}: {exc})"
-        return "<pre>" + html.escape(text) + "</pre>"
+        page = "<pre>" + html.escape(text) + "</pre>"
+        try:
+            fig = self.main_figure()
+            if fig is not None:
+                png = base64.b64encode(figure_png(fig, dpi=80)).decode("ascii")
+                page += f'<img src="data:image/png;base64,{png}" alt="{html.escape(type(self).__name__)}: main figure">'
+        except Exception as exc:  # noqa: BLE001 - a notebook display must not raise
+            page += f"<p>(main figure unavailable: {html.escape(type(exc).__name__)}: {html.escape(str(exc))})</p>"
+        return page
 
     def write(self, out: str | Path) -> list[str]:  # pragma: no cover - every result overrides it
         raise NotImplementedError
