@@ -158,3 +158,20 @@ def test_html_cannot_be_closed_by_a_label():
     assert frag.count("</script>") == 1 and "<\\/script>" in frag
     page = standalone_html(fig)
     assert page.count("<script>") == 2 and "src=" not in page.split("</script>", 1)[1]
+
+
+def test_full_and_locked_workspace_clouds_share_their_axis_scales():
+    """Issue 16, item 2: the two clouds compare by eye: same limits on every axis."""
+    from jointlock.plots._common import offscreen_figure
+    from jointlock.plots.workspace import plot_workspace_clouds
+
+    rng = np.random.default_rng(0)
+    full = rng.normal(size=(2000, 3)) * [1.0, 2.0, 0.5]
+    locked = full[:500] * 0.3 + [0.5, 0.0, 0.0]
+    fig = plot_workspace_clouds(full, locked, fig=offscreen_figure((11, 5)))
+    a, b = fig.axes
+    for get in ("get_xlim", "get_ylim", "get_zlim"):
+        assert getattr(a, get)() == getattr(b, get)()
+    spans = [np.ptp(getattr(a, g)()) for g in ("get_xlim", "get_ylim", "get_zlim")]
+    np.testing.assert_allclose(spans, spans[0])  # equal in x, y and z
+    assert spans[0] >= np.ptp(full[:, 1])  # the widest extent fits

@@ -210,3 +210,25 @@ def test_the_3d_view_is_drawn_and_moves(tmp_path):
         coloured = (rgb.max(axis=-1) - rgb.min(axis=-1)) > 0.25  # the arm's blue, the lock's red
         assert coloured.sum() > 500, coloured.sum()
     assert np.abs(shots[0] - shots[1]).max(axis=-1).astype(bool).sum() > 500
+
+
+def test_every_example_report_has_no_empty_section_and_no_repeated_note(example_report):
+    """Issue 16, item 2: every heading has something under it; no note twice."""
+    _, report = example_report
+    page = _page_only(report.read_text())
+    parts = re.split(r"(<h[2-4][^>]*>.*?</h[2-4]>)", page)
+    empty = [parts[i] for i in range(1, len(parts) - 1, 2) if not re.sub(r"\s", "", parts[i + 1])]
+    assert not empty, empty
+    notes = re.findall(r"<li>(.*?)</li>", page)
+    assert len(notes) == len(set(notes)), [n for n in set(notes) if notes.count(n) > 1]
+    assert " at at " not in page and not re.search(r"\(-[\d.]+ % (lower|higher)\)", page)  # signs in words
+
+
+def test_the_singularity_report_writes_the_conditions_out_and_plots_them(example_report):
+    name, report = example_report
+    if name != "singular_004":
+        pytest.skip("the conditions are the singular_004 example's")
+    page = report.read_text()
+    assert "S2 = 0 and d C3 + e C34 + h S345 = 0" in page and "equations (004 eq. 30)" in page
+    assert "sigma_min on each of 004" in page
+    assert (report.parent / "figures" / "singular_conditions.svg").is_file()

@@ -21,7 +21,7 @@ import html
 import math
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, overload
 
 import numpy as np
 
@@ -47,7 +47,7 @@ class JobResult:
     def __init_subclass__(cls, **kwargs: Any) -> None:
         super().__init_subclass__(**kwargs)
         if "__repr__" not in cls.__dict__:  # set before @dataclass, which then keeps it
-            cls.__repr__ = JobResult._short_repr  # type: ignore[method-assign]
+            cls.__repr__ = JobResult._short_repr  # type: ignore[method-assign, assignment]
         raw = cls.__dict__.get("to_dict")
         if raw is None or getattr(raw, "_returns_plain", False):
             return
@@ -132,6 +132,10 @@ class JobResult:
         return self.to_dict()
 
 
+@overload
+def scenario_lock(data: Mapping[str, Any], job: str) -> tuple[int, float]: ...
+@overload
+def scenario_lock(data: Mapping[str, Any], job: None = None) -> tuple[int, float] | None: ...
 def scenario_lock(data: Mapping[str, Any], job: str | None = None) -> tuple[int, float] | None:
     """``(joint number, angle [rad])`` of a resolved scenario's ``[failure]`` when it gives both
     (the jobs that lock a joint at a known angle), else None -- or, when ``job`` is given (a

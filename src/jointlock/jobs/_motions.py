@@ -6,7 +6,7 @@ lock) in the spacecraft's first frame, the spacecraft turning and drifting when 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -32,7 +32,8 @@ def _full(model: ArmModel, q: FloatArray) -> FloatArray:
     return model.expand(q) if drawn_arm(model) is not model else np.asarray(q, dtype=float)
 
 
-def _base(model: ArmModel, response: SpacecraftResponse | None) -> dict[str, FloatArray]:
+def _base(model: ArmModel, response: SpacecraftResponse | None) -> dict[str, Any]:
+    """``base_position`` and ``base_attitude`` of :class:`ArmMotion` (none for a held base)."""
     if response is None:
         return {}
     return {"base_position": response.root_positions(model.root_body.com), "base_attitude": response.attitude}

@@ -68,6 +68,7 @@ class InverseKinematicsReport(JobResult):
         }
         if res.nearest is not None:
             near = res.nearest_pose
+            assert near is not None  # there is a nearest solution
             out["nearest"] = {
                 **_solution(res.nearest),
                 "pose": near,

@@ -282,10 +282,9 @@ def study_workspace(
     with Progress(1, "workspace", enabled=None if progress else False) as bar:
         if locked is not None:
             joint, angle = locked
-            ws: Workspace | WorkspaceComparison = compare_workspaces(
-                model, joint, angle, samples=samples, voxel=voxel, rng=seed
-            )
-            points = ws.full
+            comparison = compare_workspaces(model, joint, angle, samples=samples, voxel=voxel, rng=seed)
+            ws: Workspace | WorkspaceComparison = comparison
+            points = comparison.full
         else:
             ws = sample_workspace(model, samples=samples, voxel=voxel, rng=seed)
             points = ws.points

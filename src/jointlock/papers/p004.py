@@ -19,6 +19,22 @@ VIRTUAL_LENGTHS: MappingProxyType[str, float] = MappingProxyType(
 #: Decimals 004 prints the virtual lengths with.
 VIRTUAL_LENGTH_DECIMALS = 2
 
+#: 004 eq. (30): the singularity conditions as printed, ``Si = sin(theta_i)``, ``Cij =
+#: cos(theta_i + theta_j)`` and so on, with the virtual lengths (hatted in 004); ``cond1f`` is
+#: ours (Cond1 with the equation 004 leaves out, ``F`` of
+#: :func:`jointlock.analysis.singularity.cond1_extra`).  The equations the code solves are
+#: :func:`jointlock.analysis.singularity.condition_equations`.
+CONDITION_TEXT: MappingProxyType[str, str] = MappingProxyType(
+    {
+        "cond1": "S4 = 0",
+        "cond2": "S2 = 0 and S6 = 0",
+        "cond3": "S2 = 0 and d C3 + e C34 + h S345 = 0",
+        "cond4": "S6 = 0 and e C5 + d C45 - a S345 = 0",
+        "cond5": "d C3 + e C34 + h S345 = 0 and a + h C345 - d S3 - e S34 = 0",
+        "cond1f": "S4 = 0 and F = 0 (ours: the factor 004 leaves out)",
+    }
+)
+
 #: 004 Table 3: one configuration per singularity condition, joint angles 1-7 [deg] as printed
 #: (the angles of Cond3-Cond5 solve a length equation and are printed rounded to 0.1 deg).
 TABLE3_DEG: MappingProxyType[str, tuple[float, ...]] = MappingProxyType(

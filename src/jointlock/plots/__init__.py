@@ -35,7 +35,7 @@ _FUNCTIONS: dict[str, tuple[str, ...]] = {
         "plot_workspace_cloud",
         "plot_workspace_clouds",
     ),
-    "singular": ("plot_search_sigma_min", "plot_singular_families", "plot_family_joint_angles"),
+    "singular": ("plot_search_sigma_min", "plot_singular_families", "plot_family_joint_angles", "plot_condition_checks"),
     "summary": ("plot_jump_before_after", "plot_halt_base_torque", "plot_replan_error"),
     "campaign": ("plot_heatmap", "plot_distribution"),
     "animation": ("animation_figure", "animation_html", "standalone_html", "write_animation_html"),

@@ -79,7 +79,7 @@ def _frame_traces(
 def _trace_styles(motion: ArmMotion, colour: str, first: bool, width: int) -> list[dict[str, Any]]:
     group = motion.label
     common = {"type": "scatter3d", "legendgroup": group, "hoverinfo": "skip"}
-    styles = [
+    styles: list[dict[str, Any]] = [
         {**common, "mode": "lines+markers", "name": motion.label, "hoverinfo": "name",
          "line": {"color": colour, "width": width}, "marker": {"size": 4, "color": colour}},
         {**common, "mode": "lines", "name": "joint axes", "showlegend": False,
@@ -141,18 +141,20 @@ def animation_figure(
         if m.target is not None and i == next(k for k, mm in enumerate(motions) if mm.target is not None):
             data.append({"type": "scatter3d", "mode": "lines", "name": m.target_label, "hoverinfo": "name",
                          "line": {"color": "black", "width": 3, "dash": "dash"}, **_xyz(m.target)})  # fmt: skip
-        if boxes[i] is not None:
+        box_i = boxes[i]
+        if box_i is not None:
             moving.append(len(data))
             name = "spacecraft" if m.moving_base else "spacecraft (held)"
-            data.append(_box_trace(boxes[i][0], colour, name if len(motions) == 1 else f"{name}, {m.label}"))
+            data.append(_box_trace(box_i[0], colour, name if len(motions) == 1 else f"{name}, {m.label}"))
 
     frames = []
     for f, t in enumerate(times):
         traces: list[dict[str, Any]] = []
         for i, (m, p) in enumerate(zip(motions, points)):
             traces += _frame_traces(p, f, m, arm, float(t), scale, i == 0, p["ee"][: f + 1])
-            if boxes[i] is not None:
-                traces.append(_xyz(_box_lines(boxes[i][f])))
+            box_i = boxes[i]
+            if box_i is not None:
+                traces.append(_xyz(_box_lines(box_i[f])))
         frames.append({"name": str(f), "data": traces, "traces": moving, "layout": {"title": {"text": _frame_title(title, motions, float(t))}}})
 
     ranges = [[float(c - radius), float(c + radius)] for c in centre]

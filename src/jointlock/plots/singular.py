@@ -43,7 +43,7 @@ def plot_search_sigma_min(model: ArmModel, search: SingularitySearch, *, ax: Any
     Returns the axis."""
     ax = new_axes(ax, SIGMA_MIN_FIGSIZE)
     start = np.linalg.svd(
-        task_jacobian(model, search.q_start, jacobian=search.base, weighting=search.weighting),  # type: ignore[arg-type]
+        task_jacobian(model, search.q_start, jacobian=search.base, weighting=search.weighting),  # type: ignore[arg-type, call-overload]
         compute_uv=False,
     )
     bins = np.linspace(-17, 1, 55)
@@ -54,6 +54,34 @@ def plot_search_sigma_min(model: ArmModel, search: SingularitySearch, *, ax: Any
     ax.set_ylabel("starts")
     ax.set_title(f"{model.name}: singularity search ({search.base} Jacobian)")
     ax.legend()
+    return ax
+
+
+def plot_condition_checks(
+    conditions: dict[str, dict[str, Any]], sigma_tol: float, *, ax: Any | None = None
+) -> Any:
+    """004's conditions checked: for each condition, the median and the largest sigma_min of
+    the configurations sampled exactly on it (log scale) against the singularity tolerance,
+    and the share found singular.  ``conditions``: ``{name: {"sigma_min_median",
+    "sigma_min_max", "fraction_singular", ...}}`` as the verification's JSON gives them.
+    A condition is sufficient when even its largest sigma_min is below the tolerance.
+    Returns the axis."""
+    ax = new_axes(ax, SIGMA_MIN_FIGSIZE)
+    names = list(conditions)
+    x = np.arange(len(names))
+    floor = 1e-18  # an exact zero drawn at the bottom of the log scale
+    median = np.maximum([float(conditions[k]["sigma_min_median"]) for k in names], floor)
+    largest = np.maximum([float(conditions[k]["sigma_min_max"]) for k in names], floor)
+    ax.vlines(x, median, largest, color="0.6", lw=2)
+    ax.scatter(x, median, color="tab:blue", zorder=3, label="median sigma_min")
+    ax.scatter(x, largest, color="tab:red", marker="^", zorder=3, label="largest sigma_min")
+    ax.axhline(sigma_tol, color="k", ls="--", lw=1, label=f"singular below {sigma_tol:g}")
+    ax.set_yscale("log")
+    ax.set_xticks(x, [f"{k}\n{100 * float(conditions[k]['fraction_singular']):.0f} %" for k in names])
+    ax.set_xlabel("condition (below: share of its sampled configurations that are singular)", fontsize=8)
+    ax.set_ylabel("sigma_min on the condition")
+    ax.set_title("004's conditions: are the configurations on them singular?", fontsize=10)
+    ax.legend(fontsize=8)
     return ax
 
 

@@ -10,7 +10,7 @@ from numpy.typing import ArrayLike
 from ._common import new_axes, new_figure
 
 #: Axes (indices into x, y, z) of each projection plane.
-PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
+PLANES: dict[Literal["xy", "xz", "yz"], tuple[int, int]] = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 #: Colours of the full arm's and the locked arm's points.
 FULL_COLOUR, LOCKED_COLOUR = "tab:blue", "tab:red"
 
@@ -96,13 +96,20 @@ def plot_workspace_clouds(
     full: ArrayLike, locked: ArrayLike | None = None, *, max_points: int = 5000, fig: Any | None = None
 ) -> Any:
     """The full arm's cloud (002 Fig. 2) and, beside it, the locked arm's (Fig. 3), each on
-    its own 3-D axis.  ``fig=None``: a new 11 x 5 inch figure.  Returns the figure."""
+    its own 3-D axis, both on the same axis limits (the full arm's box, equal in x, y and z) so
+    that the two compare by eye.  ``fig=None``: a new 11 x 5 inch figure.  Returns the figure."""
     fig = new_figure(fig, (11, 5))
     clouds = [("full arm", full, FULL_COLOUR)] + (
         [("locked arm", locked, LOCKED_COLOUR)] if locked is not None else []
     )
+    every = np.vstack([np.asarray(p, dtype=float)[:max_points] for _, p, _ in clouds])
+    centre = (every.max(axis=0) + every.min(axis=0)) / 2
+    half = max(float(np.ptp(every, axis=0).max()) / 2, 1e-3)
     for k, (title, pts, color) in enumerate(clouds):
         ax = fig.add_subplot(1, len(clouds), k + 1, projection="3d")
         plot_workspace_cloud(pts, title=title, color=color, max_points=max_points, ax=ax)
+        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+            setter(c - half, c + half)
+        ax.set_box_aspect((1, 1, 1))
     fig.tight_layout()
     return fig

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..jobs.jump import KAPPA_UNIT, _points_text
+from ..papers import p004
 from ..report import Section
 from ..scenario import Scenario
 from ._summary import _pct, _pct0
@@ -159,10 +160,11 @@ def _decide_singular(scenario: Scenario, jobs: dict[str, Any]) -> tuple[list[tup
         conds = {**r["conditions"], **r.get("refined_conditions", {})}
         dtables.append(
             (
-                ["condition", "samples", "singular", "fraction", "median sigma_min", "verdict"],
+                ["condition", "equations (004 eq. 30)", "samples", "singular", "fraction", "median sigma_min", "verdict"],
                 [
                     [
                         k,
+                        p004.CONDITION_TEXT.get(k, ""),
                         c["samples"],
                         c["singular"],
                         c["fraction_singular"],
@@ -171,7 +173,8 @@ def _decide_singular(scenario: Scenario, jobs: dict[str, Any]) -> tuple[list[tup
                     ]
                     for k, c in conds.items()
                 ],
-                "004's conditions: is every sampled configuration singular? (cond1f = S4 = 0 and F = 0, ours)",
+                "004's conditions: is every sampled configuration singular? Si = sin(theta_i), Cij = "
+                "cos(theta_i + theta_j), ..., lengths virtual (hatted in 004); cond1f is ours",
             )
         )
     elif "families" in r:

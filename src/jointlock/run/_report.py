@@ -19,6 +19,7 @@ from ..locking import lock_joints
 from ..papers import REFERENCES
 from ..plots._common import offscreen_figure
 from ..plots.arm import plot_arm
+from ..plots.singular import plot_condition_checks
 from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_replan_error
 from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
 from ..robots import load_robot
@@ -350,6 +351,11 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
             ts["t"], ts["tau_b"], ts["tau_b_k0"], label=halt_k_label(jobs["halt"]["result"]), ax=fig.add_subplot()
         )
         images.append(("base disturbance torque during the halt", save_figure(fig, figdir, "base_torque")))
+    if "singular" in jobs and isinstance(jobs["singular"]["result"].get("conditions"), dict):
+        r = jobs["singular"]["result"]
+        fig = offscreen_figure((7, 4))
+        plot_condition_checks({**r["conditions"], **r.get("refined_conditions", {})}, r["sigma_tol"], ax=fig.add_subplot())
+        images.append(("singular: sigma_min on each of 004's conditions", save_figure(fig, figdir, "singular_conditions")))
     if "replan" in jobs:
         tr = jobs["replan"]["result"].get("trajectory", {})
         if tr:

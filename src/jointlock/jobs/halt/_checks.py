@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, Literal
 
 import numpy as np
 
@@ -80,7 +80,7 @@ def _check_start_margin(
 def _check_start_torques(
     model: ArmModel,
     state: FailureState,
-    base: str,
+    base: Literal["fixed", "floating"],
     kept: JointLimits,
     margin: float,
     names: Mapping[str, Any],
@@ -90,7 +90,7 @@ def _check_start_torques(
     configuration, T and k."""
     if kept.torque is None and kept.brake is None:
         return
-    motor, brake = actuator_torques(model, state.q, state.dq, state.ddq, base=base)  # type: ignore[arg-type]
+    motor, brake = actuator_torques(model, state.q, state.dq, state.ddq, base=base)
     bad = []
     for what, values, limits, numbers in (
         ("motor torque", motor, kept.torque, model.joint_numbers),
@@ -138,7 +138,7 @@ def check_halt_settings(
     samples: int,
     solver: str,
     ga: GASettings,
-    names: Mapping[str, str] = LIBRARY_NAMES,
+    names: Mapping[str, Any] = LIBRARY_NAMES,
 ) -> None:
     """Refuse settings :func:`plan_halt` cannot use, before any work; ``names`` name them in
     the messages (:data:`LIBRARY_NAMES`, or :data:`CLI_NAMES` for the command line)."""

@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, replace
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -149,7 +149,7 @@ def _torque_limits(
     n = model.dof
     given = _limit_values(torque_max_Nm, names[0], n)
     effort = np.array([j.effort_limit for j in model.joints])
-    torque, t_src = None, ()
+    torque, t_src = None, cast(tuple[str, ...], ())
     if given is not None or np.any(np.isfinite(effort)):
         g = np.full(n, np.inf) if given is None else given
         torque = np.minimum(g, effort)
@@ -159,7 +159,7 @@ def _torque_limits(
             else (names[0] if given is not None else "none")
             for i in range(n)
         )
-    brake, b_src = None, ()
+    brake, b_src = None, cast(tuple[str, ...], ())
     if brake_max_Nm is not None:
         if not model.locked:
             raise ScenarioError(

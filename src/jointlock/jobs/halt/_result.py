@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar
+from typing import Any, ClassVar, cast
 
 import numpy as np
 
@@ -370,7 +370,7 @@ class HaltPlan(JobResult):
             lines.append(f"k* = {k_text(res)}")
             if res.k_optimum is not None:
                 opt = res.k_optimum / scale
-                cost = res.objective_value / float(halt_objective(p, res.k_optimum)) - 1.0
+                cost = cast(float, res.objective_value) / float(halt_objective(p, res.k_optimum)) - 1.0
                 lines.append(
                     f"  (the objective's own optimum is k = {opt:.6g} deg/s^6; this k costs {100 * cost:.2g} % more "
                     f"(at most {100 * res.settings['prefer_margin']:g} %) and keeps larger margins to the limits, "
@@ -441,7 +441,7 @@ class HaltPlan(JobResult):
         res, p = self.motion, self.problem
         grid, tau = global_torque_curve(res)
         ts = self.time_series()
-        figures = (
+        figures: tuple[Any, ...] = (
             (
                 "global_torque_vs_k.png",
                 (7, 4),
@@ -481,7 +481,7 @@ class HaltPlan(JobResult):
         for i, ax_name in enumerate("xyz"):
             cols[f"tau_b0_{ax_name}_Nm"] = ts["tau_b_k0"][:, i]
         atomic_write_text(out / "halt_motion.csv", csv_text(cols))
-        atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**ts, k_grid=grid, global_torque_grid=tau))
+        atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**cast(dict[str, Any], ts), k_grid=grid, global_torque_grid=tau))
         atomic_write_json(out / "result.json", self.to_dict())
         files = written + ["halt_motion.csv", "halt_motion.npz", "result.json", *self._write_motions(out)]
         if loads is not None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 import math
 from collections.abc import Mapping
 from dataclasses import replace
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -43,7 +43,7 @@ from ._result import HaltPlan
 
 #: Jacobian of the halt-configuration search (CP): 000 §3.1.2's generalized Jacobian J_F of
 #: the free-floating arm, whatever the base of the disturbance torque.
-HCOM_JACOBIAN = "generalized"
+HCOM_JACOBIAN: Literal["generalized"] = "generalized"
 
 Solver = Literal["scan", "ga", "vector"]
 
@@ -135,13 +135,12 @@ def _arm_state_and_time(
     state: FailureState | None,
     locks: Mapping[int, float] | None,
     T: float | None,
-    base: str | None,
+    base: Literal["fixed", "floating"] | None,
     state_names: tuple[str, str, str],
-) -> tuple[ArmModel, FailureState, float, str, bool]:
+) -> tuple[ArmModel, FailureState, float, Literal["fixed", "floating"], bool]:
     """:func:`plan_halt`'s arm (loaded and locked when given by name), state at failure, halt
     time and base, with 000 §5's as defaults on halt7; and whether the arm is halt7."""
-    named = isinstance(robot, str)
-    if named:
+    if isinstance(robot, str):
         if locks is None and robot == "halt7":
             locks = {j: math.radians(a) for j, a in p000.SCENARIO["lock"].items()}
         base = base or "fixed"  # 000 computes the torque with the spacecraft held
@@ -200,7 +199,7 @@ def plan_halt(
     margin: float = 0.0,
     objective: str = "mean_torque",
     prefer_margin: float = 0.0,
-    _names: Mapping[str, str] = LIBRARY_NAMES,
+    _names: Mapping[str, Any] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
     """000's halt strategy: optimal halt configuration, then optimal halt motion (000 §3-§4).
@@ -380,7 +379,7 @@ def halt_from_scenario(
     if t["qf_deg"] is not None:
         qf = joint_vector_deg(model, list(t["qf_deg"]), "halt.qf_deg")
     elif not t["paper_qf"] and "halt_config" in previous:
-        qf = np.asarray(previous["halt_config"].q_best, dtype=float)  # the typed result, in radians
+        qf = np.asarray(cast(Any, previous["halt_config"]).q_best, dtype=float)  # the typed result, in radians
         names["qf"] = "the halt_config job's optimal halt configuration"
     return plan_halt(
         model,

@@ -33,7 +33,7 @@ def singular_from_scenario(
     t = data["singular"]
     locks = scenario_locks(data)
     verify = bool(t["verify_conditions"])
-    base = t["base"] or ("virtual" if verify else "fixed")
+    base: Any = t["base"] or ("virtual" if verify else "fixed")  # checked by the scenario reader
     model = singular_model(data["robot"], locks, base)
     weighting, seed, samples = t["weighting"], int(data["seed"]), t["samples"]
     length = None if t["length"] is None else float(t["length"])  # the scenario's name for it

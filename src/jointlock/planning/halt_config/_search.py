@@ -45,7 +45,7 @@ RUNNER_UP_SEPARATION = math.radians(10.0)
 EQUIVALENT_CP_RTOL = 1e-6
 
 
-def _candidate(q: FloatArray, cp: float, ind: KinematicIndices) -> HaltCandidate:
+def _candidate(q: FloatArray, cp: float | FloatArray, ind: KinematicIndices) -> HaltCandidate:
     return HaltCandidate(
         _readonly(q),
         float(cp),
@@ -152,14 +152,20 @@ def optimal_halt_configuration(
     q = lo + (hi - lo) * generator.random((k, n))  # 000 eq. (21)-(22), one row per sample
     reachable = None if exact_reach is None else exact_reach.contains(q)
     if reachable is not None and not reachable.any():
+        assert exact_reach is not None  # reachable is only set with an exact reachability
         raise InfeasibleError(
             f"none of the {k} samples is reachable within T = {exact_reach.halt_time:g} s, although "
             f"reachable configurations exist in the box [{', '.join(f'{v:.4g}' for v in np.degrees(lo))}] .. "
             f"[{', '.join(f'{v:.4g}' for v in np.degrees(hi))}] deg (a thin set): increase samples or T"
         )
-    opts = {"jacobian": jacobian, "characteristic_length": characteristic_length}
     ind = configuration_indices(
-        model_locked, q, method="gram", batch_size=batch_size, progress=progress, **opts
+        model_locked,
+        q,
+        method="gram",
+        batch_size=batch_size,
+        progress=progress,
+        jacobian=jacobian,
+        characteristic_length=characteristic_length,
     )
     ability = fit_ability_model(ind, judgment=judgment, assignment=assignment, renormalize=renormalize, ri=ri)
     cp = ability(ind)
@@ -167,7 +173,9 @@ def optimal_halt_configuration(
     n_ok = k if reachable is None else int(reachable.sum())
 
     def exact(qs: FloatArray) -> tuple[FloatArray, KinematicIndices]:
-        i = configuration_indices(model_locked, qs, method="svd", **opts)
+        i = configuration_indices(
+            model_locked, qs, method="svd", jacobian=jacobian, characteristic_length=characteristic_length
+        )
         return ability(i), i
 
     cp0, ind0 = exact(q[order[0]])

@@ -15,6 +15,7 @@ scan's size is the solver's ``n_scan``.
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -22,7 +23,7 @@ from numpy.typing import ArrayLike
 from ..._search1d import bisect_boundary
 from ...analysis.actuators import actuator_torques
 from ...model import FloatArray
-from ._constants import CHUNK_SAMPLES, LIMIT_RTOL
+from ._constants import CHUNK_SAMPLES, LIMIT_RTOL, LimitKind
 from ._feasibility import Violation, feasible_k_intervals, minimum_halt_time
 from ._problem import HaltProblem
 
@@ -104,10 +105,11 @@ def torque_violations(problem: HaltProblem, k: float) -> tuple[Violation, ...]:
     motor, brake = actuator_torques(problem.model, q, dq, ddq, base=problem.base)
     tau_max, brake_max = problem.torque_limits()
     out = []
-    for kind, values, limits, numbers in (
+    groups: tuple[tuple[LimitKind, FloatArray, FloatArray, Sequence[int]], ...] = (
         ("torque", motor, tau_max, problem.model.joint_numbers),
         ("brake", brake, brake_max, [lj.number for lj in problem.model.locked]),
-    ):
+    )
+    for kind, values, limits, numbers in groups:
         for j, number in enumerate(numbers):
             if not math.isfinite(limits[j]):
                 continue
@@ -116,7 +118,7 @@ def torque_violations(problem: HaltProblem, k: float) -> tuple[Violation, ...]:
             if excess > LIMIT_RTOL * limits[j]:
                 out.append(
                     Violation(number, kind, float(limits[j]), float(values[i_t, j]), excess, float(t[i_t]))
-                )  # type: ignore[arg-type]
+                )
     return tuple(sorted(out, key=lambda v: -v.excess / v.limit))
 
 

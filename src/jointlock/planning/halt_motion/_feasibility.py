@@ -49,6 +49,7 @@ class Violation:
 
 def _limits(problem: HaltProblem) -> tuple[FloatArray, FloatArray]:
     """(3, n) lower and upper limits for angle, velocity, acceleration."""
+    assert problem.q_min is not None and problem.q_max is not None  # set by HaltProblem.__post_init__
     lo = np.stack([problem.q_min, -problem.dq_max, -problem.ddq_max])
     hi = np.stack([problem.q_max, problem.dq_max, problem.ddq_max])
     return lo, hi

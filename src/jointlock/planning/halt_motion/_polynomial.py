@@ -82,7 +82,7 @@ def polynomial_profile(coefficients: ArrayLike, t: ArrayLike) -> tuple[FloatArra
     d1[:, 1:] = j[1:] * powers[:, :-1]
     d2 = np.zeros_like(powers)
     d2[:, 2:] = j[2:] * (j[2:] - 1) * powers[:, :-2]
-    return tuple(np.einsum("...jc,tc->...tj", c, p) for p in (powers, d1, d2))  # type: ignore[return-value]
+    return tuple(np.einsum("...jc,tc->...tj", c, p) for p in (powers, d1, d2))
 
 
 def k_shape(t: ArrayLike, T: float) -> tuple[FloatArray, FloatArray, FloatArray]:

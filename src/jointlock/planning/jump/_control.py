@@ -43,28 +43,28 @@ def compensated_rates(
     w
         (...) manipulability of the healthy columns [m^3].
     """
-    jac = np.asarray(jac, dtype=float)
-    djac = np.asarray(djac, dtype=float)
+    jac_h: FloatArray = np.asarray(jac, dtype=float)
+    djac_h: FloatArray = np.asarray(djac, dtype=float)
     if healthy is not None:
         mask = np.asarray(healthy, dtype=bool)
-        jac = jac * mask[..., None, :]
-        djac = djac * mask[..., None, None, :]
-    gram = jac @ np.swapaxes(jac, -1, -2)
+        jac_h = jac_h * mask[..., None, :]
+        djac_h = djac_h * mask[..., None, None, :]
+    gram = jac_h @ np.swapaxes(jac_h, -1, -2)
     det = np.linalg.det(gram)
     w = np.sqrt(np.maximum(det, 0.0))
     try:
-        m = np.linalg.solve(gram, jac)  # (J J^T)^-1 J, rows of J^+ transposed
+        m = np.linalg.solve(gram, jac_h)  # (J J^T)^-1 J, rows of J^+ transposed
     except np.linalg.LinAlgError:
-        m = np.swapaxes(np.linalg.pinv(np.swapaxes(jac, -1, -2)), -1, -2)
+        m = np.swapaxes(np.linalg.pinv(np.swapaxes(jac_h, -1, -2)), -1, -2)
     # grad w = w tr((J J^T)^-1 J dJ_i^T), the formula of derivatives.manipulability_and_gradient,
     # written again here on purpose: it reuses the solve above (needed for J^+ anyway), while
     # derivatives uses an SVD.  Both agree to ~1e-13 relative away from singularities
     # (tests/test_jump_gradient.py) but not bit for bit, and every recorded jump output used this one.
-    grad = w[..., None] * np.einsum("...rc,...irc->...i", m, djac)
+    grad = w[..., None] * np.einsum("...rc,...irc->...i", m, djac_h)
     if healthy is not None:
         grad = grad * mask
     pinv = np.swapaxes(m, -1, -2)  # (..., n, 3)
-    null = grad - np.einsum("...ir,...r->...i", pinv, np.einsum("...rc,...c->...r", jac, grad))
+    null = grad - np.einsum("...ir,...r->...i", pinv, np.einsum("...rc,...c->...r", jac_h, grad))
     qdot = np.einsum("...ir,...r->...i", pinv, np.asarray(xdot, dtype=float))
     qdot = qdot + np.asarray(kappa, dtype=float)[..., None] * null
     return qdot, w

@@ -42,7 +42,9 @@ class _Problem:
     com0: FloatArray  # floating: system centre of mass at t=0 (inertial origin offset)
     lock_col: int
 
-    def evaluate(self, q: FloatArray, rb: FloatArray | None) -> tuple[FloatArray, ...]:
+    def evaluate(
+        self, q: FloatArray, rb: FloatArray | None
+    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
         """x (B,3), J (B,3,n), dJ (B,n,3,n), base angular Jacobian (B,3,n) or None."""
         model = self.model
         if not self.floating:
@@ -51,6 +53,7 @@ class _Problem:
             jac = np.swapaxes(lin, -1, -2)
             djac = linear_jacobian_derivatives(state.axes, jac)
             return state.ee_position, jac, djac, None
+        assert rb is not None  # a floating base always carries its attitude
         state = chain_state(model, q)
         jg = generalized_jacobian(model, q, state=state)[..., :3, :]
         djg = generalized_jacobian_derivatives(model, q)[..., :3, :]
@@ -65,6 +68,7 @@ class _Problem:
         state = chain_state(self.model, q)
         if not self.floating:
             return state.ee_position
+        assert rb is not None  # a floating base always carries its attitude
         rel = state.ee_position - system_com(self.model, q, state)
         return self.com0 + np.einsum("...ij,...j->...i", rb, rel)
 
@@ -202,7 +206,7 @@ def _integrate(
         out.qd = np.zeros((B, N, n))
         out.dev = np.zeros((B, N + 1))
         out.x = np.zeros((B, N + 1, 3))
-        if prob.floating:
+        if rb is not None:  # prob.floating
             out.rb = np.repeat(rb[:, None], N + 1, axis=1)
         if jump_col is not None:
             out.qd_plus = np.zeros((B, N, n))
@@ -234,6 +238,7 @@ def _integrate(
             check |= first & (k == 0)
         max_acc[sl] = np.where(check, np.maximum(max_acc[sl], acc), max_acc[sl])
         if record:
+            assert out.qd is not None and out.dev is not None and out.x is not None
             out.qd[sl, k] = qd
             out.dev[sl, k] = dev
             out.x[sl, k] = x
@@ -241,6 +246,8 @@ def _integrate(
                 mask2 = mask.copy()
                 mask2[:, jump_col] = False
                 qd2, _ = compensated_rates(jac, djac, xdc, kappa[sl, k], mask2)
+                assert out.qd_plus is not None and out.task_plus is not None
+                assert out.task_noreplan is not None
                 out.qd_plus[sl, k] = qd2
                 out.task_plus[sl, k] = np.einsum("...rc,...c->...r", jac, qd2 - qd)
                 out.task_noreplan[sl, k] = -jac[..., jump_col] * qd[:, jump_col, None]
@@ -249,13 +256,16 @@ def _integrate(
         qd_prev[sl] = qd
         q[sl] = q[sl] + dt * qd
         if rb is not None:
+            assert jb is not None  # evaluate() returns it for a floating base
             omega = np.einsum("...ij,...j->...i", jb, qd) * dt
             angle = np.linalg.norm(omega, axis=-1)
             axis = omega / np.where(angle > 0, angle, 1.0)[:, None]
             rb[sl] = rb[sl] @ axis_angle_rotation(axis, angle)
         if record:
+            assert out.q is not None
             out.q[sl, k + 1] = q[sl]
             if rb is not None:
+                assert out.rb is not None
                 out.rb[sl, k + 1] = rb[sl]
         if progress is not None:
             progress.update()
@@ -264,6 +274,7 @@ def _integrate(
         dev_end = np.linalg.norm(prob.x_nom[N] - x_end, axis=-1)
         max_dev[:] = np.maximum(max_dev, dev_end)
         if record:
+            assert out.dev is not None and out.x is not None
             out.dev[:, N] = dev_end
             out.x[:, N] = x_end
         if sc.rest_transitions:
@@ -343,6 +354,7 @@ def _post_runs(
     started from the healthy history.  Returns the outputs in sorted order and the order."""
     order = np.argsort(fsteps, kind="stable")
     ks, fs = kidx[order], fsteps[order]
+    assert healthy.q is not None  # _healthy_runs records
     q_init = healthy.q[ks, fs]
     rb_init = None if healthy.rb is None else healthy.rb[ks, fs]
     out = _integrate(prob, krows[ks], q_init, rb_init, fs, fs[:, None], [prob.lock_col], progress=progress)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -79,7 +80,8 @@ class KappaFit:
 
     def polynomial(self, t: ArrayLike) -> FloatArray:
         """The single polynomial ``p(t/T)`` (001's form), without segments or pieces."""
-        return np.polynomial.polynomial.polyval(np.asarray(t, dtype=float) / self.duration, self.coefficients)
+        tau = np.asarray(t, dtype=float) / self.duration
+        return cast(FloatArray, np.polynomial.polynomial.polyval(tau, self.coefficients))
 
     def __call__(self, t: ArrayLike) -> FloatArray:
         """Piecewise kappa(t): each piece on its span, 0 elsewhere."""
@@ -303,6 +305,7 @@ def _fit_single(
         )
         pk = np.polynomial.polynomial.polyval(tau, coef)
         table = _healthy_runs(prob, _kappa_rows(prob, pk), k_stop=int(search.fail_steps.max()) + 1)
+        assert table.qd_plus is not None and table.qd is not None  # _healthy_runs records both
         obj_fit = np.linalg.norm(table.qd_plus - table.qd, axis=-1)[np.arange(t.size), search.fail_steps]
         d = obj_fit - search.objective_zero
         inside = (pk >= search.interval[:, 0] - 1e-15) & (pk <= search.interval[:, 1] + 1e-15)
@@ -314,6 +317,7 @@ def _fit_single(
         if new_used.sum() < 2 or np.array_equal(new_used, used):
             break
         used = new_used
+    assert res is not None  # the loop runs at least once
     ordr, coef, ssr, thr, acc, seg, used, obj_fit = res
     return KappaFit(
         int(ordr), coef, ssr, float(thr), bool(acc), seg, used, obj_fit, search.objective_zero, sc.duration

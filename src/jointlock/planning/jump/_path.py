@@ -59,15 +59,15 @@ def cartesian_trapezoid(
     """
     if not (duration > 0 and 0 < blend <= duration / 2):
         raise ScenarioError(f"need 0 < blend <= duration/2; got blend={blend!r}, duration={duration!r}")
-    t = np.clip(np.asarray(t, dtype=float), 0.0, duration)
+    times: FloatArray = np.clip(np.asarray(t, dtype=float), 0.0, duration)
     v = 1.0 / (duration - blend)
     a = v / blend
-    rise = t < blend
-    fall = t > duration - blend
-    tau = duration - t
-    s = np.where(rise, 0.5 * a * t**2, np.where(fall, 1.0 - 0.5 * a * tau**2, v * (t - 0.5 * blend)))
-    sd = np.where(rise, a * t, np.where(fall, a * tau, v))
+    rise = times < blend
+    fall = times > duration - blend
+    tau = duration - times
+    s = np.where(rise, 0.5 * a * times**2, np.where(fall, 1.0 - 0.5 * a * tau**2, v * (times - 0.5 * blend)))
+    sd = np.where(rise, a * times, np.where(fall, a * tau, v))
     sdd = np.where(rise, a, np.where(fall, -a, 0.0))
     x0 = np.asarray(x0, dtype=float)
     dx = np.asarray(dx, dtype=float)
-    return CartesianPath(t, s, sd, sdd, x0 + s[..., None] * dx, sd[..., None] * dx, sdd[..., None] * dx)
+    return CartesianPath(times, s, sd, sdd, x0 + s[..., None] * dx, sd[..., None] * dx, sdd[..., None] * dx)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -54,7 +55,7 @@ class KappaPiece:
     def polynomial(self, t: ArrayLike) -> FloatArray:
         """The piece's polynomial at ``t`` [s] (no span check)."""
         u = (np.asarray(t, dtype=float) - self.center) / self.half_width
-        return np.polynomial.polynomial.polyval(u, self.coefficients)
+        return cast(FloatArray, np.polynomial.polynomial.polyval(u, self.coefficients))
 
 
 

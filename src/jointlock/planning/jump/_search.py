@@ -285,8 +285,8 @@ def _grid_starts(
         minima = minima[np.argsort(obj_f[minima], kind="stable")][: max(int(n_starts), 1)]
         if best not in minima:
             minima = np.concatenate([[best], minima[:-1]])
-        for i in minima:
-            rlo, rhi = _contiguous(feas, int(i))
+        for i in map(int, minima):
+            rlo, rhi = _contiguous(feas, i)
             s_f.append(f)
             s_lo.append(grid[max(i - 1, rlo)])
             s_x.append(grid[i])
@@ -380,6 +380,7 @@ def _refine(
 
     def obj(kap: FloatArray) -> FloatArray:
         out = _healthy_runs(prob, _kappa_rows(prob, kap), k_stop=k_stop)
+        assert out.qd_plus is not None and out.qd is not None  # _healthy_runs records both
         return np.linalg.norm(out.qd_plus - out.qd, axis=-1)[rows, fsteps]
 
     a, b, x, fx = a.copy(), b.copy(), x.copy(), fx.copy()

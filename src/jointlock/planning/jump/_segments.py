@@ -15,6 +15,7 @@ from ._search import KappaSearch
 def _jumps(prob: _Problem, fail_steps: np.ndarray, schedules: list[FloatArray], k_stop: int) -> FloatArray:
     """(S, F) ``||dqdot||`` at ``fail_steps`` in the healthy runs with the (N,) ``schedules``."""
     out = _healthy_runs(prob, np.stack(schedules), k_stop=k_stop)
+    assert out.qd_plus is not None and out.qd is not None  # _healthy_runs records both
     return np.linalg.norm(out.qd_plus - out.qd, axis=-1)[:, fail_steps]
 
 
@@ -89,6 +90,7 @@ def _decide_segments(
             kept.append(best_piece)
             used[idx[np.isfinite(merged.kappa_opt[idx])]] = True
         elif choice == "trimmed":
+            assert trimmed is not None  # "trimmed" is a candidate only when trim gave one
             kept.append(trimmed)
             used[
                 idx[

@@ -158,6 +158,7 @@ def simulate(
     for c, k in zip(cols, steps):
         healthy[k:, c] = False
     limits = _limit_report(prob, [out], [None])
+    assert out.q is not None and out.qd is not None and out.x is not None and out.dev is not None
     return Trajectory(
         prob.t,
         out.q[0],
@@ -235,6 +236,9 @@ def jump_table(model: ArmModel, scenario: JumpScenario | None = None, kappa: Arr
 
 
 def _table(prob: _Problem, krows: FloatArray, out: _RunOut) -> JumpTable:
+    # a healthy run (_healthy_runs) records all of these
+    assert out.q is not None and out.qd is not None and out.qd_plus is not None
+    assert out.task_plus is not None and out.task_noreplan is not None
     jump = out.qd_plus - out.qd
     return JumpTable(
         prob.t[:-1],

@@ -9,7 +9,7 @@ import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Literal
+from typing import Any, Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -138,7 +138,7 @@ class JumpScenario:
     @property
     def times(self) -> FloatArray:
         """(N + 1,) sample times ``k dt`` [s], k = 0..N."""
-        return np.arange(self.n_steps + 1) * self.dt
+        return cast(FloatArray, np.arange(self.n_steps + 1) * self.dt)
 
     def step_of(self, t: ArrayLike) -> np.ndarray:
         """Control step at which a failure at time(s) ``t`` [s] takes effect: ``ceil(t/dt)``."""

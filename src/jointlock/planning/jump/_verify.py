@@ -122,6 +122,7 @@ def ramp_schedule(kappa: ArrayLike, max_step: float) -> FloatArray:
 
 def _step_limits(prob: _Problem, out: _RunOut) -> np.ndarray:
     """(B, N) the healthy record keeps every limit at the steps before k (prefix check)."""
+    assert out.qd is not None and out.dev is not None  # a recorded run
     sc = prob.scenario
     slack = 1.0 + LIMIT_RTOL
     bad = np.abs(out.qd).max(-1) > sc.vmax * slack

@@ -90,7 +90,7 @@ class GammaSweep:
     gammas: FloatArray
     q: FloatArray
     q_branches: FloatArray
-    valid: FloatArray
+    valid: np.ndarray
     branch: int
     target: FloatArray
 

@@ -4,6 +4,7 @@
 from __future__ import annotations
 
 import math
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -166,7 +167,7 @@ def replan_line(
     absorbed = (perr <= EXACT_POSITION_TOL) & (rerr <= EXACT_ROTATION_TOL)
     if method == "pointwise":  # the first implementation's flag: a root on the followed branch
         absorbed |= _pointwise_absorbed(geom, nominal, gamma, b, joint, angle, gamma_tolerance, gamma_step)
-    times = np.arange(k) * cycle
+    times = cast(FloatArray, np.arange(k) * cycle)
     dq = np.gradient(q, cycle, axis=0) if k > 1 else np.zeros_like(q)
     vel = _ee_twist(actual, cycle)
 

@@ -93,7 +93,7 @@ class ReplanResult:
     q_full: FloatArray
     dq: FloatArray
     gamma: FloatArray
-    absorbed: FloatArray
+    absorbed: np.ndarray
     nominal: FloatArray
     target: FloatArray
     actual: FloatArray
