@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Every test, the paper reproductions included: creates .venv if needed (with the test
-# extra: pytest, ruff, import-linter, Pinocchio and EAIK as oracles), lints (ruff), checks the
-# import layers (lint-imports, contracts in pyproject.toml), then runs pytest.
+# extra: pytest, ruff, import-linter, mypy, Pinocchio and EAIK as oracles), lints (ruff), checks the
+# import layers (lint-imports, contracts in pyproject.toml) and the types (mypy), then runs pytest.
 set -euo pipefail
 source "$(dirname "$0")/_venv.sh" "test"
 # CI also installs Debian's chromium for the HTML rendering test (skipped where it is absent).
@@ -9,4 +9,5 @@ if [ "${CI:-}" = "true" ]; then bash scripts/system_deps.sh || echo "chromium no
 export MPLBACKEND=Agg
 .venv/bin/ruff check .
 .venv/bin/lint-imports
+.venv/bin/mypy
 exec .venv/bin/python -m pytest -q "$@"

@@ -19,7 +19,7 @@ import pytest
 
 import jointlock as jl
 from jointlock.cli import main
-from jointlock.io.files import to_plain
+from jointlock.io.files import to_plain, with_svg
 from jointlock.jobs.replan import ReplanJobResult, plan_replan, replan_from_scenario
 from jointlock.jobs.tolerance_angle import (
     ToleranceAngleResult,
@@ -38,14 +38,9 @@ Q_TARGET = [5.0, 60.0, 35.2, 10.0, -120.0, 90.0]  # 35.2 and 60 do not survive d
 Q_FROM = [0.0, 30.0, 30.0, 10.0, -80.0, 30.0]
 Q_TO = [5.0, 60.0, 65.0, 10.0, -120.0, 90.0]
 # the files each command's --out writes (as before the jobs moved into the library)
-TOLERANCE_FILES = [
-    "joints_vs_gamma.png",
-    "joints_vs_gamma_zoom.png",
-    "locked_joint_vs_gamma.png",
-    "sweep.json",
-]
-REPLAN_FILES = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json", "motion.json"]
-WORKSPACE_FILES = ["projections.png", "clouds.png", "points.npz", "workspace.json"]
+TOLERANCE_FILES = with_svg(["joints_vs_gamma.png", "joints_vs_gamma_zoom.png", "locked_joint_vs_gamma.png", "sweep.json"])
+REPLAN_FILES = with_svg(["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json", "motion.json"])
+WORKSPACE_FILES = with_svg(["projections.png", "clouds.png", "points.npz", "workspace.json"])
 
 
 def _cli(capsys, argv: list[str]) -> tuple[list[str], list[str]]:

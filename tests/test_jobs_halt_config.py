@@ -16,7 +16,7 @@ from equivalent_commands import call_subcommand, job_argv
 
 import jointlock as jl
 from jointlock.cli import main as cli_main
-from jointlock.io.files import to_plain
+from jointlock.io.files import to_plain, with_svg
 from jointlock.jobs.halt import CLI_LIMIT_NAMES, FailureState
 from jointlock.jobs.halt_config import (
     HaltConfigurationStudy,
@@ -103,9 +103,9 @@ def test_write_equals_the_command_files(results, tmp_path, capsys):
     assert cli_main(_argv("exact") + ["--out", str(cli_out)]) == 0
     lines = capsys.readouterr().out.splitlines()
     names = r.write(tmp_path / "lib")
-    assert names == ["result.json", "samples.npz", "samples.csv"] + [
+    assert names == with_svg(["result.json", "samples.npz", "samples.csv"] + [
         f"section_joint{n}.png" for n in (1, 2, 3, 5, 6, 7)
-    ]
+    ])
     assert sorted(names) == sorted(p.name for p in cli_out.iterdir())
     assert lines == r.summary() + ["", f"wrote {len(names)} files to {cli_out}: " + ", ".join(names)]
     written = json.loads((tmp_path / "lib" / "result.json").read_text())
@@ -122,9 +122,9 @@ def test_json_with_out_lists_the_files(results, tmp_path, capsys):
     printed = json.loads(capsys.readouterr().out)
     files = printed.pop("files")
     assert printed == to_plain(r.to_dict())
-    expected = ["result.json", "samples.npz", "samples.csv"] + [
+    expected = with_svg(["result.json", "samples.npz", "samples.csv"] + [
         f"section_joint{n}.png" for n in (1, 2, 3, 5, 6, 7)
-    ]
+    ])
     assert files == [str(tmp_path / name) for name in expected]
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(expected)
 

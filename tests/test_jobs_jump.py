@@ -13,7 +13,7 @@ from equivalent_commands import call_subcommand, job_argv
 
 import jointlock as jl
 from jointlock.cli import main as cli_main
-from jointlock.io.files import to_plain
+from jointlock.io.files import to_plain, with_svg
 from jointlock.jobs.jump import (
     JumpJobResult,
     jump_from_scenario,
@@ -99,7 +99,7 @@ def test_sweep_summary_and_files_equal_the_command(results, task_file, tmp_path,
 def test_write_fail_at_files(results, tmp_path):
     r = results["fail_at_kappa"]  # kappa given: no search, so no objective figure
     names = r.write(tmp_path)
-    assert names == ["results.json", "fig6_joint_velocities.png", "fig7_position_deviation.png", "motion.json"]
+    assert names == with_svg(["results.json", "fig6_joint_velocities.png", "fig7_position_deviation.png", "motion.json"])
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
     assert json.loads((tmp_path / "results.json").read_text()) == to_plain(r.to_dict())
 

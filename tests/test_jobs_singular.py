@@ -18,7 +18,7 @@ import pytest
 from equivalent_commands import call_subcommand, job_argv
 
 from jointlock.cli import main as cli_main
-from jointlock.io.files import to_plain
+from jointlock.io.files import to_plain, with_svg
 from jointlock.jobs.singular import (
     ConditionVerificationResult,
     SingularityResult,
@@ -197,7 +197,7 @@ def test_search_to_dict_and_summary_equal_the_command(name):
 def test_search_writes_the_files_of_the_command(tmp_path):
     result = _search("halt7_two_starts")
     names = result.write(tmp_path / "lib")
-    assert names == ["search.json", "sigma_min.png", "families.png", "joint_angles.png"]
+    assert names == with_svg(["search.json", "sigma_min.png", "families.png", "joint_angles.png"])
     assert sorted(p.name for p in (tmp_path / "lib").iterdir()) == sorted(names)
     written = json.loads((tmp_path / "lib" / "search.json").read_text())
     assert written == to_plain(result.search_json())

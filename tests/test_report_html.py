@@ -232,3 +232,33 @@ def test_the_singularity_report_writes_the_conditions_out_and_plots_them(example
     assert "S2 = 0 and d C3 + e C34 + h S345 = 0" in page and "equations (004 eq. 30)" in page
     assert "sigma_min on each of 004" in page
     assert (report.parent / "figures" / "singular_conditions.svg").is_file()
+
+
+def test_every_figure_of_every_example_is_also_svg(example_report):
+    """Issue 16, item 2: each PNG a run writes has an SVG beside it, a well-formed document
+    under 2 MB (dense scatters drawn as an image inside it)."""
+    import xml.etree.ElementTree as ET
+
+    _, report = example_report
+    pngs = sorted(report.parent.rglob("*.png"))
+    assert pngs
+    for png in pngs:
+        svg = png.with_suffix(".svg")
+        assert svg.is_file(), svg
+        assert ET.parse(svg).getroot().tag.endswith("svg")
+        assert svg.stat().st_size < 2_000_000, (svg, svg.stat().st_size)
+
+
+def test_svg_figures_are_reproducible(tmp_path):
+    from jointlock.io.files import write_figure
+    from jointlock.plots._common import offscreen_figure
+
+    fig = offscreen_figure((4, 3))
+    ax = fig.add_subplot()
+    ax.plot([0, 1], [1, 0])
+    ax.scatter(*np.random.default_rng(0).normal(size=(2, 5000)), s=1)
+    assert write_figure(fig, tmp_path / "a", "f.png") == ["f.png", "f.svg"]
+    write_figure(fig, tmp_path / "b", "f.png")
+    first = (tmp_path / "a" / "f.svg").read_bytes()
+    assert first == (tmp_path / "b" / "f.svg").read_bytes()
+    assert b"<image" in first  # the 5000 points rasterized, the line and axes vector

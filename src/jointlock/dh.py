@@ -148,7 +148,7 @@ def from_dh(
     joints = tuple(
         Joint(
             placements[i],
-            (0.0, 0.0, 1.0),
+            np.array([0.0, 0.0, 1.0]),
             lo[i],
             hi[i],
             vmax[i],

@@ -371,7 +371,12 @@ def rnea(
     check_overflow(rows, "rnea", dq=dqf, ddq=ddqf)
     tau, force, moment, acc_base, nu0 = rows
     return InverseDynamics(
-        *(_rows_out(rows, n_samples, batch) for rows in (tau, force, moment, acc_base, nu0)), point
+        _rows_out(tau, n_samples, batch),
+        _rows_out(force, n_samples, batch),
+        _rows_out(moment, n_samples, batch),
+        _rows_out(acc_base, n_samples, batch),
+        _rows_out(nu0, n_samples, batch),
+        point,
     )
 
 

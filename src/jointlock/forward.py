@@ -95,18 +95,14 @@ class ChainState:
         m = np.asarray(mask, dtype=bool).reshape(-1)
         q = np.where(m.reshape(a.batch_shape)[..., None], a.q, b.q)
         q.setflags(write=False)
-        return ChainState(
-            a.batch_shape,
-            *(
-                np.where(m, x, y)
-                for x, y in zip(
-                    (a.soa_rotations, a.soa_positions, a.soa_axes, a.soa_ee_rotation, a.soa_ee_position),
-                    (b.soa_rotations, b.soa_positions, b.soa_axes, b.soa_ee_rotation, b.soa_ee_position),
-                )
-            ),
-            q,
-            a.model,
+        rotations, positions, axes, ee_rotation, ee_position = (
+            np.where(m, x, y)
+            for x, y in zip(
+                (a.soa_rotations, a.soa_positions, a.soa_axes, a.soa_ee_rotation, a.soa_ee_position),
+                (b.soa_rotations, b.soa_positions, b.soa_axes, b.soa_ee_rotation, b.soa_ee_position),
+            )
         )
+        return ChainState(a.batch_shape, rotations, positions, axes, ee_rotation, ee_position, q, a.model)
 
 
 def _kinematic_key(model: ArmModel) -> bytes:
@@ -168,6 +164,7 @@ def chain_state(model: ArmModel, q: ArrayLike) -> ChainState:
             out[...] = a + sin[i] * _rotate_soa(k, a) + (1.0 - cos[i]) * _rotate_soa(k @ k, a)
             axes[i] = np.einsum("rjN,j->rN", out, axis)
         rot, pos = rotations[i], positions[i]
+    assert rot is not None and pos is not None  # a chain has joints (q.reshape(-1, 0) refuses none)
     tool = model.tool
     ee_rot = _rotate_soa(tool[:3, :3], rot)
     ee_pos = pos + np.einsum("rjN,j->rN", rot, tool[:3, 3])

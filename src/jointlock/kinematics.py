@@ -21,7 +21,7 @@ taking ``q`` and ``state=`` uses the state only at the angles it was computed at
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -175,7 +175,7 @@ def base_jacobian(model: ArmModel, q: ArrayLike | None, state: ChainState | None
     """
     h = momentum_matrix(model, q, state)
     try:
-        return -np.linalg.solve(h[..., :, :6], h[..., :, 6:])
+        return cast(FloatArray, -np.linalg.solve(h[..., :, :6], h[..., :, 6:]))  # numpy stubs: floating[Any]
     except np.linalg.LinAlgError:
         raise ModelError(
             f"model {model.name!r}: the free-floating system's inertia is singular (e.g. collinear "

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -479,8 +480,8 @@ def chain_from_placements(
     n = len(placements)
     joints = tuple(
         Joint(
-            placement=placements[i],
-            axis=(axes[i] if axes is not None else (0.0, 0.0, 1.0)),
+            placement=cast(FloatArray, placements[i]),  # Joint converts and checks
+            axis=cast(FloatArray, axes[i] if axes is not None else (0.0, 0.0, 1.0)),
             lower=(lower[i] if lower is not None else -math.pi),
             upper=(upper[i] if upper is not None else math.pi),
             number=i + 1,
@@ -492,7 +493,7 @@ def chain_from_placements(
         name=name,
         joints=joints,
         bodies=tuple(bodies),
-        tool=np.eye(4) if tool is None else tool,
+        tool=np.eye(4) if tool is None else cast(FloatArray, tool),  # ArmModel converts and checks
         root_body=root_body if root_body is not None else Body(0.0, name="root"),
         floating=floating,
         description=description,

@@ -11,7 +11,7 @@ import functools
 import math
 from collections.abc import Callable
 from pathlib import Path
-from typing import Literal
+from typing import Literal, cast
 
 import numpy as np
 
@@ -19,7 +19,7 @@ from .bounds import shown
 from .dh import from_dh
 from .errors import ModelError
 from .io.files import check_path_text
-from .model import ArmModel, Body, Joint
+from .model import ArmModel, Body, FloatArray, Joint
 from .spatial import rot_x, translation
 
 BaseMode = Literal["fixed", "floating"]
@@ -35,7 +35,9 @@ def _check_base(base: str) -> None:
 #: Default spacecraft for ``halt7``.  000 gives no base: this one is ours, a 2000 kg body
 #: shaped like a 2 m cube (I = m s^2 / 6), its centre of mass 1 m below the arm's mounting
 #: point (the root frame origin).
-HALT7_SPACECRAFT = Body(2000.0, [0.0, 0.0, -1.0], np.diag([2000.0 * 4 / 6] * 3), name="spacecraft")
+HALT7_SPACECRAFT = Body(
+    2000.0, np.array([0.0, 0.0, -1.0]), np.diag([2000.0 * 4 / 6] * 3), name="spacecraft"
+)
 
 
 def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
@@ -77,7 +79,10 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
         (42.5, (0.89, 0.89, 0.05), (0.0, 0.0, -0.25)),
         (42.5, (1.28, 1.28, 0.05), (0.0, 0.0, -0.3)),
     ]
-    bodies = [Body(m, com, inertia, name=f"link{i + 1}") for i, (m, inertia, com) in enumerate(table7)]
+    bodies = [
+        Body(m, np.array(com), np.array(inertia), name=f"link{i + 1}")
+        for i, (m, inertia, com) in enumerate(table7)
+    ]
     return from_dh(
         "halt7",
         a=a,
@@ -192,7 +197,9 @@ PUMA6_D6 = 0.382
 
 #: Default spacecraft for ``puma6`` (002 has a fixed base; this one is ours): 500 kg, a
 #: 1.2 m cube (I = m s^2 / 6), centre of mass 0.8 m below the root frame origin.
-PUMA6_SPACECRAFT = Body(500.0, [0.0, 0.0, -0.8], np.diag([500.0 * 1.44 / 6] * 3), name="spacecraft")
+PUMA6_SPACECRAFT = Body(
+    500.0, np.array([0.0, 0.0, -0.8]), np.diag([500.0 * 1.44 / 6] * 3), name="spacecraft"
+)
 
 
 def puma6(*, base: BaseMode = "fixed") -> ArmModel:
@@ -224,7 +231,8 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
     bodies = []
     for i in range(6):
         fixed = translation([0.0, 0.0, d[i]]) @ translation([a[i], 0.0, 0.0]) @ rot_x(alpha[i])
-        previous_origin = np.linalg.inv(fixed)[:3, 3]  # previous DH origin, in DH frame i
+        inverse = cast(FloatArray, np.linalg.inv(fixed))  # numpy stubs: floating[Any]
+        previous_origin = inverse[:3, 3]  # previous DH origin, in DH frame i
         length = float(np.linalg.norm(previous_origin))
         rod = masses[i] * max(length, 0.1) ** 2 / 12.0
         bodies.append(Body(masses[i], 0.5 * previous_origin, np.diag([rod, rod, rod]), name=f"link{i + 1}"))

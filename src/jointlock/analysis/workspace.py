@@ -18,7 +18,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .._random import resolve_rng
 from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M, as_real
@@ -289,7 +289,7 @@ def compare_workspaces(
     )
 
 
-def _rows_in(a: FloatArray, b: FloatArray) -> FloatArray:
+def _rows_in(a: FloatArray, b: FloatArray) -> NDArray[np.bool_]:
     """(len(a),) bool: row of ``a`` present in ``b`` (integer rows)."""
     if a.size == 0:
         return np.zeros(0, dtype=bool)

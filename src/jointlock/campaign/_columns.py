@@ -10,10 +10,11 @@ time or a sweep.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
+from numpy.typing import NDArray
 
 from ..errors import CampaignError
 from ._cases import CasePlan
@@ -108,13 +109,14 @@ def _reduce(value: Any, reducer: str) -> Any:
     if reducer == "last":
         return numbers[-1]
     arr = np.asarray(numbers, dtype=float)
-    out = {
+    reducers: dict[str, Callable[[NDArray[np.float64]], Any]] = {
         "max": np.max,
         "min": np.min,
         "mean": np.mean,
         "sum": np.sum,
         "absmax": lambda a: np.max(np.abs(a)),
-    }[reducer](arr)
+    }
+    out = reducers[reducer](arr)
     return float(out)
 
 

@@ -139,6 +139,7 @@ class Ledger:
                 "VALUES (?, ?, ?, ?, ?, ?, ?)",
                 (_now(), engine, workers, planned, to_run, source, version),
             )
+        assert cur.lastrowid is not None  # set by the INSERT
         return int(cur.lastrowid)
 
     def finish_run(self, run_id: int, ok: int, failed: int, stopped_by: str | None) -> None:

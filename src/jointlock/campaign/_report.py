@@ -134,7 +134,7 @@ class CampaignReport:
     def html(self, folder: Path | None = None) -> str:
         """The report page (links to the worst cases' files relative to ``folder``)."""
         s, t = self.status, self.table
-        sections = [_overview(s, self.spec), _varied(self.spec)]
+        sections: list[rp.Section | None] = [_overview(s, self.spec), _varied(self.spec)]
         ok_rows = [r for r in t.rows if r["status"] == "ok"]
         numeric = [m for m in t.metrics if is_numeric([r.get(m) for r in ok_rows])]
         sections.append(_headline(ok_rows, numeric))

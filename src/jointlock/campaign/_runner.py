@@ -212,7 +212,7 @@ def run_campaign(
             finished |= ledger.finished_keys(status="error") - ledger.keys_with_error(WORKER_LOST)
         todo = [c for c in plan.cases if c.key not in finished]
         own = not isinstance(engine, Engine)  # made here: closed here
-        if not own:
+        if isinstance(engine, Engine):
             pass
         elif not todo:
             engine = dataclasses.replace(in_process(), description="none (nothing left to run)")
@@ -392,9 +392,9 @@ class _Coordinator:
             self.counts["ok" if o.ok else "failed"] += 1
             self.case_seconds += o.seconds
         if self.unknown_columns is None:
-            first = next((o for o in outcomes if o.ok and o.result is not None), None)
+            first = next((o.result for o in outcomes if o.ok and o.result is not None), None)
             if first is not None:
-                self.unknown_columns = tuple(missing_columns(decode_result(first.result), self.columns))
+                self.unknown_columns = tuple(missing_columns(decode_result(first), self.columns))
         failed = self.counts["failed"]
         self.bar.update(len(outcomes), note=f"{failed} failed" if failed else "")
 

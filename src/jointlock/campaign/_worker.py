@@ -161,6 +161,7 @@ def _run_case(
     spec: CampaignSpec, key: str, overrides: Mapping[str, Any], seed: int, columns: tuple[str, ...], worker: str
 ) -> CaseOutcome:
     start = time.perf_counter()
+    outcome: tuple[dict[str, Any] | None, bytes | None, str | None, str | None]
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         try:

@@ -18,7 +18,7 @@ from ..errors import CampaignError
 from ._common import check_out_dir, int_at_least, print_json
 
 if TYPE_CHECKING:
-    from ..campaign import Engine
+    from ..campaign import CampaignSpec, Engine
 
 DESCRIPTION = (
     "Sweep failure cases: a campaign file (TOML) names a base scenario and what to vary with the names "
@@ -118,8 +118,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     report.set_defaults(func=_report)
 
 
-def _out(args: argparse.Namespace, spec: object) -> Path:
-    out = check_out_dir(args.out) if args.out else spec.default_out()  # type: ignore[attr-defined]
+def _out(args: argparse.Namespace, spec: CampaignSpec) -> Path:
+    out = check_out_dir(args.out) if args.out else spec.default_out()
+    assert out is not None  # check_out_dir returns None for no path only
     return Path(out)
 
 

@@ -7,6 +7,7 @@ from __future__ import annotations
 import argparse
 import math
 from pathlib import Path
+from typing import Any
 
 from ..io.urdf_export import write_urdf
 from ._common import add_robot_arguments, model_from_args, print_json
@@ -35,7 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     model = model_from_args(args)
     path = write_urdf(model, args.out)
-    facts = {
+    facts: dict[str, Any] = {
         "file": str(path),
         "robot": model.name,
         "base": "floating" if model.floating else "fixed",

@@ -241,7 +241,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     ]
     if missing:
         which = (
-            f"halt7 with {locked_text({j: math.degrees(a) for j, a in locks.items()})}"
+            f"halt7 with {locked_text({str(j): math.degrees(a) for j, a in locks.items()})}"
             if args.robot == "halt7"
             else "this robot"
         )

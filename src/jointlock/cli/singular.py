@@ -115,7 +115,7 @@ def run(args: argparse.Namespace) -> int:
     if args.out is not None and not args.search:
         warnings.warn("--out: nothing written (only --search writes files: search.json and plots)", UserWarning, stacklevel=1)
     if args.verify_conditions:
-        base = args.base or "virtual"
+        base: sg.BaseKind = args.base or "virtual"
         if base == "floating":
             raise ScenarioError(
                 "--verify-conditions needs --base virtual (004's case) or fixed; got floating"

@@ -8,7 +8,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from .._random import resolve_rng
 from ..errors import ConfigurationError
@@ -43,7 +43,7 @@ class NumericIK:
     gamma: FloatArray
     position_error: FloatArray
     rotation_error: FloatArray
-    exact: FloatArray
+    exact: NDArray[np.bool_]
     iterations: int
     seed: int | None = None
 

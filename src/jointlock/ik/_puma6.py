@@ -7,7 +7,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..errors import ModelError
 from ..kinematics import ee_pose
@@ -113,7 +113,7 @@ def puma6_geometry(model: ArmModel) -> Puma6Geometry:
         raise ModelError(
             f"model {model.name!r} is not of the puma6 family (orientation does not match 002 Table 1)"
         )
-    basis = [_dh_chain(*unit, q_full)[..., 5, :3, 3] for unit in ((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0))]
+    basis = [_dh_chain(a, d, e, q_full)[..., 5, :3, 3] for a, d, e in ((1.0, 0, 0), (0, 1.0, 0), (0, 0, 1.0))]
     cols = basis + [r06[..., :, 0], r06[..., :, 1]]
     mat = np.stack(cols, axis=-1).reshape(-1, 5)
     rhs = actual[..., :3, 3].reshape(-1)
@@ -142,6 +142,7 @@ def _position_branches(geom: Puma6Geometry, pw: FloatArray, lock: tuple[int, flo
     """Joints 1-3 from the wrist centre ``pw`` (..., 3): arrays (..., B, 3) and validity."""
     a2, d4 = geom.a2, geom.d4
     base = np.arctan2(pw[..., 1], pw[..., 0])
+    t1: FloatArray  # (numpy's stubs give np.full(base.shape + (1,), ...) a 0-d shape)
     if lock is not None and lock[0] == 1:
         t1 = np.full(base.shape + (1,), lock[1])
     else:
@@ -209,7 +210,7 @@ def _wrist_branches(m: FloatArray, lock: tuple[int, float] | None) -> FloatArray
     return np.stack([t4, t5, t6], axis=-1)
 
 
-def puma6_branches(geometry: Puma6Geometry, target06: ArrayLike) -> tuple[FloatArray, FloatArray]:
+def puma6_branches(geometry: Puma6Geometry, target06: ArrayLike) -> tuple[FloatArray, NDArray[np.bool_]]:
     """Every closed-form branch for targets given as DH frame 6 (tool removed).
 
     Parameters
@@ -270,10 +271,10 @@ class IKBranches:
 
     q: FloatArray
     q_full: FloatArray
-    valid: FloatArray
+    valid: NDArray[np.bool_]
     position_error: FloatArray
     rotation_error: FloatArray
-    exact: FloatArray
+    exact: NDArray[np.bool_]
 
 
 def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:

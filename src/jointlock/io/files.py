@@ -287,11 +287,49 @@ def figure_png(fig: Any, dpi: int = PNG_DPI) -> bytes:
     return buf.getvalue()
 
 
-def figure_svg(fig: Any) -> bytes:
-    """The figure as SVG (text kept as paths, so it renders the same everywhere)."""
+#: A scatter of more points than this is drawn as an image inside the SVG (axes, labels and
+#: lines stay vector): a workspace cloud or 36,000 samples as vector marks would be megabytes.
+SVG_RASTER_POINTS = 2000
+
+
+def figure_svg(fig: Any, *, tight: bool = True) -> bytes:
+    """The figure as SVG (text kept as paths, so it renders the same everywhere); scatters of
+    more than :data:`SVG_RASTER_POINTS` points rasterized at the PNG's resolution."""
+    for ax in fig.axes:
+        dense = [a for a in ax.collections if len(getattr(a, "get_offsets", lambda: ())()) > SVG_RASTER_POINTS]
+        if dense and ax.name == "3d":  # mplot3d rasterizes by z-order only
+            ax.set_rasterization_zorder(max(a.get_zorder() for a in dense) + 0.5)
+        for artist in dense if ax.name != "3d" else ():
+            artist.set_rasterized(True)
+    import matplotlib
+
     buf = io.BytesIO()
-    fig.savefig(buf, format="svg", bbox_inches="tight")
+    # no date and fixed element ids: the same figure gives the same bytes (diffable, reproducible)
+    with matplotlib.rc_context({"svg.hashsalt": "jointlock"}):
+        fig.savefig(buf, format="svg", dpi=PNG_DPI, metadata={"Date": None},
+                    **({"bbox_inches": "tight"} if tight else {}))  # fmt: skip
     return buf.getvalue()
+
+
+def with_svg(names: list[str]) -> list[str]:
+    """``names`` with each ``.png`` followed by its ``.svg`` (what :func:`write_figure` writes)."""
+    return [m for n in names for m in ((n, n[: -len(".png")] + ".svg") if n.endswith(".png") else (n,))]
+
+
+def write_figure(fig: Any, folder: str | Path, name: str, *, dpi: int = PNG_DPI, tight: bool = True) -> list[str]:
+    """Write the figure as ``folder/name`` (a ``.png`` name) and beside it as SVG (for print
+    and reviews: :func:`figure_svg`), atomically; returns both names.  ``tight``: crop to the
+    drawn content (else the figure's own size, as :func:`write_png`).  The figure is left open."""
+    if not name.endswith(".png"):
+        raise ValueError(f"write_figure writes a .png name (and its .svg); got {name!r}")
+    folder = Path(folder)
+    if tight:
+        atomic_write_bytes(folder / name, figure_png(fig, dpi=dpi))
+    else:
+        write_png(fig, folder / name, dpi=dpi)
+    svg = name[: -len(".png")] + ".svg"
+    atomic_write_bytes(folder / svg, figure_svg(fig, tight=tight))
+    return [name, svg]
 
 
 def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = PNG_DPI, svg: bool = True) -> bytes:

@@ -150,10 +150,11 @@ def read_urdf(
     name
         Model name; default: the ``<robot name>``.
     """
-    text: str | bytes = str(source)
+    source_text = str(source)
+    text: str | bytes = source_text
     label = "URDF"
-    if not str(text).lstrip().startswith("<"):
-        path = check_path_text(text, "URDF file", ModelError)
+    if not source_text.lstrip().startswith("<"):
+        path = check_path_text(source_text, "URDF file", ModelError)
         label = shorten(str(path))
         text = _urdf_text(path, label)
     try:
@@ -185,14 +186,16 @@ def read_urdf(
         if kind not in ("revolute", "continuous", "fixed"):
             raise ModelError(f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, fixed)")
         parent_el, child_el = jel.find("parent"), jel.find("child")
-        if parent_el is None or child_el is None or not parent_el.get("link") or not child_el.get("link"):
+        parent = parent_el.get("link") if parent_el is not None else None
+        child = child_el.get("link") if child_el is not None else None
+        if not parent or not child:
             raise ModelError(f"{where}: needs <parent link=...> and <child link=...>")
-        parent, child = parent_el.get("link"), child_el.get("link")
         for role, lname in (("parent", parent), ("child", child)):
             if lname not in links:
                 raise ModelError(f"{where}: {role} link {shown(lname)} is not defined")
+        axis_el = jel.find("axis")
         axis = _floats(
-            jel.find("axis").get("xyz") if jel.find("axis") is not None else None,
+            axis_el.get("xyz") if axis_el is not None else None,
             3,
             f"{where} <axis>",
             [1, 0, 0],

@@ -23,7 +23,7 @@ import numpy as np
 from .._deprecate import renamed_keyword
 from ..analysis.ability import INDEX_NAMES, Assignment, JacobianKind
 from ..errors import ConfigurationError
-from ..io.files import atomic_write_bytes, atomic_write_json, figure_png
+from ..io.files import atomic_write_bytes, atomic_write_json, with_svg, write_figure
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..papers import p000
@@ -232,7 +232,7 @@ class HaltConfigurationStudy(JobResult):
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (the command's JSON lists them as paths)."""
         names = ["result.json", "samples.npz", "samples.csv"]
-        return names + [f"section_joint{number}.png" for number in self.configuration.joint_numbers]
+        return with_svg(names + [f"section_joint{number}.png" for number in self.configuration.joint_numbers])
 
     def write(self, out: str | Path) -> list[str]:
         """Write ``result.json``, ``samples.npz``, ``samples.csv`` and one section plot per
@@ -253,9 +253,8 @@ def write_section_plots(result: Any, folder: str | Path, *, dpi: int = SECTION_D
     configuration = getattr(result, "configuration", result)
     paths = []
     for number, fig in zip(configuration.joint_numbers, section_figures(configuration)):
-        path = folder / f"section_joint{number}.png"
-        atomic_write_bytes(path, figure_png(fig, dpi=dpi))
-        paths.append(path)
+        write_figure(fig, folder, f"section_joint{number}.png", dpi=dpi)
+        paths.append(folder / f"section_joint{number}.png")
     return paths
 
 

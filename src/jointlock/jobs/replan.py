@@ -20,7 +20,7 @@ from numpy.typing import ArrayLike
 
 from ..analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ..errors import ScenarioError
-from ..io.files import atomic_write_json, atomic_write_text, write_png
+from ..io.files import atomic_write_json, atomic_write_text, with_svg, write_figure
 from ..kinematics import ee_pose
 from ..locking import lock
 from ..model import ArmModel
@@ -196,7 +196,7 @@ class ReplanJobResult(JobResult):
         """The names :meth:`write` writes (its JSON lists them as paths)."""
         names = ["joints.png", "pose.png", "error.png", "velocity.png", "trajectory.csv", "plan.json"]
         names += ["motion.json"] if self.model is not None else []
-        return names + (["spacecraft_attitude.png"] if self.spacecraft_response() is not None else [])
+        return with_svg(names + (["spacecraft_attitude.png"] if self.spacecraft_response() is not None else []))
 
     def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]] | None:
         """The re-planned path to animate (:func:`~jointlock.jobs._motions.replan_motions`);
@@ -220,13 +220,13 @@ class ReplanJobResult(JobResult):
         fig = offscreen_figure(JOINTS_FIGSIZE)
         plot_replan_joints(self.plan, ax=fig.add_subplot())
         fig.tight_layout()
-        write_png(fig, folder / "joints.png", dpi=110)
+        write_figure(fig, folder, "joints.png", tight=False)
         for name, plot in (
             ("pose.png", plot_replan_pose),
             ("error.png", plot_replan_errors),
             ("velocity.png", plot_replan_velocity),
         ):
-            write_png(plot(self.plan, fig=offscreen_figure(PANELS_FIGSIZE)), folder / name, dpi=110)
+            write_figure(plot(self.plan, fig=offscreen_figure(PANELS_FIGSIZE)), folder, name, tight=False)
         atomic_write_text(folder / "trajectory.csv", self.trajectory_csv())
         atomic_write_json(folder / "plan.json", self.to_dict())
         sc = self.spacecraft_response()
@@ -234,7 +234,7 @@ class ReplanJobResult(JobResult):
             from ..plots.spacecraft import plot_spacecraft_responses
 
             fig = plot_spacecraft_responses({"re-planned path": sc}, fig=offscreen_figure((7, 5)))
-            write_png(fig, folder / "spacecraft_attitude.png", dpi=110)
+            write_figure(fig, folder, "spacecraft_attitude.png", tight=False)
         self._write_motions(folder)
         return self.file_names()
 

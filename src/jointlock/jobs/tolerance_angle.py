@@ -18,7 +18,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..errors import ScenarioError
-from ..io.files import atomic_write_json, write_png
+from ..io.files import atomic_write_json, with_svg, write_figure
 from ..kinematics import ee_pose
 from ..model import ArmModel
 from ..planning.replan import GammaRoot, GammaSweep, LockRange, absorbable_range, gamma_sweep, gammas_for_lock
@@ -139,7 +139,7 @@ class ToleranceAngleResult(JobResult):
 
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (its JSON lists them as paths)."""
-        return ["joints_vs_gamma.png", "joints_vs_gamma_zoom.png", "locked_joint_vs_gamma.png", "sweep.json"]
+        return with_svg(["joints_vs_gamma.png", "joints_vs_gamma_zoom.png", "locked_joint_vs_gamma.png", "sweep.json"])
 
     def write(self, out: str | Path) -> list[str]:
         """Write ``joints_vs_gamma.png`` (002 Fig. 7), ``joints_vs_gamma_zoom.png`` (Fig. 8),
@@ -161,11 +161,11 @@ class ToleranceAngleResult(JobResult):
                 window_deg=window,
                 fig=offscreen_figure(PANELS_FIGSIZE),
             )
-            write_png(fig, folder / name, dpi=110)
+            write_figure(fig, folder, name, tight=False)
         fig = offscreen_figure(LOCKED_FIGSIZE)
         plot_locked_joint_vs_gamma(self.sweep, self.joint, self.angle, ax=fig.add_subplot())
         fig.tight_layout()
-        write_png(fig, folder / "locked_joint_vs_gamma.png", dpi=110)
+        write_figure(fig, folder, "locked_joint_vs_gamma.png", tight=False)
         sweep = {"gamma_deg": np.degrees(self.sweep.gammas), "q_deg": np.degrees(self.sweep.q)}
         atomic_write_json(folder / "sweep.json", {**self.to_dict(), **sweep})
         return self.file_names()

@@ -31,7 +31,7 @@ from ..analysis.workspace import (
 )
 from ..errors import ScenarioError
 from ..io import files as _files
-from ..io.files import atomic_write_json, npz_bytes, write_png
+from ..io.files import atomic_write_json, npz_bytes, with_svg, write_figure
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..progress import Progress
@@ -204,7 +204,7 @@ class WorkspaceStudy(JobResult):
 
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (its JSON lists them as paths)."""
-        return ["projections.png", "clouds.png", "points.npz", "workspace.json"]
+        return with_svg(["projections.png", "clouds.png", "points.npz", "workspace.json"])
 
     def write(self, out: str | Path) -> list[str]:
         """Write ``projections.png`` (xy, xz, yz), ``clouds.png`` (002 Figs. 2-3),
@@ -218,9 +218,9 @@ class WorkspaceStudy(JobResult):
         folder.mkdir(parents=True, exist_ok=True)
         full, locked = self.full_points, self.locked_points
         fig = plot_workspace_projections(full, locked, fig=offscreen_figure(PROJECTIONS_FIGSIZE))
-        write_png(fig, folder / "projections.png", dpi=110)
+        write_figure(fig, folder, "projections.png", tight=False)
         fig = plot_workspace_clouds(full, locked, fig=offscreen_figure(CLOUDS_FIGSIZE))
-        write_png(fig, folder / "clouds.png", dpi=110)
+        write_figure(fig, folder, "clouds.png", tight=False)
         arrays = {"full": full} if locked is None else {"full": full, "locked": locked}
         _files.atomic_write_bytes(folder / "points.npz", npz_bytes(compressed=True, **arrays))  # spies see it
         atomic_write_json(folder / "workspace.json", self.to_dict())

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import difflib
-from collections.abc import Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 from typing import Any
 
@@ -398,7 +398,7 @@ def _spellings(table: str, name: str) -> tuple[str, ...]:
     return (new, *(o for o, n in old.items() if n == new))
 
 
-def _hint(key: str, allowed: Sequence[str]) -> str:
+def _hint(key: str, allowed: Iterable[str]) -> str:
     close = difflib.get_close_matches(key, list(allowed), n=1, cutoff=0.6)
     if close:
         return f" (did you mean {close[0]!r}?)"

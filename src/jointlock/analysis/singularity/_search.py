@@ -6,6 +6,7 @@ from __future__ import annotations
 import logging
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -48,7 +49,7 @@ def _sigma_min_and_gradient(
 
 
 def _sigma_min(fun: Callable[[FloatArray], FloatArray], q: FloatArray) -> FloatArray:
-    return np.linalg.svd(fun(q), compute_uv=False)[..., -1]
+    return cast(FloatArray, np.linalg.svd(fun(q), compute_uv=False)[..., -1])  # numpy stubs: floating[Any]
 
 
 def _project(model: ArmModel, q: FloatArray) -> FloatArray:

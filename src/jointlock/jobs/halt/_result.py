@@ -18,8 +18,8 @@ from ...io.files import (
     atomic_write_json,
     atomic_write_text,
     csv_text,
-    figure_png,
     npz_bytes,
+    write_figure,
 )
 from ...model import ArmModel
 from ...papers import p000
@@ -469,8 +469,7 @@ class HaltPlan(JobResult):
         for name, size, draw in figures:
             fig = offscreen_figure(size)
             draw(fig)
-            atomic_write_bytes(out / name, figure_png(fig))
-            written.append(name)
+            written += write_figure(fig, out, name)
         cols = {"t_s": ts["t"]}
         for j, num in enumerate(p.model.joint_numbers):
             cols[f"q{num}_deg"] = np.degrees(ts["q"][:, j])

@@ -12,7 +12,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ...io.files import atomic_write_bytes, atomic_write_json, atomic_write_text, figure_png
+from ...io.files import atomic_write_json, atomic_write_text, write_figure
 from ...model import ArmModel
 from ...planning.jump import (
     JumpAtTime,
@@ -169,7 +169,7 @@ class JumpJobResult(JobResult):
             assert res is not None
             if res.search is not None:
                 ax = plot_objective_vs_kappa(res.search, 0, title=f"failure at {res.fail_time:g} s", ax=_axes())
-                names.append(_save(out, FIG_OBJECTIVE, ax.figure))
+                names += _save(out, FIG_OBJECTIVE, ax.figure)
             return names + self._write_runs(out)
         ver = self.verification
         assert ver is not None
@@ -180,26 +180,26 @@ class JumpJobResult(JobResult):
             s = st.search
             mid = int(np.argmin(np.abs(s.fail_times - self.task.duration / 2)))
             ax = plot_objective_vs_kappa(s, mid, title=f"failure at {s.fail_times[mid]:g} s", ax=_axes())
-            names.append(_save(out, FIG_OBJECTIVE, ax.figure))
+            names += _save(out, FIG_OBJECTIVE, ax.figure)
             ax = plot_kappa_fit(s, st.fit, self.task.duration, ax=_axes())
-            names.append(_save(out, FIG_KAPPA_FIT, ax.figure))
+            names += _save(out, FIG_KAPPA_FIT, ax.figure)
         names += self._write_runs(out)
         fixed = st.verification_fixed if st is not None else None
         ax = plot_jump_vs_failure_time(ver, fixed, ax=_axes((7, 3.6)))
-        names.append(_save(out, FIG_JUMP, ax.figure))
+        names += _save(out, FIG_JUMP, ax.figure)
         return names
 
     def _write_runs(self, out: Path) -> list[str]:
         """fig6 (joint rates) and fig7 (position deviation) of :meth:`runs`."""
         r0, r1, t_fail = self.runs()
         fig = plot_joint_rates(self.model, self.task.lock_joint, r0, r1, t_fail, fig=offscreen_figure((10, 3.6)))
-        names = [_save(out, FIG_JOINT_RATES, fig)]
+        names = _save(out, FIG_JOINT_RATES, fig)
         ax = plot_position_deviation(r0, r1, t_fail, self.task.eps, ax=_axes())
-        names.append(_save(out, FIG_DEVIATION, ax.figure))
+        names += _save(out, FIG_DEVIATION, ax.figure)
         responses = self.spacecraft_responses()
         if responses is not None:
             title = f"spacecraft (free), joint {self.task.lock_joint} locks at {t_fail:g} s"
-            names.append(_save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title)))
+            names += _save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title))
         return names + self._write_motions(out)
 
 
@@ -351,6 +351,6 @@ def _axes(figsize: tuple[float, float] = (6, 3.6)) -> Any:
     return offscreen_figure(figsize).add_subplot()
 
 
-def _save(out: Path, name: str, fig: Any) -> str:
-    atomic_write_bytes(out / name, figure_png(fig))
-    return name
+def _save(out: Path, name: str, fig: Any) -> list[str]:
+    """The figure as ``name`` (PNG) and its SVG in ``out``; returns both names."""
+    return write_figure(fig, out, name)

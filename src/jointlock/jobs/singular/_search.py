@@ -14,7 +14,7 @@ import numpy as np
 from ..._deprecate import renamed_keyword
 from ..._random import resolve_seed
 from ...analysis import singularity as sg
-from ...io.files import atomic_write_bytes, atomic_write_json, figure_png
+from ...io.files import atomic_write_json, with_svg, write_figure
 from ...kinematics import VMWeighting
 from ...model import ArmModel
 from ...plots._common import offscreen_figure
@@ -134,7 +134,7 @@ class SingularitySearchResult(JobResult):
 
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes."""
-        return ["search.json", "sigma_min.png"] + (["families.png", "joint_angles.png"] if self.search.families else [])
+        return with_svg(["search.json", "sigma_min.png"] + (["families.png", "joint_angles.png"] if self.search.families else []))
 
     def write(self, out: str | Path) -> list[str]:
         """``search.json`` (:meth:`search_json`), ``sigma_min.png`` and, when the search found
@@ -144,16 +144,16 @@ class SingularitySearchResult(JobResult):
         atomic_write_json(out / "search.json", self.search_json())
         fig = offscreen_figure(SIGMA_MIN_FIGSIZE)
         plot_search_sigma_min(self.model, self.search, ax=fig.add_subplot())
-        atomic_write_bytes(out / "sigma_min.png", figure_png(fig))
+        write_figure(fig, out, "sigma_min.png")
         if self.search.families:
             fig = plot_singular_families(
                 self.model, self.search, fig=offscreen_figure(families_figsize(self.search))
             )
-            atomic_write_bytes(out / "families.png", figure_png(fig))
+            write_figure(fig, out, "families.png")
             fig = plot_family_joint_angles(
                 self.model, self.search, fig=offscreen_figure(joint_angles_figsize(self.model))
             )
-            atomic_write_bytes(out / "joint_angles.png", figure_png(fig))
+            write_figure(fig, out, "joint_angles.png")
         return self.file_names()
 
 

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from numpy.typing import ArrayLike
+from numpy.typing import ArrayLike, NDArray
 
 from ..._search1d import bisect_root
 from ...errors import ConfigurationError
@@ -46,7 +46,7 @@ def _full_geometry(model: ArmModel) -> Puma6Geometry:
     return Puma6Geometry(geom.a2, geom.d4, geom.d6, geom.tool, None)
 
 
-def _full_branches(geom: Puma6Geometry, poses: FloatArray) -> tuple[FloatArray, FloatArray]:
+def _full_branches(geom: Puma6Geometry, poses: FloatArray) -> tuple[FloatArray, NDArray[np.bool_]]:
     return puma6_branches(geom, poses @ invert(geom.tool))
 
 
@@ -130,7 +130,7 @@ def gamma_sweep(
     return GammaSweep(g, q, q_all, valid, b, t)
 
 
-def _continuous(q: FloatArray, valid: FloatArray, gammas: FloatArray) -> FloatArray:
+def _continuous(q: FloatArray, valid: NDArray[np.bool_], gammas: FloatArray) -> FloatArray:
     out = np.full(q.shape, np.nan)
     if not np.any(valid):
         return out
