@@ -483,13 +483,13 @@ def _figures(monkeypatch):
     import jointlock.jobs.halt._result as halt_job  # HaltPlan.write renders its figures there
 
     figs = []
-    real = halt_job.figure_png
+    real = halt_job.write_figure
 
     def keep(fig, *a, **kw):
         figs.append(fig)
         return real(fig, *a, **kw)
 
-    monkeypatch.setattr(halt_job, "figure_png", keep)
+    monkeypatch.setattr(halt_job, "write_figure", keep)
     return figs
 
 

@@ -99,7 +99,14 @@ def test_sweep_summary_and_files_equal_the_command(results, task_file, tmp_path,
 def test_write_fail_at_files(results, tmp_path):
     r = results["fail_at_kappa"]  # kappa given: no search, so no objective figure
     names = r.write(tmp_path)
-    assert names == with_svg(["results.json", "fig6_joint_velocities.png", "fig7_position_deviation.png", "motion.json"])
+    assert names == with_svg(["results.json", "fig6_joint_velocities.png", "fig7_position_deviation.png"]) + [
+        "runs.csv",
+        "motion.json",
+    ]
+    runs = (tmp_path / "runs.csv").read_text().splitlines()
+    assert runs[0].startswith("t_s,k0_q1_deg,") and runs[0].endswith(",comp_deviation_mm")
+    r0, r1, _ = r.runs()
+    assert len(runs) == r0.t.size + 1 and float(runs[-1].split(",")[-1]) == pytest.approx(1e3 * r1.deviation[-1])
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(names)
     assert json.loads((tmp_path / "results.json").read_text()) == to_plain(r.to_dict())
 

@@ -224,10 +224,9 @@ def test_every_example_report_has_no_empty_section_and_no_repeated_note(example_
     assert " at at " not in page and not re.search(r"\(-[\d.]+ % (lower|higher)\)", page)  # signs in words
 
 
+@pytest.mark.parametrize("example_report", ["singular_004"], indirect=True)
 def test_the_singularity_report_writes_the_conditions_out_and_plots_them(example_report):
-    name, report = example_report
-    if name != "singular_004":
-        pytest.skip("the conditions are the singular_004 example's")
+    _, report = example_report
     page = report.read_text()
     assert "S2 = 0 and d C3 + e C34 + h S345 = 0" in page and "equations (004 eq. 30)" in page
     assert "sigma_min on each of 004" in page

@@ -299,6 +299,8 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         documented spacecraft; for a URDF, the root link's inertial; for a TOML file, its
         ``[base]`` table (``"fixed"`` drops it).
 
+    Notes
+    -----
     Each model is built once per process (a model file once per modification) and shared:
     models are immutable.
     """

@@ -18,8 +18,7 @@ base disturbance torque of eq. 32 under angle, speed and acceleration limits).
 The result, :class:`HaltPlan`, is what ``jointlock halt --json`` prints (``to_dict()``), the
 lines it prints (``summary()``) and the files of ``--out`` (``write()``).
 
-Modules
--------
+The package's modules:
 ``_inputs`` (:class:`FailureState`, :class:`JointLimits`, :func:`halt_limits`, 000's default
 limits), ``_checks`` (the checks before any work, the settings' names), ``_strategy``
 (:func:`plan_halt`, its search, :func:`halt_model`, :func:`halt_from_scenario`), ``_result``

@@ -14,8 +14,7 @@ Three modes, as the command has them:
 (:meth:`~JumpJobResult.summary`) and files (:meth:`~JumpJobResult.write`).
 :func:`jump_from_scenario` runs the ``[jump]`` job of a ``jointlock run`` scenario.
 
-Modules
--------
+The package's modules:
 ``_run`` (:func:`run_jump_study`, its checks and defaults, :func:`jump_from_scenario`),
 ``_result`` (:class:`JumpJobResult`, the command's JSON and files), ``_text``
 (:func:`summary_lines`).  Import from this package, not from them.

@@ -12,7 +12,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ...io.files import atomic_write_json, atomic_write_text, write_figure
+from ...io.files import atomic_write_json, atomic_write_text, csv_text, write_figure
 from ...model import ArmModel
 from ...planning.jump import (
     JumpAtTime,
@@ -200,7 +200,8 @@ class JumpJobResult(JobResult):
         if responses is not None:
             title = f"spacecraft (free), joint {self.task.lock_joint} locks at {t_fail:g} s"
             names += _save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title))
-        return names + self._write_motions(out)
+        atomic_write_text(out / "runs.csv", runs_csv(self.model, r0, r1))
+        return names + ["runs.csv"] + self._write_motions(out)
 
 
 # -- JSON ----------------------------------------------------------------------------------------
@@ -344,6 +345,18 @@ def verification_csv(ver: Verification) -> str:
         for t, k, b, a, ok in zip(ver.t, ver.kappa, ver.jump_before, ver.jump_after, ver.limits_ok_per_step)
     ]
     return "\n".join(rows) + "\n"
+
+
+def runs_csv(model: ArmModel, uncompensated: Trajectory, compensated: Trajectory) -> str:
+    """``runs.csv``: the two runs of the figures on their time grid, ``t_s``, then per run
+    (``k0_`` kappa = 0, ``comp_`` compensated) every joint's angle ``q<N>_deg`` [deg], the end
+    effector ``x_m``, ``y_m``, ``z_m`` [m] (inertial frame) and the deviation ``deviation_mm``."""
+    cols: dict[str, np.ndarray] = {"t_s": uncompensated.t}
+    for tag, run in (("k0", uncompensated), ("comp", compensated)):
+        cols.update({f"{tag}_q{n}_deg": np.degrees(run.q[:, j]) for j, n in enumerate(model.joint_numbers)})
+        cols.update({f"{tag}_{c}_m": run.x[:, i] for i, c in enumerate("xyz")})
+        cols[f"{tag}_deviation_mm"] = 1e3 * run.deviation
+    return csv_text(cols)
 
 
 def _axes(figsize: tuple[float, float] = (6, 3.6)) -> Any:

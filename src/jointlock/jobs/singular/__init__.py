@@ -21,8 +21,7 @@ Jacobian: twist ``(v [m/s], omega [rad/s])`` of the end-effector origin, base-fr
 components (see :func:`jointlock.analysis.singularity.task_jacobian`); angles in radians
 inside, degrees only in names ending ``_deg``.
 
-Modules
--------
+The package's modules:
 ``_shared`` (defaults, :func:`singular_model`, input checks), ``_study`` (one configuration),
 ``_verify`` (Cond1-Cond5), ``_search`` (the search), ``_scenario``
 (:func:`singular_from_scenario`).  Import from this package, not from them.

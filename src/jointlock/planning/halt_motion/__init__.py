@@ -30,8 +30,7 @@ Infeasible scenarios are reported, never optimised silently: :class:`HaltMotion`
 has ``feasible=False``, the least-violating ``k``, the violations (joint, limit, excess)
 and the smallest halt time ``T`` for which a feasible ``k`` exists.
 
-Modules
--------
+The package's modules:
 ``_polynomial`` (eqs. 25-27), ``_problem`` (:class:`HaltProblem`), ``_objective`` (eq. 32),
 ``_feasibility`` (eq. 33 for one problem; smallest feasible ``T``), ``_batch_feasibility``
 (feasible ``k`` of many halt configurations at once), ``_solve`` (:func:`optimal_halt_motion`,

@@ -188,7 +188,7 @@ class HaltProblem:
         return replace(self, T=T)
 
     def times(self, n: int | None = None) -> FloatArray:
-        """(n,) uniform time grid on [0, T] [s] (``n_samples`` points by default)."""
+        """(n,) uniform times [s] from 0 to T (``n_samples`` points by default)."""
         return np.linspace(0.0, self.T, self.n_samples if n is None else n)
 
     def base_profile(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
