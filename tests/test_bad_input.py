@@ -308,7 +308,7 @@ sys.exit(main(["workspace", "halt7", "--samples", "1000", "--json"]))
 """
 
 
-@pytest.mark.parametrize("module", ["numpy", "jointlock.cli.halt", "jointlock.kinematics", "scipy"])
+@pytest.mark.parametrize("module", ["numpy", "jointlock.cli.workspace", "jointlock.kinematics", "jointlock.jobs.workspace"])
 def test_an_interrupt_during_start_up_imports_is_one_line(module):
     """SIGINT while the command imports its modules (numpy, the subcommands, the core): one
     line and exit 130, never a KeyboardInterrupt traceback.  (The interpreter's own start-up,
@@ -363,7 +363,7 @@ def test_a_numpy_warning_is_an_error_not_a_result(capsys, monkeypatch):
 
     monkeypatch.setattr(kin, "run", overflow)
     parser_func = main.__globals__["build_parser"]
-    monkeypatch.setitem(main.__globals__, "build_parser", lambda: _with_func(parser_func(), overflow))
+    monkeypatch.setitem(main.__globals__, "build_parser", lambda *a: _with_func(parser_func(*a), overflow))
     code, out, err = cli(capsys, "kinematics", "halt7")
     assert_one_error_line(code, err, "numerical failure", "overflow")
 

@@ -259,3 +259,21 @@ def test_every_exact_eaik_branch_is_ours(puma, joint):
                 checked += 1
                 assert _contains(ours.q_full[k], qe, ours.exact[k])
     assert checked >= q.shape[0]
+
+
+def test_the_puma6_geometry_is_fitted_once_per_model():
+    """Issue 13: the closed form's family fit is kept on the immutable model (a single-pose IK
+    call does not fit it again); a changed model fits its own; a refusal is remembered."""
+    import dataclasses
+
+    from jointlock.ik import puma6_geometry
+
+    arm = jl.load_robot("puma6")
+    first = puma6_geometry(arm)
+    assert puma6_geometry(arm) is first
+    moved = dataclasses.replace(arm, tool=arm.tool @ jl.spatial.translation([0.0, 0.0, 0.1]))
+    assert puma6_geometry(moved) is not first and puma6_geometry(moved).d6 == pytest.approx(first.d6 + 0.1)
+    seven = jl.load_robot("halt7")
+    for _ in range(2):
+        with pytest.raises(jl.ModelError, match="6-joint arm"):
+            puma6_geometry(seven)

@@ -18,25 +18,31 @@ from typing import NoReturn
 from .._version import __version__
 from ..errors import JointlockError
 
-#: Subcommand modules, in the order ``--help`` lists them.  A module listed here that is not
-#: installed (a capability still being written) is left out of the parser.
-COMMAND_MODULES: tuple[str, ...] = (
-    "robots",
-    "kinematics",
-    "halt_config",
-    "halt",
-    "jump",
-    "ik",
-    "tolerance_angle",
-    "replan",
-    "workspace",
-    "singular",
-    "export_urdf",
-    "run",
-    "campaign",
-    "reproduce",
-    "demo",
-)
+#: Every subcommand, in the order ``--help`` lists them: its module and its line of help (the
+#: module's own parser says the same: tested).  Only the module of the command given is
+#: imported (the others, with numpy, scipy and matplotlib behind them, are not needed to list
+#: them), so ``jointlock --help`` and a command's start-up stay short.
+COMMANDS: dict[str, tuple[str, str]] = {
+    "robots": ("robots", "list the built-in robots (name, DOF, masses, lengths, base)"),
+    "kinematics": ("kinematics", "end-effector pose, Jacobian and its singular values at one configuration"),
+    "halt-config": ("halt_config", "optimal halt configuration after a lock (000 HCOM: Monte Carlo + refinement)"),
+    "halt": ("halt", "optimal halt configuration and optimal halt motion after a lock (seed 000)"),
+    "jump": ("jump", "velocity jump at an unexpected lock: optimal kappa, fitted kappa(t), verification (001)"),
+    "ik": ("ik", "inverse kinematics: every branch, full arm or with a locked joint"),
+    "tolerance-angle": ("tolerance_angle", "gamma sweep (rotate the target about the tool x axis) and the gamma absorbing a lock "
+                        "(puma6-family arms only)"),
+    "replan": ("replan", "straight-line Cartesian plan through the locked-arm IK, with the tolerance angle gamma "
+               "(puma6-family arms only)"),
+    "workspace": ("workspace", "Monte Carlo workspace, full arm vs locked arm: clouds, projections, volume, share kept"),
+    "singular": ("singular", "singular values, rank, lost directions; 004's Cond1-Cond5; singularity search"),
+    "export-urdf": ("export_urdf", "write the (locked) arm as URDF, locked joints folded in and bodies merged"),
+    "run": ("run", "run every job of a scenario file; results.json, CSV, plots and report.html in one folder"),
+    "campaign": ("campaign", "sweep thousands of failure cases (process pool or Dask), resumable"),
+    "reproduce": ("reproduce", "re-run each seed paper's published experiment and compare with its printed numbers"),
+    "demo": ("demo", "run the main job on the built-in arms and write a report"),
+}  # fmt: skip
+#: The subcommand modules, in order.
+COMMAND_MODULES: tuple[str, ...] = tuple(module for module, _ in COMMANDS.values())
 
 
 #: Help of ``--debug`` (accepted before and after the subcommand).
@@ -51,7 +57,11 @@ class Parser(argparse.ArgumentParser):
         self.exit(2, f"{self.prog}: error: {message} (see '{self.prog} --help')\n")
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(argv: Sequence[str] | None = None) -> argparse.ArgumentParser:
+    """The command-line parser.  With ``argv`` (what :func:`main` parses) only the command it
+    names gets its full parser (its module imported); the others are listed by name and help.
+    Without, every subcommand's full parser (for tools and tests that walk them)."""
+    chosen = None if argv is None else _command_in(argv)
     parser = Parser(
         prog="jointlock",
         description="Space manipulators after a locked-joint failure: halt, compensate, re-plan, analyse.",
@@ -60,10 +70,11 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--debug", action="store_true", help=DEBUG_HELP)
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     sub.required = True
-    for name in COMMAND_MODULES:
-        if importlib.util.find_spec(f"{__name__}.{name}") is None:
-            continue
-        importlib.import_module(f"{__name__}.{name}").register(sub)
+    for name, (module, help_text) in COMMANDS.items():
+        if argv is not None and name != chosen:
+            sub.add_parser(name, help=help_text)  # listed; parsed only when it is the command
+        elif importlib.util.find_spec(f"{__name__}.{module}") is not None:
+            importlib.import_module(f"{__name__}.{module}").register(sub)
     for command_parser in _all_parsers(sub):
         # --debug after the subcommand too; SUPPRESS keeps the top-level value when absent
         if not any("--debug" in a.option_strings for a in command_parser._actions):
@@ -72,6 +83,15 @@ def build_parser() -> argparse.ArgumentParser:
             )
     parser.set_defaults(_commands=sub.choices)
     return parser
+
+
+def _command_in(argv: Sequence[str]) -> str | None:
+    """The subcommand ``argv`` names: its first word that is not an option (the top-level
+    parser takes only options before the command); None when there is none or it is unknown."""
+    for word in argv:
+        if not word.startswith("-"):
+            return word if word in COMMANDS else None
+    return None
 
 
 def _all_parsers(sub: argparse._SubParsersAction) -> list[argparse.ArgumentParser]:
@@ -125,7 +145,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 def _main(argv: Sequence[str] | None) -> int:
     _headless_backend()
     _forgiving_streams()
-    parser = build_parser()
+    argv = list(sys.argv[1:] if argv is None else argv)
+    parser = build_parser(argv)
     args, extra = parser.parse_known_args(argv)
     commands = vars(args).pop("_commands", {})
     if extra:  # named by the subcommand, so that the hint points to its --help
@@ -136,7 +157,7 @@ def _main(argv: Sequence[str] | None) -> int:
         level=logging.DEBUG if args.debug else logging.WARNING, format="%(levelname)s: %(message)s"
     )
     prefix = f"jointlock {args.command}"
-    import numpy as np  # imported by every subcommand already (build_parser)
+    import numpy as np  # imported by every subcommand already
 
     # numpy's floating-point overflow, invalid value and division by zero raise (an error line)
     # instead of warning and returning inf/NaN; Python's own warning filters are kept.

@@ -19,7 +19,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "workspace",
         help="Monte Carlo workspace, full arm vs locked arm: clouds, projections, volume, share kept",
         description=(
-            "Sample joint angles uniformly within the limits (capped to +-180 deg), compute the "
+            "Sample joint angles uniformly within the limits as given (a joint without limits: one "
+            "turn), compute the "
             "end-effector positions of the full arm and, with --lock, of the arm with that joint "
             "locked (002 Figs. 2-3), and estimate each volume by voxel occupancy on one common grid "
             "(cubes of side --voxel holding at least one sample). The share of the full workspace "

@@ -9,6 +9,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
+from .._cache import cached_on
 from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
@@ -97,7 +98,16 @@ def puma6_geometry(model: ArmModel) -> Puma6Geometry:
     ------
     ModelError
         If the model is not of the family (use :func:`ik_numeric` then).
+
+    Notes
+    -----
+    Fitted once per model and kept on it (:func:`jointlock._cache.cached_on`): a single-pose IK
+    call does not fit it again.
     """
+    return cached_on(model, "puma6_geometry", lambda: _fit_geometry(model))
+
+
+def _fit_geometry(model: ArmModel) -> Puma6Geometry:
     if model.full_dof != 6 or len(model.locked) > 1:
         raise ModelError(
             f"model {model.name!r}: the puma6 closed form needs a 6-joint arm with at most one "

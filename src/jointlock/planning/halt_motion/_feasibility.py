@@ -8,7 +8,6 @@ from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import minimize_scalar
 
 from ..._search1d import bisect_boundary
 from ...model import FloatArray
@@ -152,6 +151,8 @@ def least_violating_k(problem: HaltProblem) -> float:
     viol = np.concatenate([relative_violation(problem, grid[i : i + 100]) for i in range(0, grid.size, 100)])
     i = int(np.argmin(viol))
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    from scipy.optimize import minimize_scalar  # on first use: scipy.optimize takes ~0.5 s to import
+
     res = minimize_scalar(
         lambda x: float(relative_violation(problem, x)),
         bounds=(a, b),

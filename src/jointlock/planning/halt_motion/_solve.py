@@ -10,7 +10,6 @@ from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import minimize, minimize_scalar
 
 from ..._random import resolve_seed
 from ...errors import InfeasibleError, ScenarioError
@@ -140,6 +139,8 @@ def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[floa
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, n_scan - 1)]
     best = float(grid[i])
     if b > a:
+        from scipy.optimize import minimize_scalar  # on first use (slow to import)
+
         res = minimize_scalar(
             lambda x: float(halt_objective(problem, x)),
             bounds=(a, b),
@@ -276,6 +277,8 @@ def _solve_vector(
     bounds = [(float(a), float(b)) for a, b in per]
     x0 = np.clip(np.full(problem.dof, k), per[:, 0], per[:, 1])
     scale = max(hi - lo, 1e-12)
+    from scipy.optimize import minimize  # on first use (slow to import)
+
     res = minimize(
         lambda x: float(halt_objective(problem, x * scale, per_joint=True)),
         x0 / scale,
