@@ -56,7 +56,7 @@ def main() -> None:
         import pinocchio as pin
         from pin_oracle import to_pinocchio
     except ImportError:
-        print("\nPinocchio absent: no reference loop (pip install '.[pin]')")
+        print("\nPinocchio absent: no reference loop (pip install '.[test]', which holds Pinocchio)")
         return
     pm, fid = to_pinocchio(model)
     data = pm.createData()

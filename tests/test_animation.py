@@ -47,6 +47,10 @@ def test_a_motion_round_trips_through_its_json():
         ({"t": [1, 0], "q": np.zeros((2, 6))}, "t"),
         ({"t": [0, 1], "q": np.zeros((2, 6)), "base_position": np.zeros((2, 3))}, "together"),
         ({"t": [0, 1], "q": np.full((2, 6), np.nan)}, "finite"),
+        ({"t": [0, 1], "q": None}, "q is required"),
+        ({"t": "ab", "q": np.zeros((2, 6))}, "must be numbers"),
+        ({"t": [0, 1], "q": np.zeros((2, 6)), "locks": [3]}, "pairs"),
+        ({"t": [0, 1], "q": np.zeros((2, 6)), "base_position": np.zeros((2, 3)), "base_attitude": np.zeros((2, 4))}, "unit quaternions"),
     ],
 )
 def test_a_bad_motion_is_refused_naming_what(kwargs, field):
@@ -152,12 +156,51 @@ def test_spacecraft_box_has_the_mass_and_inertia_of_the_spacecraft():
     assert spacecraft_box(jl.load_robot("puma6")) is None  # a massless mounting: no box
 
 
-def test_html_cannot_be_closed_by_a_label():
-    fig = animation_figure(jl.load_robot("puma6"), ArmMotion("</script><b>x", [0.0, 1.0], np.zeros((2, 6))))
+@pytest.mark.parametrize("label", ["</script><b>x", "<!--<script>", "x</SCRIPT >"])
+def test_html_cannot_be_closed_by_a_label(label):
+    """The figure's JSON inside <script> holds no "<" at all (no end tag, no comment opening)."""
+    from jointlock.plots.animation import plotly_js
+
+    fig = animation_figure(jl.load_robot("puma6"), ArmMotion(label, [0.0, 1.0], np.zeros((2, 6))))
     frag = animation_html(fig)
-    assert frag.count("</script>") == 1 and "<\\/script>" in frag
+    script = frag.split("<script>", 1)[1].rsplit("</script>", 1)[0]
+    assert "<" not in script and "\\u003c" in script
+    assert json.loads(script.split("var fig=", 1)[1].split(";var gd=", 1)[0])["data"][0]["name"] == label
     page = standalone_html(fig)
     assert page.count("<script>") == 2 and "src=" not in page.split("</script>", 1)[1]
+    assert "</script" not in plotly_js().lower()  # the vendored library cannot end its element
+
+
+def test_the_same_figure_gets_the_same_view_id():
+    fig = animation_figure(jl.load_robot("puma6"), ArmMotion("x", [0.0, 1.0], np.zeros((2, 6))))
+    assert animation_html(fig) == animation_html(fig)  # reports are reproducible
+
+
+def test_a_locked_model_takes_its_movable_joints_angles():
+    """A locked model's motion may give only the movable joints: the lock angle is inserted and
+    the joint marked from the start."""
+    arm = jl.lock(jl.load_robot("halt7"), 4, 0.3)
+    t = np.linspace(0.0, 1.0, 5)
+    fig = animation_figure(arm, ArmMotion("m", t, np.zeros((5, 6))))
+    marker = next(d for d in fig["data"] if d.get("name") == "locked joint")
+    assert marker["text"] == ["joint 4 locked"]
+    full = jl.load_robot("halt7")
+    expected = motion_points(full, ArmMotion("m", t, arm.expand(np.zeros((5, 6)))), t[:1])["joints"][0, 3]
+    np.testing.assert_allclose(_frame_xyz(marker)[0], expected, atol=1e-5)
+
+
+@pytest.mark.parametrize(
+    "motions, match",
+    [
+        ([], "one or more ArmMotion"),
+        (["not a motion"], "one or more ArmMotion"),
+        ([ArmMotion("x", [0.0, 1.0], np.zeros((2, 6)), ((9, 0.5),))], r"locks joints \[9\]"),
+        ([ArmMotion("x", [0.0, 1.0], np.zeros((2, 7)))], "has 7 joint angles"),
+    ],
+)
+def test_bad_figures_are_refused_in_one_line(motions, match):
+    with pytest.raises(ConfigurationError, match=match):
+        animation_figure(jl.load_robot("puma6"), motions)
 
 
 def test_full_and_locked_workspace_clouds_share_their_axis_scales():

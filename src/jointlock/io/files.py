@@ -294,20 +294,28 @@ SVG_RASTER_POINTS = 2000
 
 def figure_svg(fig: Any, *, tight: bool = True) -> bytes:
     """The figure as SVG (text kept as paths, so it renders the same everywhere); scatters of
-    more than :data:`SVG_RASTER_POINTS` points rasterized at the PNG's resolution."""
+    more than :data:`SVG_RASTER_POINTS` points rasterized at the PNG's resolution (for this
+    file only: the figure is left as it was)."""
+    import matplotlib
+
+    undo: list[Any] = []
     for ax in fig.axes:
         dense = [a for a in ax.collections if len(getattr(a, "get_offsets", lambda: ())()) > SVG_RASTER_POINTS]
         if dense and ax.name == "3d":  # mplot3d rasterizes by z-order only
+            undo.append((ax.set_rasterization_zorder, ax.get_rasterization_zorder()))
             ax.set_rasterization_zorder(max(a.get_zorder() for a in dense) + 0.5)
         for artist in dense if ax.name != "3d" else ():
+            undo.append((artist.set_rasterized, artist.get_rasterized()))
             artist.set_rasterized(True)
-    import matplotlib
-
     buf = io.BytesIO()
-    # no date and fixed element ids: the same figure gives the same bytes (diffable, reproducible)
-    with matplotlib.rc_context({"svg.hashsalt": "jointlock"}):
-        fig.savefig(buf, format="svg", dpi=PNG_DPI, metadata={"Date": None},
-                    **({"bbox_inches": "tight"} if tight else {}))  # fmt: skip
+    try:
+        # no date and fixed element ids: the same figure gives the same bytes (diffable, reproducible)
+        with matplotlib.rc_context({"svg.hashsalt": "jointlock"}):
+            fig.savefig(buf, format="svg", dpi=PNG_DPI, metadata={"Date": None},
+                        **({"bbox_inches": "tight"} if tight else {}))  # fmt: skip
+    finally:
+        for setter, value in undo:
+            setter(value)
     return buf.getvalue()
 
 

@@ -19,8 +19,9 @@ handy for a link to a moment); each view's ``data-frame`` attribute names the fr
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import html
-import itertools
 import json
 from functools import cache
 from importlib import resources
@@ -29,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from ..errors import ConfigurationError
 from ..model import ArmModel
 from .motion import ArmMotion, frame_times, motion_points, spacecraft_box
 
@@ -37,7 +39,6 @@ MOTION_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
 LOCKED_COLOUR = "#e31a1c"
 #: The 12 edges of spacecraft_box's corners (corner index = 4 i_x + 2 i_y + i_z).
 _BOX_EDGES = tuple((a, a | bit) for a in range(8) for bit in (1, 2, 4) if not a & bit)
-_ids = itertools.count()
 
 
 def _xyz(points: np.ndarray) -> dict[str, list[float | None]]:
@@ -109,7 +110,9 @@ def animation_figure(
         at its angle and marked.
     motions
         One motion or several on the same clock (e.g. the jump study's runs without and with
-        compensation), drawn in :data:`MOTION_COLOURS`.
+        compensation), drawn in :data:`MOTION_COLOURS`.  ``q`` has one angle per joint of the
+        full arm, or, for a locked model, one per movable joint (the locked angles are then
+        inserted and the locked joints marked throughout).
     title
         Figure title; each frame adds the time and the joints locked by then.
     max_frames
@@ -117,11 +120,15 @@ def animation_figure(
     """
     arm = model.unlocked if model.locked and model.unlocked is not None else model
     motions = [motions] if isinstance(motions, ArmMotion) else list(motions)
-    if not motions:
-        raise ValueError("animation_figure needs at least one motion")
+    if not motions or not all(isinstance(m, ArmMotion) for m in motions):
+        raise ConfigurationError(
+            f"animation_figure needs one or more ArmMotion; got {[type(m).__name__ for m in motions] or 'none'}"
+        )
+    motions = [_on_full_arm(model, arm, m) for m in motions]
     times = frame_times(motions, max_frames)
     points = [motion_points(arm, m, times) for m in motions]
     extent = np.vstack([np.vstack([p["joints"].reshape(-1, 3), p["ee"], p["base"]]) for p in points])
+    extent = np.vstack([extent, *[m.target for m in motions if m.target is not None]])
     box = spacecraft_box(arm)
     boxes = [None if box is None else p["base"][:, None, :] + np.einsum("fij,kj->fki", p["base_rotation"], box) for p in points]
     if box is not None:
@@ -196,6 +203,15 @@ def animation_figure(
     return {"data": data, "layout": layout, "frames": frames, "config": config}
 
 
+def _on_full_arm(model: ArmModel, arm: ArmModel, motion: ArmMotion) -> ArmMotion:
+    """``motion`` on the drawn (full) arm: a locked model's healthy-joint angles expanded with
+    its lock angles, its locked joints locked from the start."""
+    if arm is model or motion.q.shape[1] != model.dof:
+        return motion
+    locks = (*motion.locks, *((lj.number, float(motion.t[0])) for lj in model.locked if lj.number not in dict(motion.locks)))
+    return dataclasses.replace(motion, q=model.expand(motion.q), locks=locks)
+
+
 def _box_lines(corners: np.ndarray) -> np.ndarray:
     a, b = zip(*_BOX_EDGES)
     return _segments(corners[list(a)], corners[list(b)])
@@ -213,7 +229,8 @@ def _joint_labels(joints: np.ndarray, numbers: list[int], scale: float) -> list[
     for a in range(len(numbers)):
         if not labels[a]:
             continue
-        same = [b for b in range(a + 1, len(numbers)) if np.linalg.norm(joints[b] - joints[a]) < 1e-3 * scale]
+        # joints closer than a quarter of an axis' half length would print their numbers over each other
+        same = [b for b in range(a + 1, len(numbers)) if np.linalg.norm(joints[b] - joints[a]) < 0.25 * scale]
         for b in same:
             labels[a] += f",{labels[b]}" if labels[b] else ""
             labels[b] = ""
@@ -238,8 +255,8 @@ def plotly_js() -> str:
 
 
 def _json(obj: Any) -> str:
-    # inside <script>: "</" would end the element
-    return json.dumps(obj, separators=(",", ":"), allow_nan=False).replace("</", "<\\/")
+    # inside <script> no "<" at all: "</script" would end the element, "<!--" open a comment
+    return json.dumps(obj, separators=(",", ":"), allow_nan=False).replace("<", "\\u003c")
 
 
 _SCRIPT = """<script>(function(){var fig=%s;var gd=document.getElementById(%s);
@@ -254,10 +271,11 @@ else if(m){Plotly.animate(gd,[String(Math.min(+m[1],fig.frames.length-1))],{mode
 def animation_html(figure: dict[str, Any], *, height_px: int = 560) -> str:
     """The ``<div>`` and ``<script>`` showing ``figure`` (:func:`animation_figure`); the page
     must load :func:`plotly_js` first."""
-    div_id = f"jl-animation-{next(_ids)}"
+    text = _json(figure)
+    div_id = "jl-animation-" + hashlib.sha1(text.encode()).hexdigest()[:12]  # the same figure, the same page
     return (
         f'<div class="jl-animation" id="{div_id}" data-frames="{len(figure["frames"])}" '
-        f'style="width:100%;height:{int(height_px)}px"></div>\n' + _SCRIPT % (_json(figure), _json(div_id))
+        f'style="width:100%;height:{int(height_px)}px"></div>\n' + _SCRIPT % (text, _json(div_id))
     )
 
 

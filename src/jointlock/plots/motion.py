@@ -23,12 +23,17 @@ from ..model import ArmModel, FloatArray
 from ..spatial import quaternion_matrix
 
 
-def _array(value: ArrayLike | None, name: str, shape: tuple[int | None, ...]) -> FloatArray | None:
+def _array(value: ArrayLike | None, name: str, shape: tuple[int | str, ...]) -> FloatArray | None:
+    """``value`` as a read-only float array of ``shape`` (a str entry: any size, named so in
+    the error), or None; a ConfigurationError naming the field otherwise."""
     if value is None:
         return None
-    a = np.array(value, dtype=float)
-    if a.ndim != len(shape) or any(s is not None and s != n for s, n in zip(shape, a.shape)):
-        want = "(" + ", ".join("m" if s is None else str(s) for s in shape) + ")"
+    try:
+        a = np.array(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ConfigurationError(f"ArmMotion.{name} must be numbers; got {str(value)[:60]!r}") from None
+    if a.ndim != len(shape) or any(isinstance(s, int) and s != n for s, n in zip(shape, a.shape)):
+        want = "(" + ", ".join(str(s) for s in shape) + ")"
         raise ConfigurationError(f"ArmMotion.{name} must have the shape {want}; got {a.shape}")
     if not np.all(np.isfinite(a)):
         raise ConfigurationError(f"ArmMotion.{name} must be finite (no NaN or inf)")
@@ -70,19 +75,31 @@ class ArmMotion:
     target_label: str = "target path"
 
     def __post_init__(self) -> None:
-        t = _array(self.t, "t", (None,))
-        assert t is not None
-        if t.size < 1 or np.any(np.diff(t) <= 0):
-            raise ConfigurationError(f"ArmMotion.t must be one or more increasing times [s]; got {t.size} values")
+        t = _array(self.t, "t", ("m",))
+        if t is None or t.size < 1 or np.any(np.diff(t) <= 0):
+            raise ConfigurationError(
+                f"ArmMotion.t must be one or more increasing times [s]; got {0 if t is None else t.size} values"
+            )
         m = t.size
         object.__setattr__(self, "t", t)
-        object.__setattr__(self, "q", _array(self.q, "q", (m, None)))
+        if self.q is None:
+            raise ConfigurationError("ArmMotion.q is required: (m, n) joint angles [rad]")
+        object.__setattr__(self, "q", _array(self.q, "q", (m, "n")))
         object.__setattr__(self, "base_position", _array(self.base_position, "base_position", (m, 3)))
-        object.__setattr__(self, "base_attitude", _array(self.base_attitude, "base_attitude", (m, 4)))
+        attitude = _array(self.base_attitude, "base_attitude", (m, 4))
+        if attitude is not None and not np.all(np.linalg.norm(attitude, axis=-1) > 1e-9):
+            raise ConfigurationError("ArmMotion.base_attitude must be unit quaternions (w, x, y, z); got a zero row")
+        object.__setattr__(self, "base_attitude", attitude)
         object.__setattr__(self, "target", _array(self.target, "target", (m, 3)))
         if (self.base_position is None) != (self.base_attitude is None):
             raise ConfigurationError("ArmMotion: give base_position and base_attitude together, or neither")
-        object.__setattr__(self, "locks", tuple((int(j), float(s)) for j, s in self.locks))
+        try:
+            locks = tuple((int(j), float(s)) for j, s in self.locks)
+        except (TypeError, ValueError):
+            raise ConfigurationError(
+                f"ArmMotion.locks must be (joint number, time [s]) pairs; got {str(self.locks)[:60]!r}"
+            ) from None
+        object.__setattr__(self, "locks", locks)
 
     @property
     def moving_base(self) -> bool:
@@ -153,6 +170,11 @@ def motion_points(model: ArmModel, motion: ArmMotion, times: FloatArray) -> dict
     if motion.q.shape[1] != model.dof:
         raise ConfigurationError(
             f"motion {motion.label!r} has {motion.q.shape[1]} joint angles; the arm {model.name!r} has {model.dof}"
+        )
+    unknown = [j for j, _ in motion.locks if j not in model.joint_numbers]
+    if unknown:
+        raise ConfigurationError(
+            f"motion {motion.label!r} locks joints {unknown}; the arm {model.name!r} has joints {list(model.joint_numbers)}"
         )
     k = _nearest(motion.t, np.asarray(times, dtype=float))
     q = motion.q[k]

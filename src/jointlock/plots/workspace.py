@@ -96,8 +96,8 @@ def plot_workspace_clouds(
     full: ArrayLike, locked: ArrayLike | None = None, *, max_points: int = 5000, fig: Any | None = None
 ) -> Any:
     """The full arm's cloud (002 Fig. 2) and, beside it, the locked arm's (Fig. 3), each on
-    its own 3-D axis, both on the same axis limits (the full arm's box, equal in x, y and z) so
-    that the two compare by eye.  ``fig=None``: a new 11 x 5 inch figure.  Returns the figure."""
+    its own 3-D axis, both on the same axis limits (the cube around both clouds, equal in x, y
+    and z) so that the two compare by eye.  ``fig=None``: a new 11 x 5 inch figure.  Returns the figure."""
     fig = new_figure(fig, (11, 5))
     clouds = [("full arm", full, FULL_COLOUR)] + (
         [("locked arm", locked, LOCKED_COLOUR)] if locked is not None else []

@@ -107,7 +107,7 @@ def _search_halt_configuration(
             state.q, state.dq, state.ddq, float(T), limits.velocity, limits.acceleration, per_joint=per_joint
         )
     note = None
-    bar = Progress(samples, "halt configuration", enabled=progress)
+    bar = Progress(samples, "halt configuration", enabled=None if progress else False)
     try:
         hc = optimal_halt_configuration(
             model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar, reachability=reach
@@ -117,7 +117,7 @@ def _search_halt_configuration(
             raise
         note = f"not met, searched the whole ranges instead (000's way): {exc}"
         bar.close()
-        bar = Progress(samples, "halt configuration", enabled=progress)
+        bar = Progress(samples, "halt configuration", enabled=None if progress else False)
         hc = optimal_halt_configuration(
             model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar
         )
@@ -334,7 +334,7 @@ def plan_halt(
         base=base, n_samples=n_samples, moment_about=moment_about, tau_max=kept.torque, brake_max=kept.brake,
         objective=objective,
     )  # fmt: skip
-    bar = Progress(ga.n_gen, "GA generations", enabled=progress) if solver == "ga" else None
+    bar = Progress(ga.n_gen, "GA generations", enabled=None if progress else False) if solver == "ga" else None
     motion = optimal_halt_motion(
         problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar,
         prefer_margin=prefer_margin,

@@ -204,7 +204,7 @@ def search_singularities(
     _check_choice("weighting", weighting, WEIGHTINGS)
     _check_samples(samples)
     seed = resolve_seed(rng)  # None: a fresh seed, recorded in the result
-    with Progress(max_iter, "searching", enabled=progress) as bar:
+    with Progress(max_iter, "searching", enabled=None if progress else False) as bar:
         res = sg.find_singularities(
             model,
             samples=samples,

@@ -165,7 +165,7 @@ def verify_singularity_conditions(
     _check_samples(samples)
     _check_samples(search_samples, "search_samples")
     seed = resolve_seed(rng)  # None: a fresh seed, recorded in the result
-    with Progress(len(sg.CONDITIONS) + 2, "verifying", enabled=progress) as bar:
+    with Progress(len(sg.CONDITIONS) + 2, "verifying", enabled=None if progress else False) as bar:
         ver = sg.verify_conditions(
             model,
             samples=samples,
