@@ -126,8 +126,19 @@ def _urdf(body: str) -> str:
     "xml, message",
     [
         (
+            _urdf('<joint name="j" type="planar"><parent link="a"/><child link="b"/></joint>'),
+            "joint 'j': type 'planar' is not supported",
+        ),
+        (
             _urdf('<joint name="j" type="prismatic"><parent link="a"/><child link="b"/></joint>'),
-            "joint 'j': type 'prismatic' is not supported",
+            "joint 'j': a prismatic joint needs <limit",
+        ),
+        (
+            '<robot name="r"><link name="a"/><link name="b"/><link name="c"/>'
+            '<joint name="r1" type="continuous"><parent link="a"/><child link="b"/></joint>'
+            '<joint name="j" type="prismatic"><parent link="b"/><child link="c"/><limit lower="0" upper="1"/></joint>'
+            "</robot>",
+            "joint 'j' on the chain is prismatic; jointlock's chain has revolute joints only: freeze it",
         ),
         (
             _urdf('<joint name="j" type="revolute"><parent link="a"/><child link="b"/></joint>'),
@@ -170,7 +181,7 @@ def test_urdf_branching_movable_joints_are_refused():
         '<joint name="j1" type="continuous"><parent link="a"/><child link="b"/></joint>'
         '<joint name="j2" type="continuous"><parent link="a"/><child link="c"/></joint></robot>'
     )
-    with pytest.raises(jl.ModelError, match="only serial chains"):
+    with pytest.raises(jl.ModelError, match="the tree branches at link 'a' into joints \\['j1', 'j2'\\]; name the chain's end"):
         jl.read_urdf(xml)
 
 

@@ -27,12 +27,27 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     mass_kg = 1000.0
     com_m = [0.0, 0.0, -1.0]            # in the root frame (DH frame 0)
     inertia_kgm2 = [667.0, 667.0, 667.0]
+
+Or the chain of a URDF tree (:func:`jointlock.read_urdf`), which every command then takes as
+``ROBOT``::
+
+    name = "panda-arm"
+    urdf = "panda.urdf"                 # relative to this file
+    root_link = "panda_link0"           # optional: default the tree's root
+    tip_link = "panda_hand_tcp"         # optional when the tree has one movable path
+    freeze_deg = { panda_joint7 = 45.0 }            # revolute joints held [deg]
+    freeze_m = { panda_finger_joint1 = 0.02 }       # prismatic joints held [m]
+
+Every joint off the chain is held at 0 unless frozen here (a ``<mimic>`` joint follows the
+joint it mimics).  The root link's inertial is the spacecraft: with a mass, the model can be
+loaded with ``base="floating"``.
 """
 
 from __future__ import annotations
 
 import difflib
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -114,8 +129,11 @@ def _body(table: dict[str, Any], where: str, name: str) -> Body:
         raise ModelError(f"{where}: {exc}") from None
 
 
-def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
-    """Build a model from the parsed TOML structure (see the module docstring)."""
+def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Path = ".") -> ArmModel:
+    """Build a model from the parsed TOML structure (see the module docstring); ``folder``:
+    where a ``urdf`` path is relative to."""
+    if "urdf" in data:
+        return _urdf_model(data, where, Path(folder))
     _check_keys(data, _TOP_KEYS, where)
     convention = data.get("convention")
     if not isinstance(convention, str) or convention not in _CONVENTIONS:
@@ -200,4 +218,38 @@ def model_from_dict(data: dict[str, Any], where: str = "model") -> ArmModel:
 def read_model_toml(path: str | Path) -> ArmModel:
     """Read a TOML model file (format in the module docstring)."""
     data = read_toml_file(path, "model file", ModelError)
-    return model_from_dict(data, shorten(str(path)))
+    return model_from_dict(data, shorten(str(path)), Path(path).parent)
+
+
+_URDF_KEYS = {"name", "description", "urdf", "root_link", "tip_link", "freeze_deg", "freeze_m"}
+
+
+def _urdf_model(data: dict[str, Any], where: str, folder: Path) -> ArmModel:
+    """The ``urdf = ...`` form: the chain of a URDF tree, floating when its root link has mass."""
+    from .urdf import read_urdf
+
+    _check_keys(data, _URDF_KEYS, where)
+    texts = {k: data.get(k) for k in ("urdf", "root_link", "tip_link", "name", "description")}
+    for key, value in texts.items():
+        if value is not None and (not isinstance(value, str) or not value):
+            raise ModelError(f"{where}: field {shown(key)} must be a non-empty string; got {shown(value)}")
+    freeze: dict[str, float] = {}
+    for key, scale in (("freeze_deg", math.pi / 180.0), ("freeze_m", 1.0)):
+        table = data.get(key, {})
+        if not isinstance(table, dict):
+            raise ModelError(f"{where}: field {shown(key)} must be a table {{joint = value}}; got {shown(table)}")
+        for joint, value in table.items():
+            if joint in freeze:
+                raise ModelError(f"{where}: joint {shown(joint)} is in both freeze_deg and freeze_m")
+            limit = MAX_OPTION_DEG if scale != 1.0 else MAX_LENGTH_M
+            freeze[joint] = scale * as_real(value, f"{where}: {key}.{joint}", lo=-limit, hi=limit, error=ModelError)
+    model = read_urdf(
+        folder / str(texts["urdf"]),
+        name=texts["name"],
+        root_link=texts["root_link"],
+        tip_link=texts["tip_link"],
+        freeze=freeze,
+    )
+    if texts["description"]:
+        model = replace(model, description=f"{texts['description']} ({model.description})")
+    return model.with_base(model.root_body) if model.root_body.mass > 0 else model

@@ -1,10 +1,15 @@
 """URDF reader into the internal chain form.
 
-Supported: ``revolute``, ``continuous`` and ``fixed`` joints, ``<inertial>`` blocks.  Fixed
-joints are merged into their parent body (the frames behind them are kept for the end
-effector).  The movable joints must form a single serial path from the root link; branches
-of fixed links are fine.  Prismatic, planar and floating joints are rejected with a message
-naming the joint.
+A URDF is a tree; a jointlock model is the serial chain from ``root_link`` (default: the tree's
+root) to ``tip_link`` (default: the end of the one path of movable joints, when there is one).
+On that chain, ``revolute`` and ``continuous`` joints move; everything else is frozen and its
+bodies merged into the chain link it hangs from (as :func:`jointlock.lock` does): ``fixed``
+joints, the joints named in ``freeze`` (at the value given), and every joint off the chain --
+the other arm of a dual-arm robot, gripper fingers, sensors -- at its ``freeze`` value, else at
+0 (a ``<mimic>`` joint at ``multiplier * value + offset`` of the joint it follows).  Links
+above ``root_link`` are left out.  A prismatic joint on the chain must be frozen (the chain
+model has revolute joints only), and so must a mimic joint on it (no coupled joints): each is
+refused in one line naming it.  Planar and floating joints are refused anywhere.
 """
 
 from __future__ import annotations
@@ -12,6 +17,7 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
+from collections.abc import Mapping
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Literal
@@ -22,6 +28,7 @@ from ..bounds import MAX_JOINT_VALUE, MAX_LENGTH_M, shown
 from ..errors import ModelError
 from ..model import ArmModel, Body, Joint
 from ..spatial import pose, rpy_matrix
+from ._urdf_chain import Chain, select_chain
 from .files import check_path_text, decode_text, read_input_bytes, shorten
 
 
@@ -37,6 +44,7 @@ class _UrdfJoint:
     upper: float
     velocity: float
     effort: float
+    mimic: tuple[str, float, float] | None = None  # (joint followed, multiplier, offset)
 
 
 def _floats(text: str | None, count: int, where: str, default: list[float]) -> np.ndarray:
@@ -134,6 +142,9 @@ def read_urdf(
     base: Literal["fixed", "floating"] = "fixed",
     ee_link: str | None = None,
     name: str | None = None,
+    root_link: str | None = None,
+    tip_link: str | None = None,
+    freeze: Mapping[str, float] | None = None,
 ) -> ArmModel:
     """Read a URDF file (or a string holding URDF XML) into an :class:`ArmModel`.
 
@@ -144,11 +155,22 @@ def read_urdf(
     base
         ``"fixed"``, or ``"floating"``: the root link's inertial becomes the spacecraft (it
         must have a positive mass).
-    ee_link
-        Link whose frame is the end effector; default: the last link of the chain (following
-        fixed joints after the last movable joint while the path is unique).
+    ee_link, tip_link
+        Link whose frame is the end effector (the chain's end; one setting, two names);
+        default: the end of the one path of movable joints from ``root_link`` (then fixed
+        joints while the path is unique).  A tree that branches into several movable paths
+        (two arms, two gripper fingers) needs it, or the other branches frozen.
     name
         Model name; default: the ``<robot name>``.
+    root_link
+        Link the chain starts from (its root body; the spacecraft with ``base="floating"``);
+        default: the tree's root.  Links above it are left out.
+    freeze
+        ``{joint name: value}`` [rad, or m for a prismatic joint]: joints held at a value and
+        merged, on the chain or off it.  Joints off the chain not named here are held at 0 (a
+        ``<mimic>`` joint at ``multiplier * value + offset`` of the one it follows).
+
+    The chain is described in the model's ``description`` (root, tip, frozen joints).
     """
     source_text = str(source)
     text: str | bytes = source_text
@@ -179,12 +201,14 @@ def read_urdf(
         jname = jel.get("name") or "?"
         where = f"{label}: joint {shown(jname)}"
         kind = jel.get("type")
-        if kind in ("prismatic", "planar", "floating"):
+        if kind in ("planar", "floating"):
             raise ModelError(
-                f"{where}: type {shown(kind)} is not supported (allowed: revolute, continuous, fixed)"
+                f"{where}: type {shown(kind)} is not supported (allowed: revolute, continuous, prismatic, fixed)"
             )
-        if kind not in ("revolute", "continuous", "fixed"):
-            raise ModelError(f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, fixed)")
+        if kind not in ("revolute", "continuous", "prismatic", "fixed"):
+            raise ModelError(
+                f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, prismatic, fixed)"
+            )
         parent_el, child_el = jel.find("parent"), jel.find("child")
         parent = parent_el.get("link") if parent_el is not None else None
         child = child_el.get("link") if child_el is not None else None
@@ -202,9 +226,9 @@ def read_urdf(
         )
         lower, upper, velocity, effort = -math.inf, math.inf, math.inf, math.inf
         limit = jel.find("limit")
-        if kind == "revolute":
+        if kind in ("revolute", "prismatic"):
             if limit is None:
-                raise ModelError(f"{where}: a revolute joint needs <limit lower=... upper=...>")
+                raise ModelError(f"{where}: a {kind} joint needs <limit lower=... upper=...>")
             lower = _number(limit, "lower", f"{where} <limit>", 0.0)
             upper = _number(limit, "upper", f"{where} <limit>", 0.0)
         if limit is not None and limit.get("velocity") is not None:
@@ -217,98 +241,56 @@ def read_urdf(
                 effort = math.inf
         if kind != "fixed" and np.max(np.abs(axis)) < 1e-12:  # (a norm would overflow at 1e154)
             raise ModelError(f"{where}: <axis xyz> must be non-zero")
+        mimic_el = jel.find("mimic")
+        mimic = None
+        if mimic_el is not None and kind != "fixed":
+            mimic = (
+                mimic_el.get("joint") or "?",
+                _number(mimic_el, "multiplier", f"{where} <mimic>", 1.0),
+                _number(mimic_el, "offset", f"{where} <mimic>", 0.0),
+            )
         joints.append(
             _UrdfJoint(
-                jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity, effort
+                jname, kind, parent, child, _origin(jel.find("origin"), where), axis, lower, upper, velocity, effort,
+                mimic,
             )
-        )
+        )  # fmt: skip
 
-    children: dict[str, list[_UrdfJoint]] = {k: [] for k in links}
-    parent_of: dict[str, str] = {}
-    for j in joints:
-        if j.child in parent_of:
-            raise ModelError(f"{label}: link {shown(j.child)} has two parent joints")
-        parent_of[j.child] = j.name
-        children[j.parent].append(j)
     if not links:
         raise ModelError(f"{label}: no <link> found (a robot is links joined by joints)")
-    roots = [k for k in links if k not in parent_of]
-    if len(roots) != 1:
-        names = _some_names(roots)
-        why = " (every link has a parent: the joints form a cycle)" if not roots else ""
-        raise ModelError(f"{label}: expected exactly one root link; found {len(roots)}: [{names}]{why}")
-    root_link = roots[0]
+    if ee_link is not None and tip_link is not None and ee_link != tip_link:
+        raise ModelError(f"{label}: ee_link {shown(ee_link)} and tip_link {shown(tip_link)} differ (they are one setting)")
+    chain = select_chain(
+        label, list(links), joints, root_link=root_link, tip_link=tip_link or ee_link, freeze=freeze
+    )
+    owner, in_owner, movable = chain.owner, chain.in_owner, chain.movable
 
-    # Walk the tree: every link belongs to an owner body (root = -1 or a movable joint index).
-    owner: dict[str, int] = {root_link: -1}
-    in_owner: dict[str, np.ndarray] = {root_link: np.eye(4)}
-    movable: list[tuple[_UrdfJoint, np.ndarray, int]] = []  # joint, placement in parent owner, parent owner
-    stack = [root_link]
-    while stack:
-        lname = stack.pop()
-        for j in children[lname]:
-            if j.kind == "fixed":
-                owner[j.child] = owner[lname]
-                in_owner[j.child] = in_owner[lname] @ j.origin
-            else:
-                movable.append((j, in_owner[lname] @ j.origin, owner[lname]))
-                owner[j.child] = len(movable) - 1
-                in_owner[j.child] = np.eye(4)
-            stack.append(j.child)
-    unreached = [k for k in links if k not in owner]
-    if unreached:  # beside the tree from the root: links whose joints form a closed loop
-        names = _some_names(unreached)
-        raise ModelError(
-            f"{label}: links {names} are not connected to the root link {shown(root_link)} (their joints "
-            "form a closed loop); a model is one tree from its root"
-        )
-    if not movable:
-        raise ModelError(f"{label}: no revolute or continuous joint found")
-    for i, (j, _, parent_owner) in enumerate(movable):
-        if parent_owner != i - 1:
-            prev = movable[parent_owner][0].name if parent_owner >= 0 else f"root link {shown(root_link)}"
-            raise ModelError(
-                f"{label}: joint {shown(j.name)} branches from {prev}; only serial chains of movable "
-                "joints are supported"
-            )
-
-    bodies = [Body(0.0, name=movable[i][0].child) for i in range(len(movable))]
-    root_body = Body(0.0, name=root_link)
+    bodies = [Body(0.0, name=j.child) for j, _ in movable]
+    root_body = Body(0.0, name=chain.root)
     for lname, link in links.items():
+        if lname not in owner:  # above root_link: not part of the model
+            continue
         body = _inertial(link, label)
         if body.mass == 0 and not np.any(body.inertia):
             continue
         o = owner[lname]
         if o < 0:
-            root_body = root_body.merged(body, in_owner[lname], name=root_link)
+            root_body = root_body.merged(body, in_owner[lname], name=chain.root)
         else:
             bodies[o] = bodies[o].merged(body, in_owner[lname], name=bodies[o].name)
-
-    last = len(movable) - 1
-    if ee_link is None:
-        ee_link = movable[-1][0].child
-        while len(children[ee_link]) == 1 and children[ee_link][0].kind == "fixed":
-            ee_link = children[ee_link][0].child
-    elif ee_link not in links:
-        raise ModelError(f"{label}: ee_link {shown(ee_link)} is not a link of the robot")
-    elif owner[ee_link] != last:
-        raise ModelError(
-            f"{label}: ee_link {shown(ee_link)} must be rigidly attached to the last movable joint "
-            f"{movable[-1][0].name!r}"
-        )
-    tool = in_owner[ee_link]
+    tool = in_owner[chain.tip]
 
     try:
         model_joints = tuple(
             Joint(placement, j.axis, j.lower, j.upper, j.velocity, number=i + 1, name=j.name, effort_limit=j.effort)
-            for i, (j, placement, _) in enumerate(movable)
+            for i, (j, placement) in enumerate(movable)
         )
     except ModelError as exc:  # e.g. lower > upper: named with the file
         raise ModelError(f"{label}: {exc}") from None
     if base == "floating" and root_body.mass <= 0:
         raise ModelError(
             f"{label}: base='floating' needs an <inertial> with positive mass on the root link "
-            f"{shown(root_link)} (the spacecraft)"
+            f"{shown(chain.root)} (the spacecraft)"
         )
     return ArmModel(
         name=name or root.get("name") or "urdf-arm",
@@ -317,5 +299,16 @@ def read_urdf(
         tool=tool,
         root_body=root_body,
         floating=base == "floating",
-        description=f"read from {label}",
+        description=f"read from {label}" + _selection_text(chain),
     )
+
+
+def _selection_text(chain: Chain) -> str:
+    """``", chain 'a' -> 'b', frozen: j1 = 0.1, ..."`` for the model's description."""
+    text = f", chain {chain.root!r} -> {chain.tip!r}"
+    if chain.frozen:
+        items = [f"{k} = {v:g}" for k, v in chain.frozen.items()]
+        text += ", frozen: " + ", ".join(items[:6]) + (f", ... ({len(items)})" if len(items) > 6 else "")
+    if chain.left_out:
+        text += f", {len(chain.left_out)} links above the root left out"
+    return text
