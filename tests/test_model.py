@@ -97,3 +97,60 @@ def test_a_model_prints_in_one_short_line():
             text = repr(model)
             assert "\n" not in text and len(text) < 200 and text.startswith(f"ArmModel({name!r}")
     assert "locked {2: 17.1887 deg, 4: 0 deg}" in repr(jl.lock_joints(jl.load_robot("halt7"), {2: 0.3, 4: 0.0}))
+
+
+def _three_link(**kwargs):
+    return jl.from_dh(
+        "three", a=[0.0, 0.5, 0.4], alpha=[np.pi / 2, 0.0, 0.0], d=[0.3, 0.0, 0.1], convention="standard",
+        bodies=[jl.Body(2.0, [0.0, 0.1, 0.0], [0.1, 0.2, 0.3])] * 3, **kwargs,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+def test_from_dh_mounts_the_table_on_a_base_pose(convention):
+    """Issue 15, item 1: ``base`` = DH frame 0 in the root frame: every pose moves by it, the
+    Jacobian turns with it, the mass matrix does not change."""
+    from jointlock.spatial import pose, rpy_matrix
+
+    mount = pose(rpy_matrix([0.3, -0.2, 1.1]), [0.1, -0.4, 0.7])
+    plain = jl.from_dh("a", a=[0.0, 0.5, 0.4], alpha=[np.pi / 2, 0.0, 0.0], d=[0.3, 0.0, 0.1], convention=convention)
+    moved = jl.from_dh(
+        "a", a=[0.0, 0.5, 0.4], alpha=[np.pi / 2, 0.0, 0.0], d=[0.3, 0.0, 0.1], convention=convention, base=mount
+    )
+    q = np.random.default_rng(2).uniform(-2, 2, (6, 3))
+    np.testing.assert_allclose(jl.ee_pose(moved, q), mount @ jl.ee_pose(plain, q), atol=1e-12)
+    rot = np.kron(np.eye(2), mount[:3, :3])
+    np.testing.assert_allclose(jl.jacobian(moved, q), rot @ jl.jacobian(plain, q), atol=1e-12)
+
+
+def test_a_flipped_joint_turns_the_other_way():
+    """``flip``: the joint turns about -z, i.e. the table with ``theta - q``."""
+    plain, flipped = _three_link(), _three_link(flip=[False, True, False])
+    q = np.random.default_rng(4).uniform(-2, 2, (6, 3))
+    mirrored = q * [1.0, -1.0, 1.0]
+    np.testing.assert_allclose(jl.ee_pose(flipped, q), jl.ee_pose(plain, mirrored), atol=1e-12)
+    np.testing.assert_allclose(jl.jacobian(flipped, q), jl.jacobian(plain, mirrored) * [1.0, -1.0, 1.0], atol=1e-12)
+    sign = np.diag([1.0, -1.0, 1.0])
+    np.testing.assert_allclose(jl.mass_matrix(flipped, q), sign @ jl.mass_matrix(plain, mirrored) @ sign, atol=1e-12)
+    with pytest.raises(jl.ModelError, match="flip must hold 3 booleans"):
+        _three_link(flip=[1, 0, 0])
+    with pytest.raises(jl.ModelError, match=r"base must be a \(4, 4\) pose"):
+        _three_link(base=np.eye(3))
+
+
+def test_a_model_file_mounts_and_flips(tmp_path):
+    from jointlock.spatial import pose, rpy_matrix
+
+    path = tmp_path / "m.toml"
+    path.write_text(
+        'name = "m"\nconvention = "dh_standard"\n[[joint]]\nalpha_deg = 90.0\nd_m = 0.3\n'
+        "[[joint]]\na_m = 0.5\nflip = true\n[mount]\nxyz_m = [0.0, 0.0, 0.5]\nrpy_deg = [0.0, 0.0, 90.0]\n"
+    )
+    model = jl.read_model_toml(path)
+    plain = jl.from_dh("p", a=[0.0, 0.5], alpha=[np.pi / 2, 0.0], d=[0.3, 0.0], convention="standard")
+    mount = pose(rpy_matrix(np.radians([0.0, 0.0, 90.0])), [0.0, 0.0, 0.5])
+    q = np.array([0.4, 0.7])
+    np.testing.assert_allclose(jl.ee_pose(model, q), mount @ jl.ee_pose(plain, q * [1, -1]), atol=1e-12)
+    path.write_text('convention = "dh_standard"\n[[joint]]\nd_m = 0.3\nflip = "yes"\n')
+    with pytest.raises(jl.ModelError, match="field 'flip' must be true or false"):
+        jl.read_model_toml(path)

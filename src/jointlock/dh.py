@@ -64,6 +64,8 @@ def from_dh(
     effort_limit: ArrayLike | None = None,
     spacecraft: Body | None = None,
     description: str = "",
+    base: ArrayLike | None = None,
+    flip: Sequence[bool] | None = None,
 ) -> ArmModel:
     """Build an arm from a DH table.
 
@@ -87,10 +89,16 @@ def from_dh(
     effort_limit
         (n,) motor torque limits [N m]; unlimited when omitted.
     spacecraft
-        Spacecraft body (centre of mass and inertia in the root frame = DH frame 0); the arm
-        is free-floating when given, fixed-base otherwise.
+        Spacecraft body (centre of mass and inertia in the root frame: DH frame 0 unless
+        ``base`` moves it); the arm is free-floating when given, fixed-base otherwise.
     description
         Provenance and readings, kept with the model.
+    base
+        (4, 4) pose of DH frame 0 in the root frame (the arm's mounting on its spacecraft or
+        pedestal) [m]; identity when omitted.
+    flip
+        (n,) True for a joint whose positive rotation is about -z (``theta_i - q_i`` in the
+        table, roboticstoolbox's ``flip``); all False when omitted.
     """
     if convention not in ("standard", "modified"):
         raise ModelError(f"convention must be 'standard' or 'modified'; got {shown(convention)}")
@@ -121,6 +129,12 @@ def from_dh(
     if len(bodies) != n:
         raise ModelError(f"bodies must hold one body per DH row ({n}); got {len(bodies)}")
     tool_arr = np.eye(4) if tool is None else np.asarray(tool, dtype=float)
+    base_arr = np.eye(4) if base is None else np.asarray(base, dtype=float)
+    if base_arr.shape != (4, 4) or not np.all(np.isfinite(base_arr)):
+        raise ModelError(f"base must be a (4, 4) pose of DH frame 0 [m]; got shape {base_arr.shape}")
+    flips = [False] * n if flip is None else list(flip)
+    if len(flips) != n or not all(isinstance(f, (bool, np.bool_)) for f in flips):
+        raise ModelError(f"flip must hold {n} booleans (True: the joint turns about -z); got {shown(flip)}")
 
     if convention == "modified":
         placements = [
@@ -145,10 +159,11 @@ def from_dh(
         frame_bodies = [bodies[i].transformed(fixed[i]) for i in range(n)]
         model_tool = fixed[-1] @ tool_arr
 
+    placements[0] = base_arr @ placements[0]
     joints = tuple(
         Joint(
             placements[i],
-            np.array([0.0, 0.0, 1.0]),
+            np.array([0.0, 0.0, -1.0 if flips[i] else 1.0]),
             lo[i],
             hi[i],
             vmax[i],

@@ -18,10 +18,15 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     mass_kg = 42.5                      # optional body of the link, in its DH frame
     com_m = [0.0, 0.25, 0.0]
     inertia_kgm2 = [0.89, 0.05, 0.89]   # [Ixx, Iyy, Izz], 6 values or 3x3
+    flip = false                        # optional: true = turns about -z (theta - q)
 
     [tool]                              # optional: end effector in the last DH frame
     xyz_m = [0.0, 0.0, 0.1]
     rpy_deg = [0.0, 0.0, 0.0]           # URDF roll-pitch-yaw
+
+    [mount]                             # optional: DH frame 0 in the root frame
+    xyz_m = [0.0, 0.0, 0.5]
+    rpy_deg = [0.0, 0.0, 90.0]
 
     [base]                              # optional: a free-floating spacecraft
     mass_kg = 1000.0
@@ -60,7 +65,7 @@ from ..model import ArmModel, Body
 from ..spatial import pose, rpy_matrix
 from .files import read_toml_file, shorten
 
-_TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base"}
+_TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base", "mount"}
 _JOINT_KEYS = {
     "a_m",
     "alpha_deg",
@@ -74,6 +79,7 @@ _JOINT_KEYS = {
     "com_m",
     "inertia_kgm2",
     "name",
+    "flip",
 }
 _TOOL_KEYS = {"xyz_m", "rpy_deg"}
 _BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2"}
@@ -129,6 +135,21 @@ def _body(table: dict[str, Any], where: str, name: str) -> Body:
         raise ModelError(f"{where}: {exc}") from None
 
 
+def _pose_table(data: dict[str, Any], key: str, where: str) -> np.ndarray:
+    """The pose of table ``[key]`` (``xyz_m``, ``rpy_deg``); identity without the table."""
+    if key not in data:
+        return np.eye(4)
+    tw = f"{where}: [{key}]"
+    if not isinstance(data[key], dict):
+        raise ModelError(f"{tw}: must be a table")
+    _check_keys(data[key], _TOOL_KEYS, tw)
+    xyz = _array(data[key], "xyz_m", tw, [0.0, 0.0, 0.0])
+    rpy = np.radians(_array(data[key], "rpy_deg", tw, [0.0, 0.0, 0.0]))
+    if xyz.shape != (3,) or rpy.shape != (3,):
+        raise ModelError(f"{tw}: xyz_m and rpy_deg must hold 3 numbers each")
+    return pose(rpy_matrix(rpy), xyz)
+
+
 def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Path = ".") -> ArmModel:
     """Build a model from the parsed TOML structure (see the module docstring); ``folder``:
     where a ``urdf`` path is relative to."""
@@ -145,6 +166,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
         raise ModelError(f"{where}: needs at least one [[joint]] table")
     cols: dict[str, list[float]] = {k: [] for k in ("a", "alpha", "d", "theta", "lower", "upper", "vmax", "effort")}
     bodies = []
+    flips: list[bool] = []
     for i, row in enumerate(rows, start=1):
         jw = f"{where}: joint {i}"
         if not isinstance(row, dict):
@@ -169,17 +191,11 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
                 f"{jw}: lower_deg must be <= upper_deg; got {row.get('lower_deg')} > {row.get('upper_deg')}"
             )
         bodies.append(_body(row, jw, str(row.get("name", f"link{i}"))))
-    tool = np.eye(4)
-    if "tool" in data:
-        tw = f"{where}: [tool]"
-        if not isinstance(data["tool"], dict):
-            raise ModelError(f"{tw}: must be a table")
-        _check_keys(data["tool"], _TOOL_KEYS, tw)
-        xyz = _array(data["tool"], "xyz_m", tw, [0.0, 0.0, 0.0])
-        rpy = np.radians(_array(data["tool"], "rpy_deg", tw, [0.0, 0.0, 0.0]))
-        if xyz.shape != (3,) or rpy.shape != (3,):
-            raise ModelError(f"{tw}: xyz_m and rpy_deg must hold 3 numbers each")
-        tool = pose(rpy_matrix(rpy), xyz)
+        flip = row.get("flip", False)
+        if not isinstance(flip, bool):
+            raise ModelError(f"{jw}: field 'flip' must be true or false; got {shown(flip)}")
+        flips.append(flip)
+    tool, mount = _pose_table(data, "tool", where), _pose_table(data, "mount", where)
     spacecraft = None
     if "base" in data:
         bw = f"{where}: [base]"
@@ -210,6 +226,8 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
             effort_limit=cols["effort"],
             spacecraft=spacecraft,
             description=str(data.get("description", f"read from {where}")),
+            base=mount,
+            flip=flips,
         )
     except ModelError as exc:  # e.g. a joint's limits: named with the file
         raise ModelError(f"{where}: {exc}") from None
