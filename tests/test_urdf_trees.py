@@ -194,3 +194,25 @@ def test_a_model_file_names_the_chain_so_every_command_takes_it(tmp_path, capsys
     model_file.write_text('urdf = "dual.urdf"\nfreeze_deg = { r2 = "a" }\n')
     with pytest.raises(ModelError, match=r"freeze_deg\.r2"):
         jl.read_model_toml(model_file)
+
+
+def test_review_fixes_units_mimic_followers_and_a_changed_urdf(tmp_path):
+    """freeze_deg / freeze_m are checked against the joint's type; a mimic follower is no
+    branch (the default tip passes a gripper whose master finger is frozen); a model file
+    naming a URDF sees the URDF's edits; a joint above root_link cannot be frozen."""
+    model = jl.read_urdf(DUAL_ARM, root_link="l_upper", freeze={"l_finger_a": 0.01})
+    assert [j.name for j in model.joints] == ["l2", "l3"] and "'l_tcp'" in model.description
+    with pytest.raises(ModelError, match=r"not below root_link 'l_upper'"):
+        jl.read_urdf(DUAL_ARM, root_link="l_upper", freeze={"l_finger_a": 0.01, "r1": 0.1})
+    (tmp_path / "dual.urdf").write_text(DUAL_ARM)
+    model_file = tmp_path / "m.toml"
+    model_file.write_text('urdf = "dual.urdf"\ntip_link = "l_tcp"\nfreeze_m = { r2 = 0.4 }\n')
+    with pytest.raises(ModelError, match=r"m.toml: .*dual.urdf: joint 'r2' is revolute: give it in freeze_deg"):
+        jl.load_robot(str(model_file))
+    model_file.write_text('urdf = "dual.urdf"\ntip_link = "l_tcp"\nfreeze_deg = { l_finger_a = 1.0 }\n')
+    with pytest.raises(ModelError, match=r"joint 'l_finger_a' is prismatic: give it in freeze_m"):
+        jl.load_robot(str(model_file))
+    model_file.write_text('urdf = "dual.urdf"\ntip_link = "l_tcp"\n')
+    before = jl.load_robot(str(model_file)).tool[2, 3]
+    (tmp_path / "dual.urdf").write_text(DUAL_ARM.replace('"0 0 0.12"', '"0 0 0.5"'))
+    assert jl.load_robot(str(model_file)).tool[2, 3] != pytest.approx(before)

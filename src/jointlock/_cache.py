@@ -31,5 +31,5 @@ def cached_on(obj: Any, name: str, compute: Callable[[], T]) -> T:
             store[name] = (False, exc)
     ok, value = store[name]
     if not ok:
-        raise type(value)(*value.args)
+        raise value
     return value

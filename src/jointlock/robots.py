@@ -314,8 +314,11 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         check_path_text(text, "model file", ModelError)
         try:
             stat = Path(text).stat()
+            refers = suffix == ".toml" and b"urdf" in Path(text).read_bytes()[:1_000_000]
         except OSError:  # the reader names the file and the reason
-            return _read_model_file(text, base, None)
+            return _read_model_file.__wrapped__(text, base, None)
+        if refers:  # a model file naming a URDF: the URDF may change on its own; read both afresh
+            return _read_model_file.__wrapped__(text, base, None)
         return _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size))
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""

@@ -87,11 +87,14 @@ def select_chain(
     root_link: str | None = None,
     tip_link: str | None = None,
     freeze: Mapping[str, float] | None = None,
+    freeze_units: Mapping[str, str] | None = None,
 ) -> Chain:
     """The chain from ``root_link`` to ``tip_link`` with every other joint frozen (module
     docstring); refuses, in one line naming what, a link or joint that does not exist, a tip not
     below the root, a branching tree without ``tip_link``, a prismatic or mimic joint left
-    movable on the chain, and a frozen value outside its joint's limits."""
+    movable on the chain, and a frozen value outside its joint's limits.  ``freeze_units``
+    (``{joint: "deg" | "m"}``, a model file's ``freeze_deg`` / ``freeze_m``) are checked against
+    each joint's type."""
     children, above, tree_root = _tree(label, links, joints)
     reachable = set(_below(children, tree_root))
     unreached = [k for k in links if k not in reachable]
@@ -113,12 +116,17 @@ def select_chain(
             raise ModelError(f"{label}: freeze names joint {shown(name)}, which is fixed already")
         if isinstance(given, bool) or not isinstance(given, (int, float)) or not math.isfinite(given):
             raise ModelError(f"{label}: freeze {shown(name)} must be a finite number; got {shown(given)}")
+        unit = (freeze_units or {}).get(name)
+        if unit is not None and (unit == "m") != (j.kind == "prismatic"):
+            want = "freeze_m [m]" if j.kind == "prismatic" else "freeze_deg [deg]"
+            raise ModelError(f"{label}: joint {shown(name)} is {j.kind}: give it in {want}")
     below = _below(children, root)
+    above_root = [n for n in freeze if by_name[n].child not in below]
+    if above_root:
+        raise ModelError(f"{label}: freeze names joints [{_some(above_root)}], which are not below root_link {shown(root)}")
     active_below: dict[str, bool] = {}
     for link in reversed(below):  # children before parents
-        active_below[link] = any(
-            (j.kind != "fixed" and j.name not in freeze) or active_below[j.child] for j in children[link]
-        )
+        active_below[link] = any(_active(j, freeze) or active_below[j.child] for j in children[link])
     tip = _tip(label, root, tip_link, children, above, active_below, freeze)
     if not any(j.kind in ("revolute", "continuous") for link in below for j in children[link]):
         raise ModelError(f"{label}: no revolute or continuous joint found" + (f" below {shown(root)}" if root_link else ""))
@@ -152,8 +160,10 @@ def select_chain(
             v = float(freeze[j.name])
         elif j.mimic is not None:
             master = by_name.get(j.mimic[0])
-            if master is None or master.name in seen:
-                raise ModelError(f"{label}: joint {shown(j.name)} mimics {shown(j.mimic[0])}, which is not a joint it can follow")
+            if master is None:
+                raise ModelError(f"{label}: joint {shown(j.name)} mimics {shown(j.mimic[0])}, which is not a joint")
+            if master.name in seen or master.name == j.name:
+                raise ModelError(f"{label}: joints [{_some([*seen, j.name])}] mimic each other in a cycle")
             if master.name in index:
                 raise ModelError(
                     f"{label}: joint {shown(j.name)} off the chain mimics chain joint {shown(master.name)}: its links "
@@ -162,6 +172,8 @@ def select_chain(
             v = j.mimic[1] * value(master, (*seen, j.name)) + j.mimic[2]
         else:
             v = 0.0
+        if not math.isfinite(v) or abs(v) > 1e6:
+            raise ModelError(f"{label}: joint {shown(j.name)} would be frozen at {v:g}: give it a value with freeze")
         if j.kind in ("revolute", "prismatic") and not j.lower - LIMIT_SLACK <= v <= j.upper + LIMIT_SLACK:
             raise ModelError(
                 f"{label}: joint {shown(j.name)} is frozen at {v:g} (off the chain, or named in freeze), outside its "
@@ -210,7 +222,7 @@ def _tip(
         return tip_link
     link = root
     while True:
-        branches = [j for j in children[link] if (j.kind != "fixed" and j.name not in freeze) or active_below[j.child]]
+        branches = [j for j in children[link] if _active(j, freeze) or active_below[j.child]]
         if len(branches) > 1:
             raise ModelError(
                 f"{label}: the tree branches at link {shown(link)} into joints [{_some([j.name for j in branches])}]; "
@@ -219,6 +231,12 @@ def _tip(
         if not branches:
             break
         link = branches[0].child
-    while len(children[link]) == 1 and children[link][0].kind == "fixed":
-        link = children[link][0].child
+    while len(fixed := [j for j in children[link] if j.kind == "fixed"]) == 1:  # frozen fingers beside it
+        link = fixed[0].child
     return link
+
+
+def _active(joint: Any, freeze: Mapping[str, float]) -> bool:
+    """A joint that would move on a chain: not fixed, not frozen, not a mimic follower (which
+    follows its joint: it never moves on its own)."""
+    return joint.kind != "fixed" and joint.name not in freeze and joint.mimic is None

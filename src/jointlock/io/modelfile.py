@@ -252,6 +252,7 @@ def _urdf_model(data: dict[str, Any], where: str, folder: Path) -> ArmModel:
         if value is not None and (not isinstance(value, str) or not value):
             raise ModelError(f"{where}: field {shown(key)} must be a non-empty string; got {shown(value)}")
     freeze: dict[str, float] = {}
+    units: dict[str, str] = {}
     for key, scale in (("freeze_deg", math.pi / 180.0), ("freeze_m", 1.0)):
         table = data.get(key, {})
         if not isinstance(table, dict):
@@ -260,14 +261,23 @@ def _urdf_model(data: dict[str, Any], where: str, folder: Path) -> ArmModel:
             if joint in freeze:
                 raise ModelError(f"{where}: joint {shown(joint)} is in both freeze_deg and freeze_m")
             limit = MAX_OPTION_DEG if scale != 1.0 else MAX_LENGTH_M
+            units[joint] = "m" if key == "freeze_m" else "deg"
             freeze[joint] = scale * as_real(value, f"{where}: {key}.{joint}", lo=-limit, hi=limit, error=ModelError)
-    model = read_urdf(
+    try:
+        model = _read_urdf_of(read_urdf, folder, texts, freeze, units)
+    except ModelError as exc:  # named with the model file that refers to it
+        raise ModelError(f"{where}: {exc}") from None
+    if texts["description"]:
+        model = replace(model, description=f"{texts['description']} ({model.description})")
+    return model.with_base(model.root_body) if model.root_body.mass > 0 else model
+
+
+def _read_urdf_of(read_urdf: Any, folder: Path, texts: dict[str, Any], freeze: dict[str, float], units: dict[str, str]) -> ArmModel:
+    return read_urdf(
         folder / str(texts["urdf"]),
         name=texts["name"],
         root_link=texts["root_link"],
         tip_link=texts["tip_link"],
         freeze=freeze,
+        freeze_units=units,
     )
-    if texts["description"]:
-        model = replace(model, description=f"{texts['description']} ({model.description})")
-    return model.with_base(model.root_body) if model.root_body.mass > 0 else model

@@ -145,6 +145,7 @@ def read_urdf(
     root_link: str | None = None,
     tip_link: str | None = None,
     freeze: Mapping[str, float] | None = None,
+    freeze_units: Mapping[str, str] | None = None,
 ) -> ArmModel:
     """Read a URDF file (or a string holding URDF XML) into an :class:`ArmModel`.
 
@@ -169,6 +170,9 @@ def read_urdf(
         ``{joint name: value}`` [rad, or m for a prismatic joint]: joints held at a value and
         merged, on the chain or off it.  Joints off the chain not named here are held at 0 (a
         ``<mimic>`` joint at ``multiplier * value + offset`` of the one it follows).
+    freeze_units
+        ``{joint name: "deg" | "m"}``: the unit each value was given in (a model file's
+        ``freeze_deg`` / ``freeze_m``), refused for a joint of the other kind.
 
     The chain is described in the model's ``description`` (root, tip, frozen joints).
     """
@@ -261,8 +265,9 @@ def read_urdf(
     if ee_link is not None and tip_link is not None and ee_link != tip_link:
         raise ModelError(f"{label}: ee_link {shown(ee_link)} and tip_link {shown(tip_link)} differ (they are one setting)")
     chain = select_chain(
-        label, list(links), joints, root_link=root_link, tip_link=tip_link or ee_link, freeze=freeze
-    )
+        label, list(links), joints, root_link=root_link, tip_link=tip_link or ee_link, freeze=freeze,
+        freeze_units=freeze_units,
+    )  # fmt: skip
     owner, in_owner, movable = chain.owner, chain.in_owner, chain.movable
 
     bodies = [Body(0.0, name=j.child) for j, _ in movable]
