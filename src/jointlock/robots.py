@@ -11,6 +11,7 @@ import functools
 import math
 from collections.abc import Callable
 from pathlib import Path
+from stat import S_ISREG
 from typing import Literal, cast
 
 import numpy as np
@@ -262,6 +263,12 @@ def _builtin(name: str, base: BaseMode) -> ArmModel:
     return _builtin_factories()[name](base=base)
 
 
+def _mentions_urdf(path: Path) -> bool:
+    """A regular model file that may name a URDF (its first MB says "urdf"): read uncached."""
+    with open(path, "rb") as fh:
+        return b"urdf" in fh.read(1_000_000)
+
+
 @functools.lru_cache(maxsize=32)
 def _read_model_file(path: str, base: BaseMode, stamp: tuple[str, int, int] | None) -> ArmModel:
     """A model file read once per (absolute path, base, modification time, size): an edited
@@ -314,7 +321,7 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         check_path_text(text, "model file", ModelError)
         try:
             stat = Path(text).stat()
-            refers = suffix == ".toml" and b"urdf" in Path(text).read_bytes()[:1_000_000]
+            refers = suffix == ".toml" and S_ISREG(stat.st_mode) and _mentions_urdf(Path(text))
         except OSError:  # the reader names the file and the reason
             return _read_model_file.__wrapped__(text, base, None)
         if refers:  # a model file naming a URDF: the URDF may change on its own; read both afresh
