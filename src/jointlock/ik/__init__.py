@@ -1,4 +1,5 @@
-"""Inverse kinematics: closed form for the ``puma6`` family (seed 002), numerical otherwise.
+"""Inverse kinematics: closed form for the ``puma6`` family (seed 002) and the UR family
+(three parallel axes, :mod:`jointlock.ik._ur`), numerical otherwise.
 
 Closed form (:func:`ik_closed_form`)
 ------------------------------------
@@ -104,12 +105,14 @@ from ._puma6 import (  # noqa: F401
     _position_branches,
     _rot03,
     _wrist_branches,
+    closed_form_family,
     ik_closed_form,
     puma6_branches,
     puma6_fk,
     puma6_geometry,
 )
 from ._solve import DUPLICATE_TOL, IKResult, IKSolution, _distinct, solve_ik  # noqa: F401
+from ._ur import URGeometry, ur_branches, ur_fk, ur_geometry
 
 __all__ = [
     "DUPLICATE_TOL",
@@ -122,6 +125,8 @@ __all__ = [
     "IKSolution",
     "NumericIK",
     "Puma6Geometry",
+    "URGeometry",
+    "closed_form_family",
     "ik_closed_form",
     "ik_numeric",
     "pose_from_zyx",
@@ -129,6 +134,9 @@ __all__ = [
     "puma6_fk",
     "puma6_geometry",
     "solve_ik",
+    "ur_branches",
+    "ur_fk",
+    "ur_geometry",
     "wrap_angle",
     "zyx_angles",
 ]

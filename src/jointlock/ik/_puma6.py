@@ -15,6 +15,7 @@ from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, turns_into_limits
 from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, wrap_angle
+from ._ur import ur_branches, ur_geometry
 
 #: Largest residual accepted when fitting the puma6 family to a model [m or rad].
 FAMILY_FIT_TOL = 1e-9
@@ -285,33 +286,55 @@ class IKBranches:
     position_error: FloatArray
     rotation_error: FloatArray
     exact: NDArray[np.bool_]
+    family: str = "puma6"
+
+
+def closed_form_family(model: ArmModel) -> str:
+    """``"puma6"`` (002's family, :func:`puma6_geometry`) or ``"ur"`` (three parallel axes,
+    :func:`jointlock.ik._ur.ur_geometry`): the closed form that solves ``model``, decided from
+    its own kinematics; :class:`ModelError` saying why neither does."""
+    try:
+        puma6_geometry(model)
+        return "puma6"
+    except ModelError as puma6_error:
+        try:
+            ur_geometry(model)
+            return "ur"
+        except ModelError as ur_error:
+            raise ModelError(f"no closed form for {model.name!r}: {puma6_error}; {ur_error}") from None
 
 
 def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:
-    """Closed-form IK of a ``puma6``-family arm, full or with one locked joint (batched).
+    """Closed-form IK of a ``puma6``- or UR-family arm, full or with one locked joint (batched).
 
     Parameters
     ----------
     model
-        A family member (:func:`puma6_geometry` decides), possibly with one joint locked.
+        A family member (:func:`closed_form_family` decides), possibly with one joint locked.
     target
         (..., 4, 4) end-effector poses in the root frame [m].
 
     Returns
     -------
     IKBranches
-        Eight branches for the full arm, four with a lock; see the module docstring for the
-        equations (002 eqs. 2-17, with eqs. (6)/(16) for theta3 and (17) for theta4
-        corrected).
+        ``puma6``: eight branches for the full arm, four with a lock; see the module docstring
+        for the equations (002 eqs. 2-17, with eqs. (6)/(16) for theta3 and (17) for theta4
+        corrected).  UR: the full arm's eight branches (:func:`jointlock.ik._ur.ur_branches`);
+        with a lock, those whose locked angle is the lock's are the exact ones.
 
     Raises
     ------
     ModelError
-        If the model is not of the family.
+        If the model is of neither family.
     """
-    geom = puma6_geometry(model)
+    family = closed_form_family(model)
     t = _as_poses(target)
-    q_full, valid = puma6_branches(geom, t @ invert(geom.tool))
+    if family == "puma6":
+        geom = puma6_geometry(model)
+        q_full, valid = puma6_branches(geom, t @ invert(geom.tool))
+    else:
+        ur = ur_geometry(model)
+        q_full, valid = ur_branches(ur, t @ invert(ur.tool))
     q = turns_into_limits(model.healthy(q_full), model.lower, model.upper)  # limits past +-pi kept
     q_full = np.where(valid[..., None], model.expand(np.nan_to_num(q)), np.nan)
     actual = ee_pose(model, np.where(valid[..., None], q, 0.0))
@@ -319,5 +342,5 @@ def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:
     dp = np.where(valid, dp, np.inf)
     dr = np.where(valid, dr, np.inf)
     exact = valid & (dp <= EXACT_POSITION_TOL) & (dr <= EXACT_ROTATION_TOL)
-    return IKBranches(q, q_full, valid, dp, dr, exact)
+    return IKBranches(q, q_full, valid, dp, dr, exact, family)
 

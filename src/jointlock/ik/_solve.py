@@ -16,7 +16,7 @@ from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ._numeric import ik_numeric
 from ._pose import _as_poses, wrap_angle
-from ._puma6 import ik_closed_form, puma6_geometry
+from ._puma6 import closed_form_family, ik_closed_form
 
 #: Two solutions closer than this (max wrapped joint difference) [rad] are the same: angles a
 #: whole turn apart (a joint allowed more than one turn) give one pose and count once.
@@ -82,6 +82,8 @@ class IKResult:
         ``(position [m], rotation [rad])`` within which a pose counts as reached when no exact
         solution exists (a target typed with rounded numbers); ``solutions`` then lists the
         distinct nearest configurations within it (``exact`` False).  None: exact only.
+    family
+        The closed form used (``"puma6"`` or ``"ur"``), None for the numerical method.
     """
 
     target: FloatArray
@@ -93,6 +95,7 @@ class IKResult:
     length_scale: float
     seed: int | None = None
     tolerance: tuple[float, float] | None = None
+    family: str | None = None
 
     @property
     def reachable(self) -> bool:
@@ -129,7 +132,7 @@ def solve_ik(
     ----------
     model
         Any arm, possibly locked.  ``"auto"`` uses the closed form when the model is of the
-        ``puma6`` family (:func:`puma6_geometry`) and Levenberg-Marquardt otherwise.
+        ``puma6`` or UR family (:func:`closed_form_family`) and Levenberg-Marquardt otherwise.
     target
         (4, 4) pose in the root frame [m].
     starts, rng
@@ -158,7 +161,7 @@ def solve_ik(
     use_closed = method == "closed-form"
     if method == "auto":
         try:
-            puma6_geometry(model)
+            closed_form_family(model)
             use_closed = True
         except ModelError:
             use_closed = False
@@ -213,8 +216,9 @@ def solve_ik(
                     if within[k]
                 ]
             )
+    family = closed_form_family(model) if kind == "closed-form" else None
     return IKResult(
-        t, kind, tuple(exact), tuple(cands), nearest, nearest_pose, float(length_scale), seed, tolerance
+        t, kind, tuple(exact), tuple(cands), nearest, nearest_pose, float(length_scale), seed, tolerance, family
     )
 
 

@@ -54,6 +54,7 @@ class InverseKinematicsReport(JobResult):
             "robot": self.model.name,
             "locked": locked_deg(self.model),
             "method": res.method,
+            "family": res.family,
             "target": target,
             "target_position_m": target[:3, 3],
             "target_zyx_deg": np.degrees(zyx_angles(target[:3, :3])),
@@ -84,7 +85,8 @@ class InverseKinematicsReport(JobResult):
         """The lines ``jointlock ik`` prints."""
         res, model = self.result, self.model
         lines = [
-            f"{model.name}: {res.method} IK, locked: {locked_text(locked_deg(model))}",
+            f"{model.name}: {res.method}{f' ({res.family} family)' if res.family else ''} IK, "
+            f"locked: {locked_text(locked_deg(model))}",
             "target T_base_ee [m]:",
             format_matrix(self.target, "{:>11.6f}"),
         ]
