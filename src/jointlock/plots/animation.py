@@ -151,7 +151,7 @@ def animation_figure(
         box_i = boxes[i]
         if box_i is not None:
             moving.append(len(data))
-            name = "spacecraft" if m.moving_base else "spacecraft (held)"
+            name = "spacecraft" if m.moving_base else "spacecraft (held)" if arm.floating else "base body (fixed)"
             data.append(_box_trace(box_i[0], colour, name if len(motions) == 1 else f"{name}, {m.label}"))
 
     frames = []
