@@ -234,3 +234,19 @@ def test_cli_search_labels_joints_and_names_the_lock(capsys):
     )
     rep = next(line for line in text.splitlines() if "representative q [deg]" in line)
     assert "q1=" in rep and "q3=" in rep and "q2=" not in rep
+
+
+def test_ur5_has_its_three_singularities_as_three_families():
+    """Issue 15, item 7: UR5's shoulder, elbow and wrist singularities are three families (the
+    shoulder's dependent joints vary where a null-vector entry vanishes by coincidence: nested
+    sets of one zero group are one family)."""
+    d1, a2, a3, d4, d5, d6 = (0.089159, -0.425, -0.39225, 0.10915, 0.09465, 0.0823)
+    ur5 = jl.from_dh("ur5", a=[0, a2, a3, 0, 0, 0], alpha=[np.pi / 2, 0, 0, np.pi / 2, -np.pi / 2, 0],
+                     d=[d1, 0, 0, d4, d5, d6], convention="standard")  # fmt: skip
+    res = sg.find_singularities(ur5, samples=128, rng=0)
+    assert sorted(f.zero_sine_joints for f in res.families) == [(), (3,), (5,)]
+    shoulder = next(f for f in res.families if f.zero_sine_joints == ())
+    assert shoulder.dependent_joints == (1, 2, 3, 4, 5, 6)
+    assert sum(len(f.members) for f in res.families) == len(res.q)
+    puma = sg.find_singularities(jl.load_robot("puma6"), samples=128, rng=0)
+    assert len(puma.families) == 3  # elbow and shoulder: both no joint at 0, not nested

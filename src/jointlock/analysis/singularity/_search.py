@@ -271,11 +271,15 @@ def cluster_singularities(
     """Group singular configurations (m, n) [rad] into families.
 
     Two configurations are in one family when the same joints sit at 0 or pi
-    (``|sin q| < zero_tol``) and the same joints are *dependent*: with ``v_k`` the right
+    (``|sin q| < zero_tol``) and their *dependent* joints are nested: with ``v_k`` the right
     singular vector of sigma_min (the joint motion that no longer reaches the task space),
     joint ``j`` is dependent when ``sum_i v_ij^2 > 1e-4`` over the singular values below
     ``rank_tol`` — the diagonal of the projector onto that subspace, which does not depend
-    on the SVD's choice of basis.  Both keys are discrete, so the grouping is deterministic.
+    on the SVD's choice of basis.  A dependent set inside another one with the same zero
+    joints is the same singularity where some entry of the null vector vanishes by
+    coincidence (UR5's shoulder singularity shows six such sets): they are merged
+    (transitively), the family keeping the largest set.  The keys are discrete, so the
+    grouping is deterministic.
     Families are sorted by size.  ``jacobian``, ``weighting``, ``characteristic_length``: the
     Jacobian, as in :func:`task_jacobian` (formerly ``base=`` and ``length=``, deprecated aliases).
     """
@@ -292,7 +296,7 @@ def cluster_singularities(
     weight = np.einsum("mi,mij->mj", small.astype(float), vh[:, :k, :] ** 2)
     dependent = weight > 1e-4
     zero = np.abs(np.sin(q)) < zero_tol
-    keys = [tuple(z) + tuple(d) for z, d in zip(zero, dependent)]
+    keys = _merged_keys(zero, dependent)
     rot_ee = chain_state(model, q).ee_rotation
     numbers = np.asarray(model.joint_numbers)
     n = model.dof
@@ -320,3 +324,26 @@ def cluster_singularities(
         )
     families.sort(key=lambda f: -len(f.members))
     return tuple(families)
+
+
+def _merged_keys(zero: np.ndarray, dependent: np.ndarray) -> list[tuple[bool, ...]]:
+    """Each configuration's family key ``zero joints + dependent joints`` (bools), dependent
+    sets nested within one zero group merged transitively onto their union."""
+    sets = {(tuple(z), tuple(d)) for z, d in zip(zero.tolist(), dependent.tolist())}
+    parent = {k: k for k in sets}
+
+    def root(k: tuple) -> tuple:
+        while parent[k] != k:
+            k = parent[k]
+        return k
+
+    ordered = sorted(sets)
+    for i, a in enumerate(ordered):
+        for b in ordered[i + 1 :]:
+            if a[0] == b[0] and (all(x <= y for x, y in zip(a[1], b[1])) or all(y <= x for x, y in zip(a[1], b[1]))):
+                parent[root(a)] = root(b)
+    union: dict[tuple, tuple[bool, ...]] = {}
+    for k in sets:
+        r = root(k)
+        union[r] = tuple(x or y for x, y in zip(union.get(r, k[1]), k[1]))
+    return [tuple(z) + union[root((tuple(z), tuple(d)))] for z, d in zip(zero.tolist(), dependent.tolist())]
