@@ -115,3 +115,27 @@ def test_the_numeric_fallback_finds_every_analytic_branch(name):
             total += 1
             found += _found(sols, analytic.q[k, b], 1e-5)
     assert found >= 0.99 * total, (found, total)
+
+
+@pytest.mark.oracle
+def test_the_numeric_fallback_finds_every_eaik_branch_of_puma560():
+    """Puma560 as roboticstoolbox tabulates it (shoulder offset d3, forearm offset a3: no closed
+    form here): every exact EAIK branch is among the numerical method's solutions."""
+    eaik_dh = pytest.importorskip("eaik.IK_DH")
+    a, d = [0, 0.4318, 0.0203, 0, 0, 0], [0, 0, 0.15005, 0.4318, 0, 0]
+    alpha = [np.pi / 2, 0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0]
+    arm = jl.from_dh("puma560", a=a, alpha=alpha, d=d, convention="standard")
+    robot = eaik_dh.DhRobot(np.array(alpha), np.array(a), np.array(d))
+    q = np.random.default_rng(2).uniform(-np.pi, np.pi, (15, 6))
+    t = jl.ee_pose(arm, q)
+    checked = 0
+    for k in range(len(q)):
+        res = solve_ik(arm, t[k], rng=k)
+        assert res.method == "numeric"
+        sols = np.array([s.q for s in res.solutions])
+        for qe in np.atleast_2d(robot.IK(t[k]).Q):
+            dp, dr = pose_error(t[k], jl.ee_pose(arm, qe))
+            if dp < EXACT_POSITION_TOL and dr < EXACT_POSITION_TOL:
+                checked += 1
+                assert _found(sols, wrap_angle(qe), 1e-5), (k, qe)
+    assert checked >= 4 * len(q)
