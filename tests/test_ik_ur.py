@@ -139,3 +139,11 @@ def test_the_numeric_fallback_finds_every_eaik_branch_of_puma560():
                 checked += 1
                 assert _found(sols, wrap_angle(qe), 1e-5), (k, qe)
     assert checked >= 4 * len(q)
+
+
+def test_a_redundant_arm_gets_no_symmetric_rounds():
+    """halt7 (seven joints): a pose has a continuum of solutions, not branches; the numerical
+    method reports its starts' solutions only (the symmetric rounds would multiply them)."""
+    arm = jl.load_robot("halt7")
+    res = solve_ik(arm, jl.ee_pose(arm, np.full(7, 0.3)), rng=0, starts=8)
+    assert res.reachable and len(res.candidates) <= 16

@@ -224,6 +224,7 @@ def solve_ik(
 
 #: Rounds of starts made from the solutions found (their symmetric images) in the numerical
 #: method: other branches of the same pose lie there (a wrist flip, an elbow turned over).
+#: Arms of at most six movable joints only (a redundant arm's solutions are a continuum).
 SYMMETRY_ROUNDS = 2
 #: Levenberg-Marquardt iterations from those starts (one near a branch converges in a few).
 SYMMETRY_ITERATIONS = 40
@@ -284,7 +285,8 @@ def _candidates(
         num = ik_numeric(model, t, starts=starts, rng=rng, length_scale=length_scale)
         runs = [num]
         found = frontier = num.q[num.exact]
-        for _ in range(SYMMETRY_ROUNDS):
+        # a redundant arm (more than six movable joints) has a continuum of solutions, not branches
+        for _ in range(SYMMETRY_ROUNDS if model.dof <= 6 else 0):
             if not len(frontier):
                 break
             more = ik_numeric(model, t, q0=_symmetric_starts(frontier), starts=0, rng=rng, length_scale=length_scale,
