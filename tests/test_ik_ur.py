@@ -147,3 +147,15 @@ def test_a_redundant_arm_gets_no_symmetric_rounds():
     arm = jl.load_robot("halt7")
     res = solve_ik(arm, jl.ee_pose(arm, np.full(7, 0.3)), rng=0, starts=8)
     assert res.reachable and len(res.candidates) <= 16
+
+
+def test_the_upright_pose_is_solved_exactly_at_its_three_singularities():
+    """UR5 upright (shoulder, elbow and wrist singular at once): every branch exact, theta5
+    computed from the tool axis, not an arccos of positions; locks that make two lengths
+    indistinguishable still solve (the fit is the full arm's)."""
+    arm = _arm("ur5")
+    br = ik_closed_form(arm, jl.ee_pose(arm, np.array([0.0, -np.pi / 2, 0.0, -np.pi / 2, 0.0, 0.0])))
+    assert br.valid.all() and br.exact.all()
+    locked = jl.lock(arm, 3, np.pi)
+    q = np.random.default_rng(4).uniform(-np.pi, np.pi, (10, 5))
+    assert ik_closed_form(locked, jl.ee_pose(locked, q)).exact.any(axis=-1).all()

@@ -250,3 +250,19 @@ def test_ur5_has_its_three_singularities_as_three_families():
     assert sum(len(f.members) for f in res.families) == len(res.q)
     puma = sg.find_singularities(jl.load_robot("puma6"), samples=128, rng=0)
     assert len(puma.families) == 3  # elbow and shoulder: both no joint at 0, not nested
+
+
+def test_nested_dependent_sets_join_only_their_one_maximal_set():
+    """A set inside one maximal set joins it; sets that do not nest stay apart; a set inside
+    two maximal sets, or a configuration losing two ranks, is its own family."""
+    from jointlock.analysis.singularity._search import _merged_keys
+
+    def joints(*js):
+        return [j in js for j in range(1, 7)]
+
+    dependent = np.array([joints(2, 3, 4, 5, 6), joints(1, 4, 5, 6), joints(1, 2, 3, 4, 5, 6), joints(2, 3, 4, 5), joints(4, 5, 6)])
+    zero = np.zeros((5, 6), dtype=bool)
+    lost = np.array([1, 1, 2, 1, 1])
+    keys = _merged_keys(zero, dependent, lost)
+    assert keys[3] == keys[0]  # {2..5} inside {2..6} only
+    assert len({keys[0], keys[1], keys[2], keys[4]}) == 4  # elbow, shoulder, both at once, {4,5,6} under two

@@ -81,6 +81,8 @@ def ur_geometry(model: ArmModel) -> URGeometry:
 
 
 def _fit(model: ArmModel) -> URGeometry:
+    if model.locked and model.unlocked is not None and len(model.locked) == 1:
+        return ur_geometry(model.unlocked)  # a lock can make two lengths indistinguishable
     if model.full_dof != 6 or len(model.locked) > 1:
         raise ModelError(
             f"model {model.name!r}: the UR closed form needs a 6-joint arm with at most one locked joint; "
@@ -104,7 +106,9 @@ def _fit(model: ArmModel) -> URGeometry:
     cols = [chain(*unit[k])[..., :3, 3] for k in range(6)] + [zero[..., :3, 0], zero[..., :3, 1]]
     mat = np.stack(cols, axis=-1).reshape(-1, 8)
     rhs = actual[..., :3, 3].reshape(-1)
-    sol, *_ = np.linalg.lstsq(mat, rhs, rcond=None)
+    sol, _, rank, _ = np.linalg.lstsq(mat, rhs, rcond=None)
+    if rank < mat.shape[1]:
+        raise ModelError(f"model {model.name!r}: its lengths cannot be told apart (a lock at a special angle)")
     if np.max(np.abs(mat @ sol - rhs)) > FAMILY_FIT_TOL * max(1.0, float(np.max(np.abs(rhs)))):
         raise ModelError(f"model {model.name!r} is not of the UR family (its positions do not fit the UR's lengths)")
     d1, a2, a3, d4, d5, d6, tx, ty = (float(v) for v in sol)
@@ -118,7 +122,9 @@ def ur_branches(geometry: URGeometry, target06: ArrayLike) -> tuple[FloatArray, 
 
     Returns ``q_full`` (..., 8, 6) [rad] in [-pi, pi) (branch order: shoulder +/- x wrist
     +/- x elbow +/-) and ``valid`` (..., 8): False (and NaN) where a branch has no real
-    solution.  At a wrist singularity (``sin theta5 = 0``) theta6 is free: 0 is returned.
+    solution.  At a wrist singularity (``sin theta5 = 0``) theta6 is free and 0 is taken; with
+    ``d5 != 0`` that choice can leave joints 2-3 out of reach for a few poses, which then have
+    no valid branch here (:func:`jointlock.solve_ik` then finds them numerically).
     """
     g = geometry
     t = np.asarray(target06, dtype=float)
@@ -134,10 +140,13 @@ def ur_branches(geometry: URGeometry, target06: ArrayLike) -> tuple[FloatArray, 
     for s1 in (1.0, -1.0):
         th1 = phi + s1 * psi + math.pi / 2
         c1, sn1 = np.cos(th1), np.sin(th1)
-        w5 = (t[..., 0, 3] * sn1 - t[..., 1, 3] * c1 - g.d4) / g.d6
-        ok5 = ok_shoulder & (np.abs(w5) <= 1 + 1e-12)
+        # cos theta5 = z6 . (s1, -c1, 0), sin from the other components of the unit z6: exact
+        # at the wrist singularity, where an arccos of positions / d6 loses half the digits
+        w5 = t[..., 0, 2] * sn1 - t[..., 1, 2] * c1
+        sin5 = np.hypot(t[..., 2, 2], t[..., 0, 2] * c1 + t[..., 1, 2] * sn1)
+        ok5 = ok_shoulder
         for s5 in (1.0, -1.0):
-            th5 = s5 * np.arccos(np.clip(w5, -1.0, 1.0))
+            th5 = s5 * np.arctan2(sin5, w5)
             sn5 = np.sin(th5)
             safe5 = np.where(np.abs(sn5) > 1e-12, sn5, 1.0)
             y = (-t60[..., 1, 0] * sn1 + t60[..., 1, 1] * c1) / safe5

@@ -276,10 +276,11 @@ def cluster_singularities(
     joint ``j`` is dependent when ``sum_i v_ij^2 > 1e-4`` over the singular values below
     ``rank_tol`` — the diagonal of the projector onto that subspace, which does not depend
     on the SVD's choice of basis.  A dependent set inside another one with the same zero
-    joints is the same singularity where some entry of the null vector vanishes by
-    coincidence (UR5's shoulder singularity shows six such sets): they are merged
-    (transitively), the family keeping the largest set.  The keys are discrete, so the
-    grouping is deterministic.
+    joints and as many ranks lost is the same singularity where some entry of the null vector
+    vanishes by coincidence (UR5's shoulder singularity shows six such sets): it joins the
+    one maximal set that holds it (a set under two maximal ones stays its own family, and so
+    does a configuration losing two ranks at once).  The keys are discrete, so the grouping is
+    deterministic.
     Families are sorted by size.  ``jacobian``, ``weighting``, ``characteristic_length``: the
     Jacobian, as in :func:`task_jacobian` (formerly ``base=`` and ``length=``, deprecated aliases).
     """
@@ -296,7 +297,7 @@ def cluster_singularities(
     weight = np.einsum("mi,mij->mj", small.astype(float), vh[:, :k, :] ** 2)
     dependent = weight > 1e-4
     zero = np.abs(np.sin(q)) < zero_tol
-    keys = _merged_keys(zero, dependent)
+    keys = _merged_keys(zero, dependent, small.sum(axis=1))
     rot_ee = chain_state(model, q).ee_rotation
     numbers = np.asarray(model.joint_numbers)
     n = model.dof
@@ -307,7 +308,7 @@ def cluster_singularities(
         direction = u[rep, :, k - 1]
         r = rot_ee[rep]
         zs = tuple(int(j) for j in numbers[np.flatnonzero(key[:n])])
-        dep = tuple(int(j) for j in numbers[np.flatnonzero(key[n:])])
+        dep = tuple(int(j) for j in numbers[np.flatnonzero(key[n : 2 * n])])
         label = " and ".join(f"sin q{j} = 0" for j in zs) or "no joint at 0/pi"
         label += "; dependent joints " + ", ".join(str(j) for j in dep)
         families.append(
@@ -326,24 +327,19 @@ def cluster_singularities(
     return tuple(families)
 
 
-def _merged_keys(zero: np.ndarray, dependent: np.ndarray) -> list[tuple[bool, ...]]:
-    """Each configuration's family key ``zero joints + dependent joints`` (bools), dependent
-    sets nested within one zero group merged transitively onto their union."""
-    sets = {(tuple(z), tuple(d)) for z, d in zip(zero.tolist(), dependent.tolist())}
-    parent = {k: k for k in sets}
+def _merged_keys(zero: np.ndarray, dependent: np.ndarray, lost: np.ndarray) -> list[tuple]:
+    """Each configuration's family key ``zero joints + dependent joints + ranks lost``: a
+    dependent set inside exactly one maximal set of its group (same zero joints, same ranks
+    lost) takes that set; sets that do not nest, or that nest in two maximal sets, stay apart."""
+    items = [(tuple(z), int(k), tuple(d)) for z, d, k in zip(zero.tolist(), dependent.tolist(), lost.tolist())]
+    sets = set(items)
 
-    def root(k: tuple) -> tuple:
-        while parent[k] != k:
-            k = parent[k]
-        return k
+    def inside(a: tuple, b: tuple) -> bool:
+        return a[:2] == b[:2] and all(x <= y for x, y in zip(a[2], b[2]))
 
-    ordered = sorted(sets)
-    for i, a in enumerate(ordered):
-        for b in ordered[i + 1 :]:
-            if a[0] == b[0] and (all(x <= y for x, y in zip(a[1], b[1])) or all(y <= x for x, y in zip(a[1], b[1]))):
-                parent[root(a)] = root(b)
-    union: dict[tuple, tuple[bool, ...]] = {}
-    for k in sets:
-        r = root(k)
-        union[r] = tuple(x or y for x, y in zip(union.get(r, k[1]), k[1]))
-    return [tuple(z) + union[root((tuple(z), tuple(d)))] for z, d in zip(zero.tolist(), dependent.tolist())]
+    maximal = [m for m in sets if not any(o != m and inside(m, o) for o in sets)]
+    target: dict[tuple, tuple] = {}
+    for item in sets:
+        above = [m for m in maximal if inside(item, m)]
+        target[item] = above[0] if len(above) == 1 else item
+    return [item[0] + target[item][2] + (item[1],) for item in items]
