@@ -8,8 +8,8 @@ import math
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..errors import ConfigurationError
-from ..model import FloatArray
+from ..errors import ConfigurationError, ModelError
+from ..model import ArmModel, FloatArray
 from ..spatial import pose, rot_x, rot_y, rot_z
 
 #: A branch is *exact* when its position error is below this [m] ...
@@ -58,6 +58,15 @@ def zyx_angles(rotation: ArrayLike) -> FloatArray:
 def wrap_angle(angle: ArrayLike) -> FloatArray:
     """Angles wrapped to [-pi, pi) [rad]."""
     return (np.asarray(angle, dtype=float) + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def check_six_joints(model: ArmModel, form: str) -> None:
+    """A closed form's precondition: six joints, at most one locked (else a ModelError)."""
+    if model.full_dof != 6 or len(model.locked) > 1:
+        raise ModelError(
+            f"model {model.name!r}: the {form} closed form needs a 6-joint arm with at most one locked joint; "
+            f"got {model.full_dof} joints, {len(model.locked)} locked"
+        )
 
 
 def _as_poses(target: ArrayLike, name: str = "target") -> FloatArray:

@@ -14,7 +14,7 @@ from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, turns_into_limits
-from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, wrap_angle
+from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, check_six_joints, wrap_angle
 from ._ur import ur_branches, ur_geometry
 
 #: Largest residual accepted when fitting the puma6 family to a model [m or rad].
@@ -109,11 +109,7 @@ def puma6_geometry(model: ArmModel) -> Puma6Geometry:
 
 
 def _fit_geometry(model: ArmModel) -> Puma6Geometry:
-    if model.full_dof != 6 or len(model.locked) > 1:
-        raise ModelError(
-            f"model {model.name!r}: the puma6 closed form needs a 6-joint arm with at most one "
-            f"locked joint; got {model.full_dof} joints, {len(model.locked)} locked"
-        )
+    check_six_joints(model, "puma6")
     q = np.random.default_rng(6).uniform(-np.pi, np.pi, (8, model.dof))
     actual = ee_pose(model, q)
     q_full = model.expand(q)

@@ -27,7 +27,7 @@ from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose, rot_x, rot_z, translation
-from ._pose import wrap_angle
+from ._pose import check_six_joints, wrap_angle
 
 #: Relative residual of the family fit accepted as membership.
 FAMILY_FIT_TOL = 1e-9
@@ -83,11 +83,7 @@ def ur_geometry(model: ArmModel) -> URGeometry:
 def _fit(model: ArmModel) -> URGeometry:
     if model.locked and model.unlocked is not None and len(model.locked) == 1:
         return ur_geometry(model.unlocked)  # a lock can make two lengths indistinguishable
-    if model.full_dof != 6 or len(model.locked) > 1:
-        raise ModelError(
-            f"model {model.name!r}: the UR closed form needs a 6-joint arm with at most one locked joint; "
-            f"got {model.full_dof} joints, {len(model.locked)} locked"
-        )
+    check_six_joints(model, "UR")
     q = np.random.default_rng(7).uniform(-np.pi, np.pi, (10, model.dof))
     actual = ee_pose(model, q)
     q_full = model.expand(q)

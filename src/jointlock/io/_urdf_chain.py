@@ -20,6 +20,7 @@ import numpy as np
 from ..bounds import shown
 from ..errors import ModelError
 from ..spatial import axis_angle_rotation, pose
+from .files import shorten
 
 #: A frozen value may pass a limit by this much (round-off of a value read back from a file).
 LIMIT_SLACK = 1e-9
@@ -38,9 +39,10 @@ class Chain:
     left_out: list[str] = field(default_factory=list)  # links above root_link
 
 
-def _some(names: Sequence[str], limit: int = 8) -> str:
-    shown_names = ", ".join(repr(n) for n in list(names)[:limit])
-    return shown_names + (f", ... ({len(names)} in all)" if len(names) > limit else "")
+def _some(names: Sequence[str], limit: int = 5) -> str:
+    """The first ``limit`` names, each shortened, for an error line."""
+    head = ", ".join(repr(shorten(str(k), 40)) for k in list(names)[:limit])
+    return head + (f", ... ({len(names)} in all)" if len(names) > limit else "")
 
 
 def _motion(joint: Any, value: float) -> np.ndarray:

@@ -72,11 +72,6 @@ def _urdf_text(path: Path, label: str) -> str | bytes:
     return decode_text(data, f"URDF file {shown(label)}", ModelError)
 
 
-def _some_names(names: list[str]) -> str:
-    """The first five link names, each shortened, for an error line."""
-    return ", ".join(repr(shorten(k, 40)) for k in names[:5]) + (", ..." if len(names) > 5 else "")
-
-
 def _origin(elem: ET.Element | None, where: str) -> np.ndarray:
     if elem is None:
         return np.eye(4)

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..analysis.spacecraft import SpacecraftResponse
 from ..model import ArmModel, FloatArray
-from ..plots.motion import ArmMotion
+from ..plots.motion import ArmMotion, drawn_arm
 
 if TYPE_CHECKING:
     from .halt._result import HaltPlan
@@ -21,11 +21,6 @@ if TYPE_CHECKING:
 
 #: At most this many samples per motion in ``motion.json`` (the animation shows at most 120).
 MOTION_SAMPLES = 401
-
-
-def drawn_arm(model: ArmModel) -> ArmModel:
-    """The arm a motion is drawn on: the full arm of a locked model when it kept it."""
-    return model.unlocked if model.locked and model.unlocked is not None else model
 
 
 def _full(model: ArmModel, q: FloatArray) -> FloatArray:
@@ -46,20 +41,11 @@ def halt_motions(plan: HaltPlan) -> tuple[ArmModel, list[ArmMotion]]:
     p = plan.problem
     t = p.times(min(MOTION_SAMPLES, max(p.n_samples, 2)))
     q, dq, _ = plan.motion.trajectory(t)
-    response = plan.spacecraft_response(t.size) if p.base == "floating" else None
-    if response is not None:
-        response = _resampled(response, t)
+    response = plan.spacecraft_response(t.size) if p.base == "floating" else None  # on the grid t
     locks = tuple((lj.number, float(t[0])) for lj in p.model.locked) if drawn_arm(p.model) is not p.model else ()
     label = "halt" if plan.motion.feasible else "halt (INFEASIBLE: least-violating k)"
     motion = ArmMotion(label, t, _full(p.model, q), locks, **_base(p.model, response))
     return drawn_arm(p.model), [motion]
-
-
-def _resampled(response: SpacecraftResponse, t: FloatArray) -> SpacecraftResponse:
-    """The response on ``t`` when it was computed on the same grid (a no-op guard)."""
-    if response.t.shape != t.shape or not np.allclose(response.t, t):
-        raise AssertionError("spacecraft response on another time grid")  # pragma: no cover
-    return response
 
 
 def jump_motions(result: JumpJobResult) -> tuple[ArmModel, list[ArmMotion]]:

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..errors import ConfigurationError
 from ..model import ArmModel
-from .motion import ArmMotion, frame_times, motion_points, spacecraft_box
+from .motion import ArmMotion, drawn_arm, frame_times, motion_points, spacecraft_box
 
 #: Colours of successive motions (plotly's first three).
 MOTION_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
@@ -118,7 +118,7 @@ def animation_figure(
     max_frames
         At most this many evenly spaced frames (plus each lock's instant).
     """
-    arm = model.unlocked if model.locked and model.unlocked is not None else model
+    arm = drawn_arm(model)
     motions = [motions] if isinstance(motions, ArmMotion) else list(motions)
     if not motions or not all(isinstance(m, ArmMotion) for m in motions):
         raise ConfigurationError(

@@ -140,6 +140,11 @@ class ArmMotion:
             raise ConfigurationError(f"not a motion (ArmMotion.to_dict) : {exc}") from None
 
 
+def drawn_arm(model: ArmModel) -> ArmModel:
+    """The arm a motion is drawn on: the full arm of a locked model when it kept it."""
+    return model.unlocked if model.locked and model.unlocked is not None else model
+
+
 def frame_times(motions: list[ArmMotion], max_frames: int) -> FloatArray:
     """(F,) times of the animation's frames [s]: at most ``max_frames`` evenly spaced over the
     motions' span, with every lock's time added (the failure instant is always a frame)."""
