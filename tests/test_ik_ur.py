@@ -119,8 +119,9 @@ def test_the_numeric_fallback_finds_every_analytic_branch(name):
 
 @pytest.mark.oracle
 def test_the_numeric_fallback_finds_every_eaik_branch_of_puma560():
-    """Puma560 as roboticstoolbox tabulates it (shoulder offset d3, forearm offset a3: no closed
-    form here): every exact EAIK branch is among the numerical method's solutions."""
+    """Puma560 as roboticstoolbox tabulates it (shoulder offset d3, forearm offset a3), solved
+    numerically on purpose (its closed form is tested in test_ik_spherical.py): every exact EAIK
+    branch is among the numerical method's solutions."""
     eaik_dh = pytest.importorskip("eaik.IK_DH")
     a, d = [0, 0.4318, 0.0203, 0, 0, 0], [0, 0, 0.15005, 0.4318, 0, 0]
     alpha = [np.pi / 2, 0, -np.pi / 2, np.pi / 2, -np.pi / 2, 0]
@@ -130,7 +131,7 @@ def test_the_numeric_fallback_finds_every_eaik_branch_of_puma560():
     t = jl.ee_pose(arm, q)
     checked = 0
     for k in range(len(q)):
-        res = solve_ik(arm, t[k], rng=k)
+        res = solve_ik(arm, t[k], method="numeric", rng=k)
         assert res.method == "numeric"
         sols = np.array([s.q for s in res.solutions])
         for qe in np.atleast_2d(robot.IK(t[k]).Q):

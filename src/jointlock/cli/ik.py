@@ -19,8 +19,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "ik",
         help="inverse kinematics: every branch, full arm or with a locked joint",
         description=(
-            "Closed form for the puma6 family (002, with its printed theta3/theta4 equations "
-            "corrected), Levenberg-Marquardt from several starts otherwise. When the locked arm "
+            "Closed form for 002's puma6 family (its printed theta3/theta4 equations corrected), "
+            "the UR family (three parallel axes) and spherical-wrist arms (Pieper: PUMA with "
+            "offsets, KUKA KR, ABB IRB, Staeubli), decided from the arm's own kinematics; "
+            "Levenberg-Marquardt from several starts otherwise. When the locked arm "
             "cannot reach the target, the nearest reachable pose is reported."
         ),
     )
@@ -44,10 +46,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--method",
         choices=("auto", "closed-form", "numeric"),
         default="auto",
-        help="closed-form: 002's analytic IK, every branch (puma6-family arms only: 6 joints with "
-        "002 Table 1's structure, at most one locked); numeric: Levenberg-Marquardt from several "
-        "random starts (any arm; --seed); auto (default): closed-form when the arm is of the puma6 "
-        "family, numeric otherwise",
+        help="closed-form: analytic IK, every branch (6-joint arms of the puma6, UR or "
+        "spherical-wrist family, at most one locked; the family used is printed); numeric: "
+        "Levenberg-Marquardt from several random starts (any arm; --seed); auto (default): "
+        "closed-form when the arm is of a family, numeric otherwise",
     )
     p.add_argument(
         "--length-scale",

@@ -1,5 +1,7 @@
-"""Inverse kinematics: closed form for the ``puma6`` family (seed 002) and the UR family
-(three parallel axes, :mod:`jointlock.ik._ur`), numerical otherwise.
+"""Inverse kinematics: closed form for the ``puma6`` family (seed 002), the UR family
+(three parallel axes, :mod:`jointlock.ik._ur`) and the spherical-wrist family (Pieper's
+condition with parallel shoulder-elbow axes: PUMA with offsets, KUKA KR, ABB IRB, Staeubli;
+:mod:`jointlock.ik._spherical`), numerical otherwise.
 
 Closed form (:func:`ik_closed_form`)
 ------------------------------------
@@ -78,7 +80,8 @@ Everything here is in SI units and radians; 002's ZYX Euler angles are converted
 
 Modules (private; every name, private ones included, is re-exported here): ``_pose`` (002's
 ZYX Euler angles, angle wrapping, target checks and the tolerances that call a pose exact),
-``_puma6`` (the closed form of the family, full arm and every lock), ``_numeric``
+``_puma6`` (the closed form of the family, full arm and every lock, and the dispatch between
+the closed forms), ``_ur`` and ``_spherical`` (the other two families), ``_numeric``
 (Levenberg-Marquardt, batched) and ``_solve`` (:func:`solve_ik`: every solution of one
 target, dispatching between the two).
 """
@@ -112,6 +115,12 @@ from ._puma6 import (  # noqa: F401
     puma6_geometry,
 )
 from ._solve import DUPLICATE_TOL, IKResult, IKSolution, _distinct, solve_ik  # noqa: F401
+from ._spherical import (
+    SPHERICAL_FIT_TOL,
+    SphericalWristGeometry,
+    spherical_wrist_branches,
+    spherical_wrist_geometry,
+)
 from ._ur import URGeometry, ur_branches, ur_fk, ur_geometry
 
 __all__ = [
@@ -125,6 +134,8 @@ __all__ = [
     "IKSolution",
     "NumericIK",
     "Puma6Geometry",
+    "SPHERICAL_FIT_TOL",
+    "SphericalWristGeometry",
     "URGeometry",
     "closed_form_family",
     "ik_closed_form",
@@ -134,6 +145,8 @@ __all__ = [
     "puma6_fk",
     "puma6_geometry",
     "solve_ik",
+    "spherical_wrist_branches",
+    "spherical_wrist_geometry",
     "ur_branches",
     "ur_fk",
     "ur_geometry",

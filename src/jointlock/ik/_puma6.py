@@ -15,6 +15,7 @@ from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
 from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, turns_into_limits
 from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, check_six_joints, wrap_angle
+from ._spherical import spherical_wrist_branches, spherical_wrist_geometry
 from ._ur import ur_branches, ur_geometry
 
 #: Largest residual accepted when fitting the puma6 family to a model [m or rad].
@@ -286,22 +287,25 @@ class IKBranches:
 
 
 def closed_form_family(model: ArmModel) -> str:
-    """``"puma6"`` (002's family, :func:`puma6_geometry`) or ``"ur"`` (three parallel axes,
-    :func:`jointlock.ik._ur.ur_geometry`): the closed form that solves ``model``, decided from
-    its own kinematics; :class:`ModelError` saying why neither does."""
-    try:
-        puma6_geometry(model)
-        return "puma6"
-    except ModelError as puma6_error:
+    """The closed form that solves ``model``, decided from its own kinematics: ``"puma6"``
+    (002's family, :func:`puma6_geometry`), ``"ur"`` (three parallel axes,
+    :func:`jointlock.ik._ur.ur_geometry`) or ``"spherical-wrist"`` (Pieper's spherical wrist
+    with parallel shoulder-elbow axes: PUMA with offsets, KUKA KR, ABB IRB, Staeubli;
+    :func:`jointlock.ik._spherical.spherical_wrist_geometry`); :class:`ModelError` saying why
+    none does."""
+    reasons = []
+    for family, fit in (("puma6", puma6_geometry), ("ur", ur_geometry), ("spherical-wrist", spherical_wrist_geometry)):
         try:
-            ur_geometry(model)
-            return "ur"
-        except ModelError as ur_error:
-            raise ModelError(f"no closed form for {model.name!r}: {puma6_error}; {ur_error}") from None
+            fit(model)
+            return family
+        except ModelError as error:
+            reasons.append(str(error))
+    raise ModelError(f"no closed form for {model.name!r}: " + "; ".join(reasons))
 
 
 def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:
-    """Closed-form IK of a ``puma6``- or UR-family arm, full or with one locked joint (batched).
+    """Closed-form IK of a ``puma6``-, UR- or spherical-wrist-family arm, full or with one
+    locked joint (batched).
 
     Parameters
     ----------
@@ -315,22 +319,27 @@ def ik_closed_form(model: ArmModel, target: ArrayLike) -> IKBranches:
     IKBranches
         ``puma6``: eight branches for the full arm, four with a lock; see the module docstring
         for the equations (002 eqs. 2-17, with eqs. (6)/(16) for theta3 and (17) for theta4
-        corrected).  UR: the full arm's eight branches (:func:`jointlock.ik._ur.ur_branches`);
-        with a lock, those whose locked angle is the lock's are the exact ones.
+        corrected).  UR and spherical wrist: the full arm's eight branches
+        (:func:`jointlock.ik._ur.ur_branches`,
+        :func:`jointlock.ik._spherical.spherical_wrist_branches`); with a lock, those whose
+        locked angle is the lock's are the exact ones.
 
     Raises
     ------
     ModelError
-        If the model is of neither family.
+        If the model is of no family.
     """
     family = closed_form_family(model)
     t = _as_poses(target)
     if family == "puma6":
         geom = puma6_geometry(model)
         q_full, valid = puma6_branches(geom, t @ invert(geom.tool))
-    else:
+    elif family == "ur":
         ur = ur_geometry(model)
         q_full, valid = ur_branches(ur, t @ invert(ur.tool))
+    else:
+        lock = (model.locked[0].number, model.locked[0].angle) if model.locked else None
+        q_full, valid = spherical_wrist_branches(spherical_wrist_geometry(model), t, lock)
     q = turns_into_limits(model.healthy(q_full), model.lower, model.upper)  # limits past +-pi kept
     q_full = np.where(valid[..., None], model.expand(np.nan_to_num(q)), np.nan)
     actual = ee_pose(model, np.where(valid[..., None], q, 0.0))

@@ -1,5 +1,5 @@
-"""Every IK solution of one target (:func:`solve_ik`): the closed form for the ``puma6``
-family, Levenberg-Marquardt otherwise, and the nearest reachable pose when no exact solution
+"""Every IK solution of one target (:func:`solve_ik`): the closed form for the ``puma6``, UR
+and spherical-wrist families, Levenberg-Marquardt otherwise, and the nearest reachable pose when no exact solution
 exists (see :mod:`jointlock.ik`)."""
 
 from __future__ import annotations
@@ -83,7 +83,8 @@ class IKResult:
         solution exists (a target typed with rounded numbers); ``solutions`` then lists the
         distinct nearest configurations within it (``exact`` False).  None: exact only.
     family
-        The closed form used (``"puma6"`` or ``"ur"``), None for the numerical method.
+        The closed form used (``"puma6"``, ``"ur"`` or ``"spherical-wrist"``), None for the
+        numerical method.
     """
 
     target: FloatArray
@@ -132,7 +133,8 @@ def solve_ik(
     ----------
     model
         Any arm, possibly locked.  ``"auto"`` uses the closed form when the model is of the
-        ``puma6`` or UR family (:func:`closed_form_family`) and Levenberg-Marquardt otherwise.
+        ``puma6``, UR or spherical-wrist family (:func:`closed_form_family`) and
+        Levenberg-Marquardt otherwise.
     target
         (4, 4) pose in the root frame [m].
     starts, rng

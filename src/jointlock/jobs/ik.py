@@ -134,8 +134,8 @@ def inverse_kinematics(
     tolerance: tuple[float, float] | None = None,
 ) -> InverseKinematicsReport:
     """Every IK branch of ``model`` for the pose ``target`` (4, 4) [m]
-    (:func:`jointlock.ik.solve_ik`: 002's closed form for the puma6 family, Levenberg-Marquardt
-    from several seeded starts otherwise), or the nearest reachable pose, with ``length_scale``
+    (:func:`jointlock.ik.solve_ik`: the closed form of the puma6, UR or spherical-wrist
+    family, Levenberg-Marquardt from several seeded starts otherwise), or the nearest reachable pose, with ``length_scale``
     [m] weighing rotation against position in the distance; ``tolerance`` ``(position [m],
     rotation [rad])`` accepts a target reached within it (see :func:`~jointlock.ik.solve_ik`)."""
     target = np.asarray(target, dtype=float)
