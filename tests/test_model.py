@@ -154,3 +154,51 @@ def test_a_model_file_mounts_and_flips(tmp_path):
     path.write_text('convention = "dh_standard"\n[[joint]]\nd_m = 0.3\nflip = "yes"\n')
     with pytest.raises(jl.ModelError, match="field 'flip' must be true or false"):
         jl.read_model_toml(path)
+
+
+@pytest.mark.parametrize("convention", ["standard", "modified"])
+@pytest.mark.parametrize("row", [0, 2, 3])
+@pytest.mark.parametrize("floating", [False, True])
+def test_a_prismatic_row_is_held_at_its_d_like_a_joint_locked_at_zero(convention, row, floating):
+    """``prismatic``: a row whose joint slides is held at the table's d (issue 15, item 1: the
+    chain model turns joints; a prismatic one is frozen and its link merged).  Oracle: the same
+    table with that row revolute, locked at 0 (kinematics, mass matrix, momentum, total mass)."""
+    from jointlock.model import Body
+
+    rng = np.random.default_rng(row)
+    bodies = [Body(1.0 + i, rng.uniform(-0.1, 0.1, 3), np.diag(rng.uniform(0.05, 0.3, 3))) for i in range(4)]
+    table = dict(a=[0.1, 0.4, 0.3, 0.05], alpha=[np.pi / 2, 0.0, -np.pi / 2, np.pi / 2], d=[0.3, 0.05, 0.2, 0.1],
+                 theta=[0.0, 0.2, -0.3, 0.4], convention=convention, bodies=bodies,
+                 tool=jl.spatial.translation([0.0, 0.0, 0.12]),
+                 spacecraft=Body(500.0, [0.0, 0.0, -0.5], np.diag([80.0, 90.0, 70.0])) if floating else None)  # fmt: skip
+    slides = [i == row for i in range(4)]
+    held = jl.from_dh("held", prismatic=slides, **table)
+    locked = jl.lock(jl.from_dh("held", **table), row + 1, 0.0)
+    assert held.dof == 3 and held.joint_numbers == (1, 2, 3)
+    assert [j.name for j in held.joints] == [f"joint{i + 1}" for i in range(4) if i != row]
+    q = rng.uniform(-2, 2, (5, 3))
+    np.testing.assert_allclose(jl.ee_pose(held, q), jl.ee_pose(locked, q), atol=1e-12)
+    np.testing.assert_allclose(jl.jacobian(held, q), jl.jacobian(locked, q), atol=1e-12)
+    np.testing.assert_allclose(jl.mass_matrix(held, q), jl.mass_matrix(locked, q), atol=1e-11)
+    assert held.total_mass == pytest.approx(locked.total_mass)
+    if floating:
+        np.testing.assert_allclose(jl.momentum_matrix(held, q), jl.momentum_matrix(locked, q), atol=1e-11)
+    with pytest.raises(jl.ModelError, match="prismatic must hold 4 booleans"):
+        jl.from_dh("x", prismatic=[1, 0, 0, 0], **table)
+    with pytest.raises(jl.ModelError, match="at least one DH row must be a revolute joint"):
+        jl.from_dh("x", prismatic=[True] * 4, **table)
+
+
+def test_a_model_file_holds_a_prismatic_row(tmp_path):
+    path = tmp_path / "m.toml"
+    path.write_text(
+        'name = "m"\nconvention = "dh_standard"\n[[joint]]\nalpha_deg = 90.0\nd_m = 0.3\n'
+        "[[joint]]\nd_m = 0.25\nprismatic = true\n[[joint]]\na_m = 0.5\n"
+    )
+    model = jl.read_model_toml(path)
+    plain = jl.from_dh("p", a=[0.0, 0.0, 0.5], alpha=[np.pi / 2, 0.0, 0.0], d=[0.3, 0.25, 0.0], convention="standard")
+    q = np.array([0.4, 0.7])
+    np.testing.assert_allclose(jl.ee_pose(model, q), jl.ee_pose(plain, [0.4, 0.0, 0.7]), atol=1e-12)
+    path.write_text('convention = "dh_standard"\n[[joint]]\nd_m = 0.3\nprismatic = 1\n')
+    with pytest.raises(jl.ModelError, match="field 'prismatic' must be true or false"):
+        jl.read_model_toml(path)

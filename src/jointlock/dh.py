@@ -66,6 +66,7 @@ def from_dh(
     description: str = "",
     base: ArrayLike | None = None,
     flip: Sequence[bool] | None = None,
+    prismatic: Sequence[bool] | None = None,
 ) -> ArmModel:
     """Build an arm from a DH table.
 
@@ -99,6 +100,13 @@ def from_dh(
     flip
         (n,) True for a joint whose positive rotation is about -z (``theta_i - q_i`` in the
         table, roboticstoolbox's ``flip``); all False when omitted.
+    prismatic
+        (n,) True for a row whose joint slides along z (its variable is ``d``): the chain model
+        turns its joints and does not slide them, so a prismatic joint is held at the table's
+        ``d`` (and ``theta``) and its link merged into the one before, as a frozen URDF joint
+        is.  Its limits, if given, are ignored.  The model has one joint fewer, numbered
+        1..m along the chain, each named after its table row (a prismatic row 3 of 6: joints
+        1-5 named ``joint1, joint2, joint4, joint5, joint6``).  All False when omitted.
     """
     if convention not in ("standard", "modified"):
         raise ModelError(f"convention must be 'standard' or 'modified'; got {shown(convention)}")
@@ -135,6 +143,11 @@ def from_dh(
     flips = [False] * n if flip is None else list(flip)
     if len(flips) != n or not all(isinstance(f, (bool, np.bool_)) for f in flips):
         raise ModelError(f"flip must hold {n} booleans (True: the joint turns about -z); got {shown(flip)}")
+    slides = [False] * n if prismatic is None else list(prismatic)
+    if len(slides) != n or not all(isinstance(f, (bool, np.bool_)) for f in slides):
+        raise ModelError(f"prismatic must hold {n} booleans (True: held at the row's d); got {shown(prismatic)}")
+    if all(slides):
+        raise ModelError("prismatic: at least one DH row must be a revolute joint (prismatic joints are held)")
 
     if convention == "modified":
         placements = [
@@ -160,6 +173,23 @@ def from_dh(
         model_tool = fixed[-1] @ tool_arr
 
     placements[0] = base_arr @ placements[0]
+    root_body = spacecraft if spacecraft is not None else Body(0.0, name="root")
+    kept: list[int] = []
+    carried = np.eye(4)  # the held rows' transforms since the last kept joint
+    for i in range(n):
+        if not slides[i]:
+            placements[i] = carried @ placements[i]
+            kept.append(i)
+            carried = np.eye(4)
+            continue
+        # held at q = 0: frame i is frame i-1 times its placement, its body joins link i-1's
+        carried = carried @ placements[i]
+        if kept:
+            k = kept[-1]
+            frame_bodies[k] = frame_bodies[k].merged(frame_bodies[i], carried)
+        else:
+            root_body = root_body.merged(frame_bodies[i], carried)
+    model_tool = carried @ model_tool
     joints = tuple(
         Joint(
             placements[i],
@@ -167,18 +197,18 @@ def from_dh(
             lo[i],
             hi[i],
             vmax[i],
-            number=i + 1,
+            number=k + 1,
             name=f"joint{i + 1}",
             effort_limit=effort[i],
         )
-        for i in range(n)
+        for k, i in enumerate(kept)
     )
     return ArmModel(
         name=name,
         joints=joints,
-        bodies=tuple(frame_bodies),
+        bodies=tuple(frame_bodies[i] for i in kept),
         tool=model_tool,
-        root_body=spacecraft if spacecraft is not None else Body(0.0, name="root"),
+        root_body=root_body,
         floating=spacecraft is not None,
         description=description,
     )

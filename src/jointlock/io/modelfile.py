@@ -19,6 +19,7 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     com_m = [0.0, 0.25, 0.0]
     inertia_kgm2 = [0.89, 0.05, 0.89]   # [Ixx, Iyy, Izz], 6 values or 3x3
     flip = false                        # optional: true = turns about -z (theta - q)
+    prismatic = false                   # optional: true = slides along z, held at d_m
 
     [tool]                              # optional: end effector in the last DH frame
     xyz_m = [0.0, 0.0, 0.1]
@@ -80,6 +81,7 @@ _JOINT_KEYS = {
     "inertia_kgm2",
     "name",
     "flip",
+    "prismatic",
 }
 _TOOL_KEYS = {"xyz_m", "rpy_deg"}
 _BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2"}
@@ -167,6 +169,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
     cols: dict[str, list[float]] = {k: [] for k in ("a", "alpha", "d", "theta", "lower", "upper", "vmax", "effort")}
     bodies = []
     flips: list[bool] = []
+    slides: list[bool] = []
     for i, row in enumerate(rows, start=1):
         jw = f"{where}: joint {i}"
         if not isinstance(row, dict):
@@ -195,6 +198,10 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
         if not isinstance(flip, bool):
             raise ModelError(f"{jw}: field 'flip' must be true or false; got {shown(flip)}")
         flips.append(flip)
+        slide = row.get("prismatic", False)
+        if not isinstance(slide, bool):
+            raise ModelError(f"{jw}: field 'prismatic' must be true or false; got {shown(slide)}")
+        slides.append(slide)
     tool, mount = _pose_table(data, "tool", where), _pose_table(data, "mount", where)
     spacecraft = None
     if "base" in data:
@@ -228,6 +235,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
             description=str(data.get("description", f"read from {where}")),
             base=mount,
             flip=flips,
+            prismatic=slides,
         )
     except ModelError as exc:  # e.g. a joint's limits: named with the file
         raise ModelError(f"{where}: {exc}") from None
