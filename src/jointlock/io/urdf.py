@@ -313,3 +313,19 @@ def _selection_text(chain: Chain) -> str:
     if chain.left_out:
         text += f", {len(chain.left_out)} links above the root left out"
     return text
+
+
+def urdf_joint_types(source: str | Path) -> dict[str, str]:
+    """``{joint name: type}`` of a URDF file (or XML text): which unit a value given per joint
+    is in (degrees for a revolute joint, metres for a prismatic one).  Empty when the file
+    cannot be read: :func:`read_urdf` then says why, in one line."""
+    text = str(source)
+    try:
+        if not text.lstrip().startswith("<"):
+            path = check_path_text(text, "URDF file", ModelError)
+            root = ET.fromstring(_urdf_text(path, shorten(text)))
+        else:
+            root = ET.fromstring(text)
+    except (ModelError, ET.ParseError, LookupError, ValueError):
+        return {}
+    return {j.get("name") or "?": j.get("type") or "?" for j in root.findall("joint")}
