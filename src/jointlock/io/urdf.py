@@ -171,6 +171,8 @@ def read_urdf(
         ``{joint name: "deg" | "m"}``: the unit each value was given in (a model file's
         ``freeze_deg`` / ``freeze_m``), refused for a joint of the other kind.
 
+    Notes
+    -----
     The chain is described in the model's ``description`` (root, tip, frozen joints).
     """
     source_text = str(source)
