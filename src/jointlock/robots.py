@@ -9,10 +9,11 @@ from __future__ import annotations
 import difflib
 import functools
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
 from pathlib import Path
 from stat import S_ISREG
-from typing import Literal, cast
+from typing import Any, Literal, cast
 
 import numpy as np
 
@@ -269,15 +270,67 @@ def _mentions_urdf(path: Path) -> bool:
         return b"urdf" in fh.read(1_000_000)
 
 
+#: A scenario's fields naming the chain of a URDF tree (the command line's --root, --tip, --freeze).
+CHAIN_FIELDS: tuple[str, ...] = ("root_link", "tip_link", "freeze_deg", "freeze_m")
+
+
+@dataclass(frozen=True)
+class UrdfChain:
+    """Which chain of a URDF robot to read (:func:`jointlock.read_urdf`'s ``root_link``,
+    ``tip_link`` and ``freeze``), as a scenario or the command line gives it.
+
+    ``freeze_deg``: ``((revolute joint, value [deg]), ...)``; ``freeze_m``: ``((prismatic
+    joint, value [m]), ...)``.  Hashable: part of :func:`load_robot`'s cache key.
+    """
+
+    root_link: str | None = None
+    tip_link: str | None = None
+    freeze_deg: tuple[tuple[str, float], ...] = ()
+    freeze_m: tuple[tuple[str, float], ...] = ()
+
+    @classmethod
+    def from_fields(cls, data: Mapping[str, Any]) -> UrdfChain | None:
+        """The chain named by :data:`CHAIN_FIELDS` of ``data`` (a validated scenario); None
+        when it names none."""
+        chain = cls(
+            data.get("root_link") or None,
+            data.get("tip_link") or None,
+            tuple((str(k), float(v)) for k, v in (data.get("freeze_deg") or {}).items()),
+            tuple((str(k), float(v)) for k, v in (data.get("freeze_m") or {}).items()),
+        )
+        return chain if chain != cls() else None
+
+    def fields(self) -> dict[str, Any]:
+        """The given fields as a scenario writes them (``freeze_deg = {joint = value}``)."""
+        out: dict[str, Any] = {"root_link": self.root_link, "tip_link": self.tip_link}
+        out.update(freeze_deg=dict(self.freeze_deg), freeze_m=dict(self.freeze_m))
+        return {k: v for k, v in out.items() if v}
+
+
+def _read_urdf_chain(path: str, base: BaseMode, chain: UrdfChain | None) -> ArmModel:
+    from .io.urdf import read_urdf
+
+    if chain is None:
+        return read_urdf(path, base=base)
+    freeze = {k: math.radians(v) for k, v in chain.freeze_deg} | dict(chain.freeze_m)
+    units = {k: "deg" for k, _ in chain.freeze_deg} | {k: "m" for k, _ in chain.freeze_m}
+    if len(units) < len(chain.freeze_deg) + len(chain.freeze_m):
+        twice = sorted({k for k, _ in chain.freeze_deg} & {k for k, _ in chain.freeze_m})
+        raise ModelError(f"{path}: joint {shown(twice[0])} is frozen in both degrees and metres; give it once")
+    return read_urdf(
+        path, base=base, root_link=chain.root_link, tip_link=chain.tip_link, freeze=freeze, freeze_units=units
+    )
+
+
 @functools.lru_cache(maxsize=32)
-def _read_model_file(path: str, base: BaseMode, stamp: tuple[str, int, int] | None) -> ArmModel:
-    """A model file read once per (absolute path, base, modification time, size): an edited
-    file is read again."""
+def _read_model_file(
+    path: str, base: BaseMode, stamp: tuple[str, int, int] | None, chain: UrdfChain | None = None
+) -> ArmModel:
+    """A model file read once per (absolute path, base, modification time, size, chain): an
+    edited file is read again."""
     del stamp  # part of the cache key only
     if Path(path).suffix.lower() == ".urdf":
-        from .io.urdf import read_urdf
-
-        return read_urdf(path, base=base)
+        return _read_urdf_chain(path, base, chain)
     from .io.modelfile import read_model_toml
 
     model = read_model_toml(path)
@@ -294,7 +347,7 @@ def _builtin_factories() -> dict[str, Callable[..., ArmModel]]:
 BUILTIN_ROBOTS: tuple[str, ...] = ("halt7", "canadarm7", "puma6")
 
 
-def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmModel:
+def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed", chain: UrdfChain | None = None) -> ArmModel:
     """A built-in robot by name, or a model read from a ``.urdf`` or ``.toml`` file.
 
     Parameters
@@ -305,6 +358,10 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
         ``"fixed"`` or ``"floating"``.  For built-ins, ``"floating"`` attaches the robot's
         documented spacecraft; for a URDF, the root link's inertial; for a TOML file, its
         ``[base]`` table (``"fixed"`` drops it).
+    chain
+        For a ``.urdf`` file only: the chain to read from its tree (root link, tip link,
+        frozen joints [deg or m]); refused, in one line, with a built-in robot or a ``.toml``
+        file (whose ``urdf = ...`` form names its chain itself).
 
     Notes
     -----
@@ -314,19 +371,25 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed") -> ArmMode
     _check_base(base)
     text = str(name_or_path)
     factories = _builtin_factories()
+    suffix = Path(text).suffix.lower()
+    if chain is not None and (text in factories or suffix != ".urdf"):
+        what = f"{shown(text)} is a built-in robot" if text in factories else f"{shown(text)} is not a .urdf file"
+        raise ModelError(
+            f"root_link, tip_link and freeze choose the chain of a URDF robot; {what} (a .toml model file names "
+            "its chain itself: urdf, root_link, tip_link, freeze_deg, freeze_m)"
+        )
     if text in factories:
         return _builtin(text, base)
-    suffix = Path(text).suffix.lower()
     if suffix in (".urdf", ".toml"):
         check_path_text(text, "model file", ModelError)
         try:
             stat = Path(text).stat()
             refers = suffix == ".toml" and S_ISREG(stat.st_mode) and _mentions_urdf(Path(text))
         except OSError:  # the reader names the file and the reason
-            return _read_model_file.__wrapped__(text, base, None)
+            return _read_model_file.__wrapped__(text, base, None, chain)
         if refers:  # a model file naming a URDF: the URDF may change on its own; read both afresh
-            return _read_model_file.__wrapped__(text, base, None)
-        return _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size))
+            return _read_model_file.__wrapped__(text, base, None, chain)
+        return _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size), chain)
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ModelError(

@@ -18,7 +18,7 @@ from ..io.files import to_plain as _plain  # noqa: F401  (old name)
 from ..jobs._common import format_matrix, joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
 from ..locking import lock_joints
 from ..model import ArmModel
-from ..robots import BUILTIN_ROBOTS, load_robot
+from ..robots import BUILTIN_ROBOTS, UrdfChain, load_robot
 from ..scenario import ALL_TABLES, TOP_FIELDS, Field, check_value
 
 
@@ -147,6 +147,18 @@ def add_robot_arguments(
         default=base_default,
         help=base_help,
     )
+    chain = parser.add_argument_group("the chain of a URDF robot (a tree: two arms, a gripper)")
+    chain.add_argument("--root", metavar="LINK", help="link the chain starts from (default: the tree's root)")
+    chain.add_argument("--tip", metavar="LINK", help="link the chain ends at (needed when the tree branches)")
+    chain.add_argument(
+        "--freeze",
+        metavar="JOINT=VALUE",
+        type=parse_freeze,
+        action="append",
+        default=[],
+        help="hold JOINT at VALUE (degrees for a revolute joint, metres for a prismatic one) and merge its "
+        "links; repeat for several (joints off the chain are held at 0, a <mimic> joint follows its leader)",
+    )
 
 
 def single_lock(args: argparse.Namespace) -> tuple[int, float]:
@@ -170,8 +182,48 @@ def lock_map(locks: list[tuple[int, float]] | None) -> dict[int, float]:
     return out
 
 
+def parse_freeze(text: str) -> tuple[str, float]:
+    """``"JOINT=VALUE"`` -> (joint name, value [deg or m, by the joint's type])."""
+    name, _, value_text = text.rpartition("=")
+    try:
+        value = float(value_text)
+    except ValueError:
+        value = math.nan
+    if not name.strip() or not math.isfinite(value) or abs(value) > MAX_OPTION_DEG:
+        raise argparse.ArgumentTypeError(
+            "--freeze must look like JOINT=VALUE (a URDF joint's name; a finite number within "
+            f"+-{MAX_OPTION_DEG:g}: degrees for a revolute joint, metres for a prismatic one), e.g. "
+            f"panda_finger_joint1=0.02; got {shorten(text)!r}"
+        )
+    return name.strip(), value
+
+
+def chain_from_args(args: argparse.Namespace) -> UrdfChain | None:
+    """The chain ``--root``, ``--tip`` and ``--freeze`` name (None without them); refused in one
+    line for a ROBOT that is not a ``.urdf`` file.  Each ``--freeze`` value is in the unit of its
+    joint's type, read from the file."""
+    root, tip, freeze = getattr(args, "root", None), getattr(args, "tip", None), getattr(args, "freeze", None) or []
+    if root is None and tip is None and not freeze:
+        return None
+    robot = str(args.robot)
+    if robot in BUILTIN_ROBOTS or Path(robot).suffix.lower() != ".urdf":
+        what = "a built-in robot" if robot in BUILTIN_ROBOTS else "not a .urdf file (a .toml model file names its chain itself)"
+        raise ScenarioError(f"--root, --tip and --freeze choose the chain of a URDF robot; ROBOT {shorten(robot)!r} is {what}")
+    from ..io.urdf import urdf_joint_types
+
+    types = urdf_joint_types(robot)
+    seen: dict[str, float] = {}
+    for name, value in freeze:
+        if name in seen:
+            raise ScenarioError(f"--freeze: joint {shorten(name)!r} given twice ({seen[name]:g} and {value:g}); give it once")
+        seen[name] = value
+    prismatic = {k: v for k, v in seen.items() if types.get(k) == "prismatic"}
+    degrees = {k: v for k, v in seen.items() if k not in prismatic}
+    return UrdfChain(root, tip, tuple(degrees.items()), tuple(prismatic.items()))
+
+
 def model_from_args(args: argparse.Namespace) -> ArmModel:
-    model = load_robot(args.robot, base=args.base)
+    model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     locks = lock_map(getattr(args, "lock", []))
     return lock_joints(model, locks) if locks else model
 

@@ -34,6 +34,7 @@ from ..papers import p000
 from ..planning.ga import GASettings
 from ._common import (
     add_robot_arguments,
+    chain_from_args,
     check_out_dir,
     deg_arg,
     field_arg,
@@ -222,7 +223,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga, CLI_NAMES)
     paper_lock = {j: math.radians(a) for j, a in PAPER_SCENARIO["lock"].items()}
     locks = lock_map(args.lock) if args.lock else (paper_lock if args.robot == "halt7" else {})
-    model = halt_model(args.robot, locks, args.base)
+    model = halt_model(args.robot, locks, args.base, chain=chain_from_args(args))
     paper = is_000_failure(model)  # 000's state at failure belongs to 000's failure only
     defaults = PAPER_SCENARIO if paper else {}
     if args.from_rest:

@@ -32,7 +32,7 @@ from ..papers import p001
 from ..planning.jump import JumpScenario, scenario_from_mapping
 from ..planning.jump import load_jump_task as load_scenario
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, field_arg, number_arg, print_json
+from ._common import add_robot_arguments, chain_from_args, check_out_dir, field_arg, number_arg, print_json
 
 #: A start of the example task shown when a robot needs its own q0_deg (NOTES-001's start,
 #: cut or padded with zeros to the robot's joints).
@@ -201,7 +201,7 @@ def _warn_ignored(args: argparse.Namespace) -> None:
 def run(args: argparse.Namespace) -> int:
     out_dir = check_out_dir(args.out)
     sc = _scenario(args)
-    model = load_robot(args.robot, base=sc.base)
+    model = load_robot(args.robot, base=sc.base, chain=chain_from_args(args))
     _check_q0(args, sc, model)
     _warn_ignored(args)
     result = run_jump_study(

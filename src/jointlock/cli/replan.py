@@ -16,6 +16,7 @@ from ..robots import load_robot
 from ..scenario import MAX_ABS_DEG
 from ._common import (
     add_robot_arguments,
+    chain_from_args,
     check_out_dir,
     deg_arg,
     field_arg,
@@ -102,7 +103,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
     joint, angle = single_lock(args)
-    full = load_robot(args.robot, base=args.base)
+    full = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     for opt, vals in (("--from-deg", args.from_deg), ("--to-deg", args.to_deg)):
         if len(vals) != full.dof:
             raise ScenarioError(f"{opt} needs {full.dof} values (all joints) [deg]; got {len(vals)}")

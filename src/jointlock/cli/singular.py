@@ -28,6 +28,7 @@ from ..locking import lock_joints
 from ..model import ArmModel
 from ._common import (
     add_robot_arguments,
+    chain_from_args,
     check_out_dir,
     deg_arg,
     field_arg,
@@ -101,7 +102,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _model(args: argparse.Namespace, base: str) -> ArmModel:
-    model = singular_model(args.robot, None, base)
+    model = singular_model(args.robot, None, base, chain=chain_from_args(args))
     locks = lock_map(args.lock)
     return lock_joints(model, locks) if locks else model
 

@@ -8,7 +8,15 @@ from pathlib import Path
 from ..errors import ScenarioError
 from ..jobs.tolerance_angle import MAX_GAMMA_SAMPLES, find_tolerance_angle, gamma_sample_count
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, deg_arg, field_arg, print_json, single_lock
+from ._common import (
+    add_robot_arguments,
+    chain_from_args,
+    check_out_dir,
+    deg_arg,
+    field_arg,
+    print_json,
+    single_lock,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -61,7 +69,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
     joint, angle = single_lock(args)
-    model = load_robot(args.robot, base=args.base)
+    model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     if not 1 <= joint <= model.dof:
         raise ScenarioError(f"--lock joint must be 1..{model.dof}; got {joint}")
     if len(args.q_target_deg) != model.dof:

@@ -11,7 +11,15 @@ from ..errors import ScenarioError
 from ..jobs.workspace import VoxelTooSmallError, study_workspace
 from ..locking import lock_joints
 from ..robots import load_robot
-from ._common import add_robot_arguments, check_out_dir, field_arg, lock_map, print_json, seed_arg
+from ._common import (
+    add_robot_arguments,
+    chain_from_args,
+    check_out_dir,
+    field_arg,
+    lock_map,
+    print_json,
+    seed_arg,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -53,7 +61,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
-    model = load_robot(args.robot, base=args.base)
+    model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     lock_map(args.lock)  # each joint once
     if len(args.lock) > 1:  # the last --lock is the failure; the others were locked before it
         model = lock_joints(model, lock_map(args.lock[:-1]))

@@ -123,6 +123,13 @@ def select_chain(
             want = "freeze_m [m]" if j.kind == "prismatic" else "freeze_deg [deg]"
             raise ModelError(f"{label}: joint {shown(name)} is {j.kind}: give it in {want}")
     below = _below(children, root)
+    free = next((j for link in below for j in children[link] if j.kind in ("planar", "floating")), None)
+    if free is not None:
+        raise ModelError(
+            f"{label}: joint {shown(free.name)}: type {shown(free.kind)} is not supported below root_link {shown(root)} "
+            f"(allowed: revolute, continuous, prismatic, fixed); start the chain below it (root_link = "
+            f"{shown(free.child)}; base='floating' makes that link a free-floating spacecraft)"
+        )
     above_root = [n for n in freeze if by_name[n].child not in below]
     if above_root:
         raise ModelError(f"{label}: freeze names joints [{_some(above_root)}], which are not below root_link {shown(root)}")

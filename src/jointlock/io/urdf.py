@@ -9,7 +9,9 @@ the other arm of a dual-arm robot, gripper fingers, sensors -- at its ``freeze``
 0 (a ``<mimic>`` joint at ``multiplier * value + offset`` of the joint it follows).  Links
 above ``root_link`` are left out.  A prismatic joint on the chain must be frozen (the chain
 model has revolute joints only), and so must a mimic joint on it (no coupled joints): each is
-refused in one line naming it.  Planar and floating joints are refused anywhere.
+refused in one line naming it.  Planar and floating joints are left out above ``root_link``
+(a ``world`` link joined to the robot's base for a simulator: start the chain at the base) and
+refused below it.
 """
 
 from __future__ import annotations
@@ -169,6 +171,8 @@ def read_urdf(
         ``{joint name: "deg" | "m"}``: the unit each value was given in (a model file's
         ``freeze_deg`` / ``freeze_m``), refused for a joint of the other kind.
 
+    Notes
+    -----
     The chain is described in the model's ``description`` (root, tip, frozen joints).
     """
     source_text = str(source)
@@ -200,13 +204,12 @@ def read_urdf(
         jname = jel.get("name") or "?"
         where = f"{label}: joint {shown(jname)}"
         kind = jel.get("type")
-        if kind in ("planar", "floating"):
+        # planar / floating: read, and left out above root_link (a world -> base joint written
+        # for a simulator); refused below it by select_chain
+        if kind not in ("revolute", "continuous", "prismatic", "fixed", "planar", "floating"):
             raise ModelError(
-                f"{where}: type {shown(kind)} is not supported (allowed: revolute, continuous, prismatic, fixed)"
-            )
-        if kind not in ("revolute", "continuous", "prismatic", "fixed"):
-            raise ModelError(
-                f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, prismatic, fixed)"
+                f"{where}: unknown type {shown(kind)} (allowed: revolute, continuous, prismatic, fixed; "
+                "planar and floating above root_link)"
             )
         parent_el, child_el = jel.find("parent"), jel.find("child")
         parent = parent_el.get("link") if parent_el is not None else None
@@ -312,3 +315,19 @@ def _selection_text(chain: Chain) -> str:
     if chain.left_out:
         text += f", {len(chain.left_out)} links above the root left out"
     return text
+
+
+def urdf_joint_types(source: str | Path) -> dict[str, str]:
+    """``{joint name: type}`` of a URDF file (or XML text): which unit a value given per joint
+    is in (degrees for a revolute joint, metres for a prismatic one).  Empty when the file
+    cannot be read: :func:`read_urdf` then says why, in one line."""
+    text = str(source)
+    try:
+        if not text.lstrip().startswith("<"):
+            path = check_path_text(text, "URDF file", ModelError)
+            root = ET.fromstring(_urdf_text(path, shorten(text)))
+        else:
+            root = ET.fromstring(text)
+    except (ModelError, ET.ParseError, LookupError, ValueError):
+        return {}
+    return {j.get("name") or "?": j.get("type") or "?" for j in root.findall("joint")}

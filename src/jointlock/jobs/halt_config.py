@@ -35,7 +35,7 @@ from ..planning.halt_config import (
 )
 from ..plots.halt_config import section_figures
 from ..progress import Progress
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ._common import JobResult, scenario_locks
 from .halt import SCENARIO_LIMIT_NAMES, FailureState, JointLimits, halt_limits, limits_text
 
@@ -368,7 +368,7 @@ def halt_config_from_scenario(
     (``[limits]``).  ``previous`` is not used (the job runs first).  The progress bar is
     shown from :data:`PROGRESS_MIN_SAMPLES` samples on, as the command does."""
     t, st, lim = data["halt_config"], data["state"], data["limits"]
-    model = load_robot(data["robot"], base=t.get("base") or data["base"])
+    model = load_robot(data["robot"], base=t.get("base") or data["base"], chain=UrdfChain.from_fields(data))
     locks = scenario_locks(data)
     if locks:
         model = lock_joints(model, locks)

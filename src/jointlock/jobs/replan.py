@@ -27,7 +27,7 @@ from ..model import ArmModel
 from ..planning.replan import DEFAULT_STEP_WEIGHT, ReplanResult, StepFlag, replan_line
 from ..plots.motion import ArmMotion
 from ..progress import Progress
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ._common import JobResult, scenario_lock
 from ._motions import replan_motions
 
@@ -344,7 +344,7 @@ def replan_from_scenario(
     ``jointlock replan`` with the scenario's options."""
     joint, angle = scenario_lock(data, "replan")
     t = data["replan"]
-    model = load_robot(data["robot"], base=data["base"])
+    model = load_robot(data["robot"], base=data["base"], chain=UrdfChain.from_fields(data))
     return plan_replan(
         model,
         joint,

@@ -23,7 +23,7 @@ from ..kinematics import ee_pose
 from ..model import ArmModel
 from ..planning.replan import GammaRoot, GammaSweep, LockRange, absorbable_range, gamma_sweep, gammas_for_lock
 from ..progress import Progress
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ._common import JobResult, scenario_lock
 
 #: Most gamma samples of one sweep (steps of about 0.0018 deg over +-180 deg; some 1.5 GB and
@@ -266,7 +266,7 @@ def tolerance_angle_from_scenario(
     used.  Same result as ``jointlock tolerance-angle`` with the scenario's options."""
     joint, angle = scenario_lock(data, "tolerance_angle")
     t = data["tolerance_angle"]
-    model = load_robot(data["robot"], base=data["base"])
+    model = load_robot(data["robot"], base=data["base"], chain=UrdfChain.from_fields(data))
     return find_tolerance_angle(
         model,
         joint,

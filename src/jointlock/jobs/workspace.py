@@ -35,7 +35,7 @@ from ..io.files import atomic_write_json, npz_bytes, with_svg, write_figure
 from ..locking import lock_joints
 from ..model import ArmModel
 from ..progress import Progress
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ._common import JobResult, locked_deg, locked_text, scenario_lock, scenario_locks
 
 #: Points of each cloud drawn in the projections, and in the 3-D clouds.
@@ -310,7 +310,7 @@ def workspace_from_scenario(
     t = data["workspace"]
     locks = scenario_locks(data)
     failure = scenario_lock(data)
-    model = load_robot(data["robot"], base=data["base"])
+    model = load_robot(data["robot"], base=data["base"], chain=UrdfChain.from_fields(data))
     if failure is not None:  # joints locked before the failure: the arm before it
         model = lock_joints(model, {j: a for j, a in locks.items() if j != failure[0]})
     return study_workspace(

@@ -14,7 +14,7 @@ from pathlib import Path
 from typing import Any
 
 from ..io.files import toml_document
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ..scenario import JOB_ORDER, Scenario, job_lock_args, jump_fields
 
 #: Subcommand name of each job.
@@ -35,7 +35,7 @@ def _healthy_rates(scenario: Scenario, values: list[float]) -> list[float]:
     locked = set(scenario.locks)
     if not locked:
         return values
-    full = load_robot(scenario.data["robot"], base="fixed")
+    full = load_robot(scenario.data["robot"], base="fixed", chain=UrdfChain.from_fields(scenario.data))
     if len(values) != full.dof:
         return values
     return [v for i, v in enumerate(values) if i + 1 not in locked]

@@ -22,7 +22,7 @@ from ..plots.arm import plot_arm
 from ..plots.singular import plot_condition_checks
 from ..plots.summary import plot_halt_base_torque, plot_jump_before_after, plot_replan_error
 from ..report import LIMITS_HEADER, Section, limit_status, limits_rows
-from ..robots import load_robot
+from ..robots import UrdfChain, load_robot
 from ..scenario import JOB_PAPER, Scenario
 from ..scenario._scenario import FAILURE_KEYS
 from ._decisions import _condition_verdict, _decisions_section  # noqa: F401  (re-exported)
@@ -68,7 +68,7 @@ def report_sections(
     (``typed``).  Summary figures are written to ``out/figures`` as PNG and SVG; each job's own
     figures are read from ``out/<job>`` (written before the report)."""
     jobs = results["jobs"]
-    full = load_robot(scenario.data["robot"], base="fixed")
+    full = load_robot(scenario.data["robot"], base="fixed", chain=UrdfChain.from_fields(scenario.data))
     locks = scenario_locks(scenario.data)
     locked = lock_joints(full, locks) if locks else None
     return [

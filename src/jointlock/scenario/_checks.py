@@ -9,7 +9,7 @@ from typing import Any
 from ..bounds import shown
 from ..errors import JointlockError, ScenarioError
 from ..io.files import check_path_text
-from ..robots import BUILTIN_ROBOTS
+from ..robots import BUILTIN_ROBOTS, CHAIN_FIELDS, UrdfChain
 from ._defaults import _defaults_000, _is_000_failure
 from ._fields import _BASE2, NEEDS_LOCK, _hint
 from ._jump import _check_jump
@@ -30,6 +30,13 @@ def _inherit_singular_base(out: dict[str, Any], jobs: tuple[str, ...], *, given_
 
 def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
     name = out["robot"]
+    chain = next((k for k in CHAIN_FIELDS if out.get(k) is not None), None)
+    if chain is not None and (name in BUILTIN_ROBOTS or Path(name).suffix.lower() != ".urdf"):
+        what = "a built-in robot" if name in BUILTIN_ROBOTS else "not a .urdf file"
+        raise ScenarioError(
+            f"{source}: {chain}: chooses the chain of a URDF robot; robot {shown(name)} is {what} (allowed with "
+            "robot = a .urdf file; a .toml model file names its chain itself)"
+        )
     if name in BUILTIN_ROBOTS:
         return
     check_path_text(name, f"{source}: robot: model file", ScenarioError)
@@ -56,10 +63,11 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
 def _load(out: dict[str, Any], base: str, source: str, cache: dict) -> Any:
     from ..robots import load_robot
 
-    key = (out["robot"], base)
+    chain = UrdfChain.from_fields(out)
+    key = (out["robot"], base, chain)
     if key not in cache:
         try:
-            cache[key] = load_robot(out["robot"], base=base)  # type: ignore[arg-type]
+            cache[key] = load_robot(out["robot"], base=base, chain=chain)  # type: ignore[arg-type]
         except JointlockError as exc:
             field = "base" if base == "floating" and "base" in str(exc) else "robot"
             raise ScenarioError(

@@ -56,7 +56,7 @@ class Field:
 
     ``kind``: ``"int"``, ``"number"``, ``"bool"``, ``"str"``, ``"choice"``, ``"numbers"``
     (list of numbers), ``"strings"`` (list of choices), ``"locks"`` (a table of joint
-    numbers to angles).  ``lo``/``hi`` bound numbers
+    numbers to angles), ``"joint_values"`` (a table of joint names to numbers).  ``lo``/``hi`` bound numbers
     (``lo_open``: strictly greater); ``choices`` lists allowed strings.
     """
 
@@ -79,6 +79,8 @@ class Field:
             return "a string" + unit
         if self.kind == "locks":
             return f"a table {{joint number = angle}} of finite numbers >= {self.lo:g} and <= {self.hi:g}{unit}"
+        if self.kind == "joint_values":
+            return f"a table {{joint name = value}} of finite numbers >= {self.lo:g} and <= {self.hi:g}{unit}"
         if self.kind in ("choice", "strings"):
             opts = ", ".join(repr(c) for c in self.choices)
             return ("one of " if self.kind == "choice" else "a list of ") + opts
@@ -124,6 +126,19 @@ TOP_FIELDS: dict[str, Field] = {
     "title": Field("str", "", help="a title for the report"),
     "description": Field("str", "", help="free text shown in the report"),
     "robot": Field("str", None, help="built-in name or model file (.toml DH table, .urdf)"),
+    "root_link": Field("str", None, help="URDF robot only: the link its chain starts from (default: the tree's root)"),
+    "tip_link": Field(
+        "str", None, help="URDF robot only: the link its chain ends at (needed when the tree branches: two arms, fingers)"
+    ),
+    "freeze_deg": Field(
+        "joint_values", None, lo=-MAX_ABS_DEG, hi=MAX_ABS_DEG, unit="deg",
+        help="URDF robot only: revolute joints held at these angles, their links merged (other joints off the "
+        "chain are held at 0; a <mimic> joint follows its leader)",
+    ),  # fmt: skip
+    "freeze_m": Field(
+        "joint_values", None, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m",
+        help="URDF robot only: prismatic joints held at these positions (gripper fingers, a torso lift)",
+    ),  # fmt: skip
     "base": Field("choice", "fixed", choices=("fixed", "floating"), help="spacecraft held or free-floating"),
     "seed": Field("int", 0, lo=0, hi=MAX_SEED, help="seed of every stochastic job (Monte Carlo, GA)"),
     "out": Field(

@@ -198,6 +198,14 @@ def check_value(value: Any, spec: Field, where: str) -> Any:
                 raise bad(f" (key {shown(key)} is no joint number >= 1)")
             locks[key] = check_value(angle, dataclasses.replace(spec, kind="number"), f"{where}.{key}")
         return locks
+    if kind == "joint_values":
+        if not isinstance(value, dict) or not value:
+            raise bad(f" ({type(value).__name__})" if not isinstance(value, dict) else " (empty)")
+        for key in value:
+            if not isinstance(key, str) or not key.strip():
+                raise bad(f" (key {shown(key)} is no joint name)")
+        number_spec = dataclasses.replace(spec, kind="number")
+        return {key: check_value(v, number_spec, f"{where}.{key}") for key, v in value.items()}
     if kind == "numbers":
         if not isinstance(value, list) or not value:
             raise bad(f" ({type(value).__name__})" if not isinstance(value, list) else " (empty)")

@@ -23,7 +23,7 @@ from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
 from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
 from ...progress import Progress
-from ...robots import load_robot
+from ...robots import UrdfChain, load_robot
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_locks
 from ._checks import (
     LIBRARY_NAMES,
@@ -52,20 +52,23 @@ Solver = Literal["scan", "ga", "vector"]
 MAX_MARGIN = 0.5
 
 
-def halt_model(robot: str, locks: Mapping[int, float] | None, base: str = "fixed") -> ArmModel:
+def halt_model(
+    robot: str, locks: Mapping[int, float] | None, base: str = "fixed", chain: UrdfChain | None = None
+) -> ArmModel:
     """The locked arm ``jointlock halt`` uses for ``robot`` (a built-in name or model file).
 
     The base torque is taken about the spacecraft's centre of mass (000 eq. 30), so the model
     is loaded with its spacecraft even when the base is held fixed (``base`` only picks the
     torque's base mode); a robot without one is loaded fixed (then the moment point is the
-    root frame's origin).  ``locks``: ``{joint number: angle [rad]}``.
+    root frame's origin).  ``locks``: ``{joint number: angle [rad]}``; ``chain``: the chain of a
+    URDF tree (:class:`jointlock.robots.UrdfChain`).
     """
     try:
-        model = load_robot(robot, base="floating")
+        model = load_robot(robot, base="floating", chain=chain)
     except ModelError:
         if base == "floating":
             raise
-        model = load_robot(robot, base="fixed")
+        model = load_robot(robot, base="fixed", chain=chain)
     return lock_joints(model, dict(locks)) if locks else model
 
 
@@ -366,7 +369,7 @@ def halt_from_scenario(
     t, st, lim = data["halt"], data["state"], data["limits"]
     locks = scenario_locks(data)
     base = t.get("base") or data["base"]
-    model = halt_model(data["robot"], locks, base)
+    model = halt_model(data["robot"], locks, base, chain=UrdfChain.from_fields(data))
     state = FailureState.from_degrees(
         model,
         st["q0_deg"],

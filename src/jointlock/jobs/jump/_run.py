@@ -140,13 +140,13 @@ def jump_from_scenario(
     ``jump.fix`` for the sweep), as ``jointlock run`` has always run ``jointlock jump``.
     ``previous`` is not used (the job needs no earlier result).
     """
-    from ...robots import load_robot
+    from ...robots import UrdfChain, load_robot
     from ...scenario import jump_fields
 
     del previous
     t = data["jump"]
     sc = task_as_the_command_reads_it(scenario_from_mapping(jump_fields(data), source="[jump]"))
-    model = load_robot(data["robot"], base=sc.base)
+    model = load_robot(data["robot"], base=sc.base, chain=UrdfChain.from_fields(data))
     if t["fail_at"] is not None:
         return run_jump_study(model, sc, fail_at=t["fail_at"], kappa=t["kappa"], progress=progress)
     if t["kappa"] is not None:

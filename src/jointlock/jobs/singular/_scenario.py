@@ -6,6 +6,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ...robots import UrdfChain
 from .._common import JobResult, joint_vector_deg, scenario_locks
 from ._search import SingularitySearchResult, search_singularities
 from ._shared import SEARCH_SAMPLES, VERIFY_SAMPLES, singular_model
@@ -34,7 +35,7 @@ def singular_from_scenario(
     locks = scenario_locks(data)
     verify = bool(t["verify_conditions"])
     base: Any = t["base"] or ("virtual" if verify else "fixed")  # checked by the scenario reader
-    model = singular_model(data["robot"], locks, base)
+    model = singular_model(data["robot"], locks, base, chain=UrdfChain.from_fields(data))
     weighting, seed, samples = t["weighting"], int(data["seed"]), t["samples"]
     length = None if t["length"] is None else float(t["length"])  # the scenario's name for it
     if verify:

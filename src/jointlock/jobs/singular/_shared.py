@@ -13,7 +13,7 @@ from ...analysis import singularity as sg
 from ...errors import ModelError, ScenarioError
 from ...locking import lock_joints
 from ...model import ArmModel
-from ...robots import load_robot
+from ...robots import UrdfChain, load_robot
 
 #: Virtual link lengths: 004's formula, or the exact Vafa-Dubowsky virtual manipulator.
 WEIGHTINGS: tuple[str, ...] = ("segment", "vafa-dubowsky")
@@ -33,13 +33,16 @@ Rng = int | np.random.Generator | None
 
 
 @renamed_keyword(old="base", new="jacobian")
-def singular_model(robot: str, locks: Mapping[int, float] | None = None, jacobian: str = "fixed") -> ArmModel:
+def singular_model(
+    robot: str, locks: Mapping[int, float] | None = None, jacobian: str = "fixed", *, chain: UrdfChain | None = None
+) -> ArmModel:
     """The arm ``jointlock singular`` analyses for the Jacobian ``jacobian``: ``robot`` (a
     built-in name or model file) loaded with a fixed base for ``jacobian="fixed"`` and
     free-floating otherwise (the generalized and the virtual-manipulator Jacobians need the
     spacecraft), with ``locks`` (``{joint number: angle [rad]}``) locked.  ``jacobian``:
-    formerly ``base=`` (a deprecated alias)."""
-    model = load_robot(robot, base="fixed" if jacobian == "fixed" else "floating")
+    formerly ``base=`` (a deprecated alias).  ``chain``: the chain of a URDF tree
+    (:class:`jointlock.robots.UrdfChain`)."""
+    model = load_robot(robot, base="fixed" if jacobian == "fixed" else "floating", chain=chain)
     return lock_joints(model, dict(locks)) if locks else model
 
 
