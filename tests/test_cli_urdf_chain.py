@@ -91,8 +91,9 @@ def test_export_urdf_of_baxter_s_left_arm_from_the_torso(tmp_path, capsys):
         (["kinematics", "PANDA", "--freeze", "panda_finger_joint1=0.01", "--freeze", "panda_finger_joint1=0.02"], ["--freeze: joint 'panda_finger_joint1' given twice"]),
         (["kinematics", "PANDA", "--freeze", "nope=1"], ["freeze names joint 'nope', which is not in the robot"]),
         (["kinematics", "PANDA", "--tip", "panda_leftfinger"], ["joint 'panda_finger_joint1' on the chain is prismatic"]),
-        (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_finger_joint1=1"], ["'panda_finger_joint1' is frozen at 1", "outside its limits [0, 0.04]"]),
+        (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_finger_joint1=1"], ["'panda_finger_joint1' is frozen at 1 m", "outside its limits [0, 0.04] m"]),
         (["kinematics", "PANDA", "--freeze", "panda_finger_joint1"], ["--freeze must look like JOINT=VALUE"]),
+        (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_joint4=10"], ["'panda_joint4' is frozen at 10 deg", "outside its limits [-176.", "] deg"]),
     ],
 )
 def test_a_chain_option_that_cannot_apply_is_one_error_line(capsys, argv, words):

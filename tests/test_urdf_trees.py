@@ -148,7 +148,7 @@ def test_a_chain_from_a_link_inside_the_tree():
         ({"root_link": "l_hand", "tip_link": "r_tcp"}, r"tip_link 'r_tcp' is not below root_link 'l_hand'"),
         ({"tip_link": "l_tcp", "freeze": {"nope": 1.0}}, r"freeze names joint 'nope', which is not in the robot"),
         ({"tip_link": "l_tcp", "freeze": {"l_tcp_joint": 1.0}}, r"'l_tcp_joint', which is fixed already"),
-        ({"tip_link": "l_tcp", "freeze": {"r1": 3.0}}, r"joint 'r1' is frozen at 3 \(off the chain, or named in freeze\), outside its limits \[-2.5, 2.5\]"),
+        ({"tip_link": "l_tcp", "freeze": {"r1": 3.0}}, r"joint 'r1' is frozen at 3 rad \(off the chain, or named in freeze\), outside its limits \[-2.5, 2.5\] rad"),
         ({"tip_link": "l_tcp", "ee_link": "r_tcp"}, r"ee_link 'r_tcp' and tip_link 'l_tcp' differ"),
     ],
 )

@@ -67,6 +67,7 @@ _CORE = {
     "as_joint_array": "jointlock.model",
     "BUILTIN_ROBOTS": "jointlock.robots",
     "load_robot": "jointlock.robots",
+    "UrdfChain": "jointlock.robots",
 }
 
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).
@@ -158,6 +159,7 @@ __all__ = [
     "jacobian",
     "link_poses",
     "load_robot",
+    "UrdfChain",
     "lock",
     "lock_joints",
     "mass_matrix",

@@ -184,9 +184,13 @@ def select_chain(
         if not math.isfinite(v) or abs(v) > 1e6:
             raise ModelError(f"{label}: joint {shown(j.name)} would be frozen at {v:g}: give it a value with freeze")
         if j.kind in ("revolute", "prismatic") and not j.lower - LIMIT_SLACK <= v <= j.upper + LIMIT_SLACK:
+            # in the unit it was given in (a model file's freeze_deg, the command line's degrees)
+            deg = (freeze_units or {}).get(j.name) == "deg"
+            scale, unit = (180.0 / math.pi, " deg") if deg else (1.0, " m" if j.kind == "prismatic" else " rad")
             raise ModelError(
-                f"{label}: joint {shown(j.name)} is frozen at {v:g} (off the chain, or named in freeze), outside its "
-                f"limits [{j.lower:g}, {j.upper:g}]: give it a value with freeze = {{{j.name} = value}}"
+                f"{label}: joint {shown(j.name)} is frozen at {v * scale:g}{unit} (off the chain, or named in freeze), "
+                f"outside its limits [{j.lower * scale:g}, {j.upper * scale:g}]{unit}: give it a value with "
+                f"freeze = {{{j.name} = value}}"
             )
         values[j.name] = v
         return v
