@@ -239,4 +239,5 @@ def test_workspace_summary_prints_few_digits_and_the_half_sample_estimate(tmp_pa
     assert "half the samples" in line
     import re
 
-    assert re.search(r"kept \d+ % ", line)  # a Monte Carlo share, to the percent
+    # a Monte Carlo share, to the percent (no estimate from these few samples), and its occupancy
+    assert re.search(r"kept (\d+ ± \d+ %|no estimate) \(occupancy \d+ %", line)

@@ -47,8 +47,8 @@ def test_locked_poses_are_reached_by_the_full_arm(puma, rng):
 
 def test_locked_workspace_is_a_subset_of_the_full_one(puma):
     cmp = compare_workspaces(puma, 2, math.radians(60.0), samples=100_000, rng=5)
-    assert cmp.volume_locked < cmp.volume_full
-    assert 0.2 < cmp.share_kept < 0.6
+    assert cmp.occupancy_locked < cmp.occupancy_full
+    assert 0.2 < cmp.share_kept_occupancy < 0.6
     assert cmp.outside < 0.03  # sampling only: locked voxels the full cloud's samples missed
 
 
@@ -57,7 +57,7 @@ def test_full_volume_is_the_reach_sphere(puma):
     ws = sample_workspace(puma, samples=200_000, voxel=0.2, rng=1)
     sphere = 4 / 3 * math.pi * (0.985 + 0.765 + 0.382) ** 3
     # voxel occupancy: under-sampled shell vs half a voxel layer of over-estimate
-    assert 0.85 < ws.volume / sphere < 1.2
+    assert 0.85 < ws.occupancy / sphere < 1.2
     assert np.linalg.norm(ws.points, axis=1).max() <= 0.985 + 0.765 + 0.382 + 1e-9
 
 
@@ -86,7 +86,9 @@ def test_cli_workspace(capsys, tmp_path):
         == 0
     )
     out = json.loads(capsys.readouterr().out)
-    assert 0 < out["share_kept"] < 1
+    assert 0 < out["share_kept_occupancy"] < 1
+    assert out["share_kept"] is None and out["volume_full_m3"] is None  # too few samples: no number
+    assert any("too few samples" in w for w in out["warnings"])
     assert (tmp_path / "projections.png").exists() and (tmp_path / "points.npz").exists()
 
 
@@ -134,7 +136,10 @@ def test_cli_workspace_text_has_few_digits_and_the_half_estimate(capsys):
     share = next(line for line in cap.out.splitlines() if "share kept" in line)
     import re
 
-    assert re.search(r"share kept\s+: \d+ % \(from half the samples: \d+ %\); not converged", share)
+    assert re.search(
+        r"share kept\s+: (\d+ ± \d+ %|no estimate) \(occupancy: \d+ %, from half the samples: \d+ %\); not converged",
+        share,
+    )
     assert "warning: share kept moves from" in cap.err
     assert main(["workspace", "halt7", "--lock", "4=0", "--samples", "20000", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)

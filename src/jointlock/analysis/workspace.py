@@ -1,12 +1,18 @@
 """Monte Carlo workspace of an arm before and after a joint locks (002 Figs. 2-3).
 
 Joint angles are drawn uniformly within the limits as given (:meth:`ArmModel.angle_range`), the end-effector
-positions computed in one batched pass, and the volume estimated by voxel occupancy: the
-number of cubes of side ``voxel`` [m] holding at least one sample, times ``voxel^3``.  The
-share of the full workspace that the locked arm keeps is the ratio of the two occupancies
-on one common grid.  (Voxel occupancy under-estimates with few samples and over-estimates
-by about half a voxel layer over the surface; both shrink as samples grow and the voxel
-shrinks -- report the voxel with the number.)
+positions computed in one batched pass.  The volume, ``volume`` [m^3] with its error
+``volume_error``, is the voxel occupancy at several voxel sides extrapolated to a zero side
+(:func:`jointlock.analysis._volume.estimate_volume`; NaN, with a warning, when the samples are
+too few).  The plain occupancy at the voxel ``voxel`` (cubes of that side holding at least
+one sample, times ``voxel^3``: biased high by the cubes overhanging the surface) stays
+available as ``occupancy``.
+
+The locked arm's configurations are the full arm's with one joint fixed, so its positions
+are full-arm positions: the full arm's volume is estimated from both clouds together, and the
+locked workspace is a subset of the full one by construction (share kept <= 1).  ``outside``
+still reports how many locked voxels the full arm's own samples missed: a sampling
+diagnostic, not a contradiction.
 
 The end-effector positions come from :func:`jointlock.kinematics.ee_positions`, the
 position-only forward kinematics (re-exported here with :data:`DEFAULT_CHUNK`).
@@ -26,6 +32,7 @@ from ..errors import ConfigurationError
 from ..kinematics import DEFAULT_CHUNK, ee_positions
 from ..locking import lock
 from ..model import ArmModel, FloatArray
+from ._volume import VolumeEstimate, estimate_volume
 
 __all__ = [
     "DEFAULT_CHUNK",
@@ -34,10 +41,12 @@ __all__ = [
     "OUTSIDE_TOL",
     "SAMPLES_PER_VOXEL",
     "SHARE_HALF_TOL",
+    "VolumeEstimate",
     "Workspace",
     "WorkspaceComparison",
     "compare_workspaces",
     "ee_positions",
+    "estimate_volume",
     "projection_extent",
     "sample_configurations",
     "sample_workspace",
@@ -110,24 +119,41 @@ class Workspace:
     points
         (N, 3) end-effector positions [m], root frame.
     voxel
-        Voxel side [m].
-    volume
-        Occupied volume [m^3] (voxel count x voxel^3).
+        Voxel side [m] of ``occupancy``.
+    occupancy
+        Occupied volume at that voxel [m^3] (voxel count x voxel^3; biased high).
     seed
         The seed the samples were drawn with (the fresh one drawn for ``rng=None``), or None
         when a ``Generator`` was passed.
+    estimate
+        The volume extrapolated to a zero voxel side, with its error and ladder.
     """
 
     points: FloatArray
     voxel: float
-    volume: float
+    occupancy: float
     seed: int | None
+    estimate: VolumeEstimate
+
+    @property
+    def volume(self) -> float:
+        """Estimated volume [m^3] (NaN when the samples are too few; :meth:`warnings`)."""
+        return self.estimate.volume
+
+    @property
+    def volume_error(self) -> float:
+        """Stated error of :attr:`volume` [m^3]."""
+        return self.estimate.error
 
     @property
     def samples_per_voxel(self) -> float:
         """Mean samples per occupied voxel [-] (see :data:`MIN_SAMPLES_PER_VOXEL`)."""
-        occupied = self.volume / self.voxel**3
+        occupied = self.occupancy / self.voxel**3
         return float(self.points.shape[0] / occupied) if occupied > 0 else math.nan
+
+    def warnings(self) -> list[str]:
+        """Why there is no volume estimate (empty when there is one)."""
+        return [self.estimate.warning] if self.estimate.warning else []
 
 
 def sample_workspace(
@@ -137,15 +163,16 @@ def sample_workspace(
     voxel: float | None = None,
     rng: int | np.random.Generator | None = None,
 ) -> Workspace:
-    """Monte Carlo workspace of one arm (002 Fig. 2): uniform joint samples, batched FK,
-    voxel-occupancy volume (``voxel=None``: about :data:`SAMPLES_PER_VOXEL` samples per
-    voxel of the bounding box).  ``rng``: seed, Generator or None (a fresh seed), recorded in
+    """Monte Carlo workspace of one arm (002 Fig. 2): uniform joint samples, batched FK, the
+    volume extrapolated to a zero voxel side with its error, and the plain occupancy at
+    ``voxel`` [m] (``voxel=None``: about :data:`SAMPLES_PER_VOXEL` samples per voxel of the
+    bounding box).  ``rng``: seed, Generator or None (a fresh seed), recorded in
     ``seed`` (:mod:`jointlock._random`)."""
     gen, seed = resolve_rng(rng)
     pts = ee_positions(model, sample_configurations(model, samples, gen))
     side = _auto_voxel(pts) if voxel is None else float(voxel)
     vol = voxel_keys(pts, side).shape[0] * side**3
-    return Workspace(pts, side, float(vol), seed)
+    return Workspace(pts, side, float(vol), seed, estimate_volume(pts))
 
 
 @dataclass(frozen=True)
@@ -157,60 +184,106 @@ class WorkspaceComparison:
     full, locked
         (N, 3), (M, 3) end-effector positions [m], root frame.
     voxel
-        Voxel side [m].
-    volume_full, volume_locked
-        Occupied volume [m^3] (voxel count x voxel^3).
-    share_kept
-        ``volume_locked / volume_full`` [-].
+        Voxel side [m] of the occupancies.
+    occupancy_full, occupancy_locked
+        Occupied volume at that voxel [m^3] (voxel count x voxel^3 of each cloud alone;
+        biased high).
+    share_kept_occupancy
+        ``occupancy_locked / occupancy_full`` [-].
     outside
-        Share of the locked arm's voxels not occupied by the full arm's samples [-]
-        (0 in the limit; a sampling artefact otherwise).
+        Share of the locked arm's voxels not occupied by the full arm's own samples [-]
+        (0 in the limit; a sampling diagnostic: the volumes count the locked samples as
+        full-arm samples, so the locked workspace is inside the full one by construction).
     joint, angle
         The locked joint (1-based) and its angle [rad].
     seed
         The seed the samples were drawn with (the fresh one drawn for ``rng=None``), or None
         when a ``Generator`` was passed.
     share_kept_half
-        The same estimate from the first half of each cloud (same voxel rule: the given
+        ``share_kept_occupancy`` from the first half of each cloud (same voxel rule: the given
         ``voxel``, or the automatic side for half the samples) [-]; its distance to
         ``share_kept`` shows how far the estimate has converged.
     voxel_half
         The voxel side of that estimate [m].
+    estimate_full, estimate_locked
+        The volumes extrapolated to a zero voxel side with their errors: the full arm's from
+        both clouds (the locked arm's positions are full-arm positions), the locked arm's
+        from its own.
     """
 
     full: FloatArray
     locked: FloatArray
     voxel: float
-    volume_full: float
-    volume_locked: float
-    share_kept: float
+    occupancy_full: float
+    occupancy_locked: float
+    share_kept_occupancy: float
     outside: float
     joint: int
     angle: float
     seed: int | None
-    share_kept_half: float = math.nan
-    voxel_half: float = math.nan
+    share_kept_half: float
+    voxel_half: float
+    estimate_full: VolumeEstimate
+    estimate_locked: VolumeEstimate
+
+    @property
+    def volume_full(self) -> float:
+        """Estimated volume of the full arm's workspace [m^3] (NaN: too few samples)."""
+        return self.estimate_full.volume
+
+    @property
+    def volume_full_error(self) -> float:
+        """Stated error of :attr:`volume_full` [m^3]."""
+        return self.estimate_full.error
+
+    @property
+    def volume_locked(self) -> float:
+        """Estimated volume of the locked arm's workspace [m^3] (NaN: too few samples)."""
+        return self.estimate_locked.volume
+
+    @property
+    def volume_locked_error(self) -> float:
+        """Stated error of :attr:`volume_locked` [m^3]."""
+        return self.estimate_locked.error
+
+    @property
+    def share_kept(self) -> float:
+        """``volume_locked / volume_full`` [-], at most 1 (the locked workspace is a subset)."""
+        ratio = self.volume_locked / self.volume_full
+        return min(1.0, ratio) if math.isfinite(ratio) else math.nan
+
+    @property
+    def share_kept_error(self) -> float:
+        """Stated error of :attr:`share_kept` [-] (the relative errors of both volumes added)."""
+        ratio = self.volume_locked / self.volume_full
+        return abs(ratio) * (self.volume_locked_error / self.volume_locked + self.volume_full_error / self.volume_full)
 
     @property
     def samples_per_voxel(self) -> float:
         """Mean full-arm samples per occupied voxel [-] (below :data:`MIN_SAMPLES_PER_VOXEL`
         the voxel is too small for the samples)."""
-        occupied = self.volume_full / self.voxel**3
+        occupied = self.occupancy_full / self.voxel**3
         return float(self.full.shape[0] / occupied) if occupied > 0 else math.nan
 
     def warnings(self) -> list[str]:
-        """Why ``share_kept`` should not be trusted to its digits (empty when it looks converged):
-        it moves by more than :data:`SHARE_HALF_TOL` between half and all the samples, more than
+        """Why the numbers should not be trusted to their digits (empty when they look converged):
+        a volume without an estimate (too few samples), the occupancy share kept moves by more
+        than :data:`SHARE_HALF_TOL` between half and all the samples, more than
         :data:`OUTSIDE_TOL` of the locked voxels lie outside the full cloud (samples missed),
         or the voxel holds fewer than :data:`MIN_SAMPLES_PER_VOXEL` samples on average."""
-        out = []
+        out = [
+            f"{which} arm volume: {est.warning}"
+            for which, est in (("full", self.estimate_full), ("locked", self.estimate_locked))
+            if est.warning
+        ]
         if (
             math.isfinite(self.share_kept_half)
-            and abs(self.share_kept - self.share_kept_half) > SHARE_HALF_TOL
+            and abs(self.share_kept_occupancy - self.share_kept_half) > SHARE_HALF_TOL
         ):
             out.append(
                 f"share kept moves from {100 * self.share_kept_half:.0f} % (half the samples) to "
-                f"{100 * self.share_kept:.0f} % (all): not converged; use more samples"
+                f"{100 * self.share_kept_occupancy:.0f} % (all) at voxel {self.voxel:.3g} m: not converged; "
+                "use more samples"
             )
         if self.outside > OUTSIDE_TOL:
             out.append(
@@ -246,7 +319,7 @@ def compare_workspaces(
     samples, locked_samples
         Monte Carlo sizes (the locked arm defaults to the same number).
     voxel
-        Voxel side [m] of the volume estimate; default: the side giving about
+        Voxel side [m] of the plain occupancies; default: the side giving about
         :data:`SAMPLES_PER_VOXEL` full-arm samples per voxel of the full cloud's bounding box.
     rng
         Seed (int >= 0), ``numpy.random.Generator`` or None (a fresh seed), recorded in
@@ -273,6 +346,10 @@ def compare_workspaces(
     if nf >= 1 and nl >= 1:
         voxel_half = _auto_voxel(full[:nf]) if auto else float(voxel)
         share_half = voxel_keys(locked[:nl], voxel_half).shape[0] / voxel_keys(full[:nf], voxel_half).shape[0]
+    # the locked arm's positions are full-arm positions: the full volume counts both clouds
+    # (the half estimate: the first half of each)
+    both = np.concatenate([full, locked])
+    first_half = np.concatenate([np.arange(full.shape[0]) < nf, np.arange(locked.shape[0]) < nl])
     return WorkspaceComparison(
         full,
         locked,
@@ -286,6 +363,8 @@ def compare_workspaces(
         seed,
         float(share_half),
         float(voxel_half),
+        estimate_volume(both, first_half),
+        estimate_volume(locked),
     )
 
 

@@ -2,8 +2,9 @@
 
 Joint angles are sampled uniformly within the limits (capped to +-180 deg); the end-effector
 positions of the full arm and, with a lock, of the arm with that joint locked give each
-volume by voxel occupancy on one common grid, and the share of the full workspace that the
-locked arm keeps (:mod:`jointlock.analysis.workspace` does the sampling; this job adds the
+volume, extrapolated to a zero voxel side with its error (the full arm's counting the locked
+arm's positions too: a subset by construction), the share of the full workspace that the
+locked arm keeps, and the plain voxel occupancies on one common grid (:mod:`jointlock.analysis.workspace` does the sampling; this job adds the
 settings, the checks and the outputs).  The command ``jointlock workspace`` is this call plus
 printing.
 """
@@ -45,6 +46,21 @@ CLOUD_POINTS = 5000
 #: Size of the projections figure [inch], and of the clouds figure.
 PROJECTIONS_FIGSIZE = (14.0, 4.5)
 CLOUDS_FIGSIZE = (11.0, 5.0)
+
+
+def volume_text(volume: float | None, error: float | None) -> str:
+    """``"V ± err m^3"`` (3 significant digits), or ``"no estimate (too few samples)"`` for a
+    NaN or missing volume (``None``: the JSON form)."""
+    if volume is None or error is None or not (math.isfinite(volume) and math.isfinite(error)):
+        return "no estimate (too few samples)"
+    return f"{volume:.3g} ± {error:.2g} m^3"
+
+
+def share_text(share: float | None, error: float | None) -> str:
+    """``"S ± err %"`` (whole percent), or ``"no estimate"`` for a NaN or missing share."""
+    if share is None or error is None or not (math.isfinite(share) and math.isfinite(error)):
+        return "no estimate"
+    return f"{100 * share:.0f} ± {100 * error:.0f} %"
 
 
 class VoxelTooSmallError(ScenarioError):
@@ -93,9 +109,10 @@ class WorkspaceStudy(JobResult):
         The seed the samples were drawn with (None when a Generator was passed).
     workspace
         Without a lock: the full arm's :class:`~jointlock.analysis.workspace.Workspace`
-        (``points`` (N, 3) [m], ``voxel`` [m], ``volume`` [m^3]).  With one: the
+        (``points`` (N, 3) [m], ``voxel`` [m], ``volume`` and ``volume_error`` [m^3]).  With one: the
         :class:`~jointlock.analysis.workspace.WorkspaceComparison` (``full`` (N, 3), ``locked``
-        (N, 3) [m], both volumes, the share kept and its half-sample estimate).
+        (N, 3) [m], both volumes with their errors, the share kept, the occupancies and the
+        half-sample estimate).
     already_locked
         ``{joint: angle [deg]}`` locked before the failure (``model.locked`` of the arm given):
         then "full" is the arm before this failure, with those joints locked.
@@ -137,10 +154,9 @@ class WorkspaceStudy(JobResult):
         return self.workspace.samples_per_voxel
 
     def warnings(self) -> list[str]:
-        """Why the share kept should not be trusted to its digits (empty without a lock, or when
-        it looks converged)."""
-        ws = self.workspace
-        return ws.warnings() if isinstance(ws, WorkspaceComparison) else []
+        """Why the volumes or the share kept should not be trusted to their digits (empty when
+        they look converged)."""
+        return self.workspace.warnings()
 
     def to_dict(self) -> dict[str, Any]:
         """The JSON object of ``jointlock workspace --json`` (without ``files``)."""
@@ -153,8 +169,14 @@ class WorkspaceStudy(JobResult):
                 "lock": {"joint": ws.joint, "angle_deg": math.degrees(ws.angle)},
                 "voxel_m": ws.voxel,
                 "volume_full_m3": ws.volume_full,
+                "volume_full_error_m3": ws.volume_full_error,
                 "volume_locked_m3": ws.volume_locked,
+                "volume_locked_error_m3": ws.volume_locked_error,
                 "share_kept": ws.share_kept,
+                "share_kept_error": ws.share_kept_error,
+                "occupancy_full_m3": ws.occupancy_full,
+                "occupancy_locked_m3": ws.occupancy_locked,
+                "share_kept_occupancy": ws.share_kept_occupancy,
                 "share_kept_half_samples": ws.share_kept_half,
                 "voxel_half_samples_m": ws.voxel_half,
                 "locked_voxels_outside_full": ws.outside,
@@ -171,8 +193,11 @@ class WorkspaceStudy(JobResult):
                 "lock": None,
                 "voxel_m": ws.voxel,
                 "volume_full_m3": ws.volume,
+                "volume_full_error_m3": ws.volume_error,
+                "occupancy_full_m3": ws.occupancy,
                 "extent_full_m": projection_extent(ws.points),
                 "samples_per_voxel": ws.samples_per_voxel,
+                "warnings": ws.warnings(),
             }
         if self.already_locked:  # "full" is the arm before the failure
             out["already_locked_deg"] = dict(self.already_locked)
@@ -190,16 +215,21 @@ class WorkspaceStudy(JobResult):
         if isinstance(ws, WorkspaceComparison):
             warnings = ws.warnings()
             lines += [
-                f"  {self._before + ' volume':<18}: {ws.volume_full:.3g} m^3",
-                f"  locked arm volume : {ws.volume_locked:.3g} m^3 (joint {ws.joint} at "
-                f"{math.degrees(ws.angle):g} deg)",
-                f"  share kept        : {100 * ws.share_kept:.0f} % (from half the samples: "
+                f"  {self._before + ' volume':<18}: {volume_text(ws.volume_full, ws.volume_full_error)} "
+                f"(occupancy at the voxel: {ws.occupancy_full:.3g} m^3)",
+                f"  locked arm volume : {volume_text(ws.volume_locked, ws.volume_locked_error)} (joint "
+                f"{ws.joint} at {math.degrees(ws.angle):g} deg; occupancy {ws.occupancy_locked:.3g} m^3)",
+                f"  share kept        : {share_text(ws.share_kept, ws.share_kept_error)} (occupancy: "
+                f"{100 * ws.share_kept_occupancy:.0f} %, from half the samples: "
                 f"{100 * ws.share_kept_half:.0f} %)"
                 + ("; not converged, see the warnings" if warnings else ""),
                 f"  locked voxels outside the full cloud (sampling): {100 * ws.outside:.1f} %",
             ]
         else:
-            lines.append(f"  {self._before + ' volume':<18}: {ws.volume:.3g} m^3")
+            lines.append(
+                f"  {self._before + ' volume':<18}: {volume_text(ws.volume, ws.volume_error)} "
+                f"(occupancy at the voxel: {ws.occupancy:.3g} m^3)"
+            )
         return lines
 
     def file_names(self) -> list[str]:

@@ -8,6 +8,7 @@ from typing import Any
 import numpy as np
 
 from ..jobs.jump import KAPPA_UNIT, _points_text
+from ..jobs.workspace import share_text, volume_text
 from ..papers import p004
 from ..report import Section
 from ..scenario import Scenario
@@ -134,16 +135,19 @@ def _decide_workspace(scenario: Scenario, jobs: dict[str, Any]) -> tuple[list[tu
     decisions: list[tuple[str, Any]] = []
     dtables: list[Any] = []
     r = jobs["workspace"]["result"]
-    if r.get("volume_locked_m3") is None:
-        decisions.append(("workspace volume [m^3]", f"{r['volume_full_m3']:.3g}"))
+    full = volume_text(r.get("volume_full_m3"), r.get("volume_full_error_m3"))
+    if r.get("share_kept_occupancy") is None:  # no lock
+        decisions.append(("workspace volume", full))
     else:
         decisions.append(
             (
-                "workspace volume before / after the failure [m^3]"
+                "workspace volume before / after the failure"
                 if r.get("already_locked_deg")
-                else "workspace volume full / locked [m^3]",
-                f"{r['volume_full_m3']:.3g} / {r['volume_locked_m3']:.3g} (kept {_pct0(r.get('share_kept'))}; "
-                f"from half the samples {_pct0(r.get('share_kept_half_samples'))})",
+                else "workspace volume full / locked",
+                f"{full} / {volume_text(r.get('volume_locked_m3'), r.get('volume_locked_error_m3'))} "
+                f"(kept {share_text(r.get('share_kept'), r.get('share_kept_error'))}; occupancy "
+                f"{_pct0(r.get('share_kept_occupancy'))}, from half the samples "
+                f"{_pct0(r.get('share_kept_half_samples'))})",
             )
         )
         for w in r.get("warnings", []):

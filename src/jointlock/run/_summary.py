@@ -7,6 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from ..jobs.workspace import share_text, volume_text
+
 
 def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
     """Headline figures of each job (plain data)."""
@@ -65,8 +67,14 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
             k: r.get(k)
             for k in (
                 "volume_full_m3",
+                "volume_full_error_m3",
                 "volume_locked_m3",
+                "volume_locked_error_m3",
                 "share_kept",
+                "share_kept_error",
+                "occupancy_full_m3",
+                "occupancy_locked_m3",
+                "share_kept_occupancy",
                 "share_kept_half_samples",
                 "warnings",
             )
@@ -149,12 +157,14 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     if "workspace" in s:
         w = s["workspace"]
         lines.append(
-            f"  workspace: {'before the failure' if w.get('already_locked_deg') else 'full'} {w['volume_full_m3']:.3g} m^3"
+            f"  workspace: {'before the failure' if w.get('already_locked_deg') else 'full'} "
+            f"{volume_text(w.get('volume_full_m3'), w.get('volume_full_error_m3'))}"
             + (
-                f", locked {w['volume_locked_m3']:.3g} m^3, kept {_pct0(w['share_kept'])} "
-                f"(half the samples: {_pct0(w.get('share_kept_half_samples'))})"
+                f", locked {volume_text(w.get('volume_locked_m3'), w.get('volume_locked_error_m3'))}, kept "
+                f"{share_text(w.get('share_kept'), w.get('share_kept_error'))} (occupancy {_pct0(w['share_kept_occupancy'])}, "
+                f"half the samples: {_pct0(w.get('share_kept_half_samples'))})"
                 + ("; not converged" if w.get("warnings") else "")
-                if w.get("volume_locked_m3") is not None
+                if w.get("share_kept_occupancy") is not None
                 else ""
             )
         )
