@@ -1,8 +1,17 @@
 """Regression against the numbers of the pre-refactor code: each example scenario's job results
 and summary, recorded with the original command-line implementation (commit 44d6d37, files in
 tests/data/golden/), must be reproduced by the in-process library run -- every number to a
-relative 1e-9 (summation order may differ in the last bits), every flag and every key.  Text
-fields may be reworded (they are not compared); timings and file paths are left out."""
+relative 1e-6 (or within 1e-12: round-off-level quantities), every flag and every key.  Text
+fields may be reworded (they are not compared); timings and file paths are left out.
+
+Why not bit-level: OpenBLAS picks its kernels by CPU (with or without AVX-512, ...), and the
+last bits of a product or a decomposition differ between machines.  Near-singular quantities
+amplify that (halt_000's normalising sigma_min of 4.6e-5 moves by 4e-8 relative between an AMD
+Zen 3 and the machine the files were recorded on); the tolerance leaves that and catches any
+change of method.  The singularity search's completeness counts are counts of starts that
+converge within a fixed number of iterations: a start at the edge converges on one machine and
+not on another, so those counts may differ by :data:`COUNT_SLACK` (1 of 381 starts and 2 of 121
+per condition between those two machines)."""
 
 from __future__ import annotations
 
@@ -25,8 +34,12 @@ FAST = {
     "replan_002": {"workspace.samples": 4000, "replan.steps": 10},
     "singular_004": {"singular.samples": 50},
 }
-#: Relative tolerance on a number [-]: bit-level differences only (summation order).
-RTOL = 1e-9
+#: Relative tolerance on a number [-] and the absolute one below which two numbers are equal
+#: (round-off-level quantities such as a residual of 1e-35 or a rotation error of 1e-14 deg).
+RTOL = 1e-6
+ATOL = 1e-12
+#: Largest relative difference of a completeness count of the singularity search [-].
+COUNT_SLACK = 0.03
 #: Keys left out of the comparison: wall-clock timings and the paths of written files.
 SKIP = {"elapsed_s", "files"}
 
@@ -51,7 +64,8 @@ def _compare(old, new, path: str, problems: list[str]) -> None:
         if new != old:
             problems.append(f"{path}: {old!r} -> {new!r}")
     elif isinstance(old, (int, float)):
-        if not isinstance(new, (int, float)) or not math.isclose(old, new, rel_tol=RTOL, abs_tol=1e-300):
+        rtol = COUNT_SLACK if "/completeness/" in path and isinstance(old, int) else RTOL
+        if not isinstance(new, (int, float)) or not math.isclose(old, new, rel_tol=rtol, abs_tol=ATOL):
             problems.append(f"{path}: {old!r} -> {new!r}")
 
 
@@ -69,5 +83,8 @@ def test_example_runs_reproduce_the_pre_refactor_numbers(name):
 
 def test_the_comparison_can_fail():
     problems: list[str] = []
-    _compare({"a": 1.0, "b": [True, 2], "c": {"d": 3}}, {"a": 1.0 + 1e-6, "b": [False, 2], "c": {}}, "", problems)
-    assert problems == ["/a: 1.0 -> 1.000001", "/b[0]: True -> False", "/c/d: missing"]
+    _compare({"a": 1.0, "b": [True, 2], "c": {"d": 3}}, {"a": 1.0 + 1e-5, "b": [False, 2], "c": {}}, "", problems)
+    assert problems == ["/a: 1.0 -> 1.00001", "/b[0]: True -> False", "/c/d: missing"]
+    problems.clear()
+    _compare({"completeness": {"n": 100}, "m": 100}, {"completeness": {"n": 104}, "m": 101}, "", problems)
+    assert problems == ["/completeness/n: 100 -> 104", "/m: 100 -> 101"]

