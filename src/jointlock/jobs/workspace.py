@@ -49,11 +49,15 @@ CLOUDS_FIGSIZE = (11.0, 5.0)
 
 
 def volume_text(volume: float | None, error: float | None) -> str:
-    """``"V ± err m^3"`` (3 significant digits), or ``"no estimate (too few samples)"`` for a
-    NaN or missing volume (``None``: the JSON form)."""
+    """``"V ± err m^3"`` (the error to 2 significant digits, the volume to the same decimal
+    place: ``"13.9 ± 1.0 m^3"``, ``"14.10 ± 0.63 m^3"``), or ``"no estimate (too few samples)"``
+    for a NaN or missing volume (``None``: the JSON form)."""
     if volume is None or error is None or not (math.isfinite(volume) and math.isfinite(error)):
         return "no estimate (too few samples)"
-    return f"{volume:.3g} ± {error:.2g} m^3"
+    if error <= 0:
+        return f"{volume:.3g} ± 0 m^3"
+    places = max(0, 1 - math.floor(math.log10(error)))
+    return f"{volume:.{places}f} ± {error:.{places}f} m^3"
 
 
 def share_text(share: float | None, error: float | None) -> str:
