@@ -314,3 +314,23 @@ def ee_position_rows(program: tuple[list[tuple[FloatArray, list]], list], q: Flo
         v = [lc(((mat[k, 0], v[0]), (mat[k, 1], v[1]), (mat[k, 2], v[2])), nz(off[k])) for k in range(3)]
         v = [None if isinstance(x, float) and x == 0.0 else x for x in v]
     return v
+
+
+def kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The chain as the compiled kernels (:mod:`jointlock._kernels`) take it: ``E_i`` (n, 3, 3),
+    ``p_i`` (n, 3) [m], the tool point in the last ``z``-joint frame (3,) [m] (the numbers of
+    :func:`position_program`), and (n,) bool: joint ``i`` cannot move the tool point (the
+    joints :func:`ee_position_rows` skips)."""
+    steps, tool_rows = position_program(model)
+    rot = np.ascontiguousarray([mat for mat, _ in steps], dtype=float)
+    pos = np.array([[0.0 if x is None else x for x in off] for _, off in steps], dtype=float)
+    tool = np.array([0.0 if x is None else x for x in tool_rows], dtype=float)
+    skip = np.zeros(len(steps), dtype=bool)
+    zero = [x is None for x in tool_rows]  # which components are exactly zero for every q
+    for i in range(len(steps) - 1, -1, -1):
+        skip[i] = zero[0] and zero[1]
+        if not skip[i]:
+            zero[0] = zero[1] = False
+        mat, off = steps[i]
+        zero = [off[k] is None and all(mat[k, j] == 0.0 or zero[j] for j in range(3)) for k in range(3)]
+    return rot, pos, tool, skip
