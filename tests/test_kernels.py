@@ -9,7 +9,7 @@ import pytest
 from scipy.optimize import minimize_scalar
 
 import jointlock as jl
-from jointlock import _kernels
+from jointlock import _kernels, forward
 from jointlock._chain import ee_position_rows, kernel_program, position_program
 from jointlock.analysis.ability import configuration_indices, kinematic_indices, singular_values
 from jointlock.kinematics import chain_state, ee_positions, generalized_jacobian, jacobian
@@ -80,7 +80,8 @@ def test_sincos_within_an_ulp() -> None:
 
 
 @pytest.mark.parametrize("name", ARMS)
-def test_ee_positions_and_jacobian_match_numpy(name: str) -> None:
+def test_ee_positions_and_jacobian_match_numpy(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setattr(forward, "COMPILED_MIN_BATCH", 1)  # the kernel, whatever the batch
     for base in ("fixed", "floating"):
         for model in _models(name, base):
             q = _singular_set(model, name)[:60] if base == "fixed" else np.random.default_rng(1).uniform(
@@ -104,7 +105,7 @@ def test_singular_values_match_lapack_near_singularities(name: str) -> None:
         jac = jacobian(model, q, state=chain_state(model, q))  # the numpy reference Jacobian
         ref = _lapack(jac)
         _assert_sv(singular_values(jac, method="jacobi"), ref)
-        ind = configuration_indices(model, q, jacobian="fixed", batch_size=97)  # fused kernel
+        ind = configuration_indices(model, q, jacobian="fixed", batch_size=97, method="jacobi")  # fused
         np.testing.assert_allclose(ind.sigma_min, ref[:, -1], rtol=0, atol=SV_TOL * ref[:, 0].max())
         # |dw| <= sum_i |d sigma_i| prod_{j != i} sigma_j
         bound = ref.shape[1] * SV_TOL * ref[:, 0] * np.prod(ref[:, :-1], axis=1)
@@ -114,7 +115,7 @@ def test_singular_values_match_lapack_near_singularities(name: str) -> None:
 def test_characteristic_length_matches_scaled_rows() -> None:
     model = jl.lock(jl.load_robot("halt7"), 4, 0.0)
     q = np.random.default_rng(3).uniform(-np.pi, np.pi, (300, model.dof))
-    fused = configuration_indices(model, q, jacobian="fixed", characteristic_length=2.5)
+    fused = configuration_indices(model, q, jacobian="fixed", characteristic_length=2.5, method="jacobi")
     ref = _lapack(jacobian(model, q, state=chain_state(model, q)) * np.array([[1 / 2.5] * 3 + [1.0] * 3]).T)
     np.testing.assert_allclose(fused.sigma_min, ref[:, -1], rtol=0, atol=SV_TOL * ref[:, 0].max())
 
@@ -125,7 +126,7 @@ def test_generalized_indices_match_lapack(name: str) -> None:
         q = _singular_set(model, name)[:80]
         ref = _lapack(generalized_jacobian(model, q))
         _assert_sv(singular_values(generalized_jacobian(model, q), method="jacobi"), ref)
-        ind = configuration_indices(model, q, jacobian="generalized")
+        ind = configuration_indices(model, q, jacobian="generalized", method="jacobi")
         lapack = kinematic_indices(generalized_jacobian(model, q), method="gram")  # independent route
         np.testing.assert_allclose(ind.sigma_min, ref[:, -1], rtol=0, atol=SV_TOL * ref[:, 0].max())
         np.testing.assert_allclose(ind.condition_number[ref[:, -1] > 1e-3], lapack.condition_number[ref[:, -1] > 1e-3], rtol=1e-7)
@@ -152,3 +153,19 @@ def test_out_of_range_matrices_go_to_lapack() -> None:
     mats = np.random.default_rng(5).standard_normal((4, 6, 6))
     for scale in (1e200, 1e-200):
         np.testing.assert_array_equal(singular_values(mats * scale, method="jacobi"), _lapack(mats * scale))
+
+
+def test_large_batches_take_the_kernels_by_default(monkeypatch: pytest.MonkeyPatch) -> None:
+    model = jl.lock(jl.load_robot("halt7"), 4, 0.0)
+    q = np.random.default_rng(4).uniform(-np.pi, np.pi, (50, model.dof))
+    calls: list[str] = []
+    for name in ("fixed_singular_values", "ee_positions"):
+        kernel = getattr(_kernels, name)
+        monkeypatch.setattr(_kernels, name, lambda *a, k=kernel, n=name: (calls.append(n), k(*a))[1])
+    small = configuration_indices(model, q, jacobian="fixed"), ee_positions(model, q)  # numpy + LAPACK
+    assert calls == []
+    monkeypatch.setattr(forward, "COMPILED_MIN_BATCH", 10)
+    large = configuration_indices(model, q, jacobian="fixed"), ee_positions(model, q)  # kernels
+    assert calls == ["fixed_singular_values", "ee_positions"]
+    np.testing.assert_allclose(large[0].sigma_min, small[0].sigma_min, rtol=0, atol=SV_TOL)  # sigma_max ~ 1
+    np.testing.assert_allclose(large[1], small[1], rtol=0, atol=1e-12)

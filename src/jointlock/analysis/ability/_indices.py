@@ -297,7 +297,7 @@ def configuration_indices(
     *,
     jacobian: JacobianKind = "generalized",
     characteristic_length: float | None = None,
-    method: Literal["jacobi", "svd", "gram"] = "jacobi",
+    method: Literal["jacobi", "svd", "gram"] | None = None,
     batch_size: int = DEFAULT_BATCH,
     progress: Progress | None = None,
 ) -> KinematicIndices:
@@ -317,7 +317,10 @@ def configuration_indices(
     characteristic_length
         See :func:`kinematic_indices`.
     method
-        ``"jacobi"`` (default): compiled; for a fixed-base Jacobian (``jacobian="fixed"`` or a
+        ``None`` (default): ``"jacobi"`` for batches of
+        :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations or more, else ``"svd"``
+        (the same values to round-off; small batches do not pay numba's start-up).
+        ``"jacobi"``: compiled; for a fixed-base Jacobian (``jacobian="fixed"`` or a
         fixed-base model) one kernel (:func:`jointlock._kernels.fixed_singular_values`) builds
         each block's Jacobian and its singular values by one-sided Jacobi, within
         ~1e-15 * sigma_max of LAPACK's; for the generalized Jacobian of a floating model the
@@ -346,6 +349,10 @@ def configuration_indices(
     arr = as_joint_array(model, q)
     batch = arr.shape[:-1]
     flat = np.ascontiguousarray(arr.reshape(-1, model.dof))
+    if method is None:
+        from ...forward import COMPILED_MIN_BATCH
+
+        method = "jacobi" if flat.shape[0] >= COMPILED_MIN_BATCH else "svd"
     fused = method == "jacobi" and (jacobian == "fixed" or not model.floating)
     if fused:  # the compiled kernel builds each block's Jacobian and its singular values at once
         from ... import _kernels
