@@ -112,7 +112,7 @@ base, n = sys.argv[1], int(sys.argv[2])
 model = jl.lock(jl.load_robot("halt7", base=base), 4, 0.0)
 kind = "fixed" if base == "fixed" else "generalized"
 t1 = time.perf_counter()
-configuration_indices(model, np.zeros((100, model.dof)), jacobian=kind)
+configuration_indices(model, np.zeros((100, model.dof)), jacobian=kind, method="jacobi")
 t2 = time.perf_counter()
 if n:
     rss0 = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss

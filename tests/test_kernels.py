@@ -10,7 +10,7 @@ from scipy.optimize import minimize_scalar
 
 import jointlock as jl
 from jointlock import _kernels, forward
-from jointlock._chain import ee_position_rows, kernel_program, position_program
+from jointlock._chain import ee_position_rows, kernel_mass_program, kernel_program, position_program
 from jointlock.analysis.ability import configuration_indices, kinematic_indices, singular_values
 from jointlock.kinematics import chain_state, ee_positions, generalized_jacobian, jacobian
 
@@ -122,11 +122,14 @@ def test_characteristic_length_matches_scaled_rows() -> None:
 
 @pytest.mark.parametrize("name", ARMS)
 def test_generalized_indices_match_lapack(name: str) -> None:
-    for model in _models(name, "floating")[:3]:
-        q = _singular_set(model, name)[:80]
+    for model in _models(name, "floating"):
+        q = np.ascontiguousarray(_singular_set(model, name)[:80])
         ref = _lapack(generalized_jacobian(model, q))
         _assert_sv(singular_values(generalized_jacobian(model, q), method="jacobi"), ref)
-        ind = configuration_indices(model, q, jacobian="generalized", method="jacobi")
+        jac = np.empty((len(q), 6, model.dof))
+        _kernels.generalized_jacobian(q, *kernel_program(model)[:3], *kernel_mass_program(model), jac)
+        np.testing.assert_allclose(jac, generalized_jacobian(model, q), rtol=0, atol=1e-12)
+        ind = configuration_indices(model, q, jacobian="generalized", method="jacobi")  # fused
         lapack = kinematic_indices(generalized_jacobian(model, q), method="gram")  # independent route
         np.testing.assert_allclose(ind.sigma_min, ref[:, -1], rtol=0, atol=SV_TOL * ref[:, 0].max())
         np.testing.assert_allclose(ind.condition_number[ref[:, -1] > 1e-3], lapack.condition_number[ref[:, -1] > 1e-3], rtol=1e-7)

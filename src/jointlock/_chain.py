@@ -334,3 +334,18 @@ def kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray,
         mat, off = steps[i]
         zero = [off[k] is None and all(mat[k, j] == 0.0 or zero[j] for j in range(3)) for k in range(3)]
     return rot, pos, tool, skip
+
+
+def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The masses for :func:`jointlock._kernels.generalized_jacobian`: per link mass (n,),
+    centre of mass (n, 3) [m] and inertia about it (n, 3, 3) [kg m^2] in its ``z``-joint
+    frame, and the spacecraft's mass, centre of mass and inertia (root frame) packed (13,)."""
+    links = link_constants(model, np.zeros(3))
+    root = model.root_body
+    packed = np.concatenate([[root.mass], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])
+    return (
+        np.array([link.mass for link in links], dtype=float),
+        np.ascontiguousarray([link.com for link in links], dtype=float),
+        np.ascontiguousarray([link.inertia for link in links], dtype=float),
+        packed.astype(float),
+    )

@@ -320,12 +320,11 @@ def configuration_indices(
         ``None`` (default): ``"jacobi"`` for batches of
         :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations or more, else ``"svd"``
         (the same values to round-off; small batches do not pay numba's start-up).
-        ``"jacobi"``: compiled; for a fixed-base Jacobian (``jacobian="fixed"`` or a
-        fixed-base model) one kernel (:func:`jointlock._kernels.fixed_singular_values`) builds
-        each block's Jacobian and its singular values by one-sided Jacobi, within
-        ~1e-15 * sigma_max of LAPACK's; for the generalized Jacobian of a floating model the
-        Jacobian comes from numpy (:func:`jointlock.kinematics.generalized_jacobian`) and the
-        singular values from the compiled kernel.  ``"svd"``, ``"gram"``: see
+        ``"jacobi"``: compiled; one kernel builds each block's Jacobian
+        (:func:`jointlock._kernels.fixed_singular_values`, or
+        :func:`jointlock._kernels.generalized_singular_values` for the generalized Jacobian
+        of a floating model) and its singular values by one-sided Jacobi, within
+        ~1e-15 * sigma_max of LAPACK's.  ``"svd"``, ``"gram"``: see
         :func:`kinematic_indices` (``"svd"`` is LAPACK's, the reference of ``"jacobi"``).
     batch_size
         Configurations per batched call (memory/cache only; results do not depend on it).
@@ -353,12 +352,14 @@ def configuration_indices(
         from ...forward import COMPILED_MIN_BATCH
 
         method = "jacobi" if flat.shape[0] >= COMPILED_MIN_BATCH else "svd"
-    fused = method == "jacobi" and (jacobian == "fixed" or not model.floating)
+    fused = method == "jacobi"
     if fused:  # the compiled kernel builds each block's Jacobian and its singular values at once
         from ... import _kernels
-        from ..._chain import kernel_program
+        from ..._chain import kernel_mass_program, kernel_program
 
-        program = kernel_program(model)
+        program = kernel_program(model)[:3]
+        floating = jacobian == "generalized" and model.floating
+        masses = kernel_mass_program(model) if floating else None
         length = 1.0 if characteristic_length is None else float(characteristic_length)
         if not (math.isfinite(length) and length > 0):
             raise ConfigurationError(f"characteristic_length must be a finite length > 0 [m]; got {length}")
@@ -369,8 +370,10 @@ def configuration_indices(
         chunk = flat[start : start + step]
         if fused:
             sv = np.empty((chunk.shape[0], min(6, model.dof)))
-            rot, pos, tool, _ = program
-            _kernels.fixed_singular_values(chunk, rot, pos, tool, length, sv)
+            if masses is None:
+                _kernels.fixed_singular_values(chunk, *program, length, sv)
+            else:
+                _kernels.generalized_singular_values(chunk, *program, *masses, length, sv)
             part = _from_singular_values(sv)
         else:
             jac = (generalized_jacobian if jacobian == "generalized" else fixed_jacobian)(model, chunk)
