@@ -31,7 +31,7 @@ import numpy as np
 import jointlock as jl
 from jointlock.kinematics import ee_positions
 arm = jl.load_robot("puma6")
-ee_positions(arm, np.zeros((10, 6)))
+ee_positions(arm, np.zeros((200_000, 6)))  # loads numba and the cached kernel
 tracemalloc.start()
 q = np.random.default_rng(0).uniform(-np.pi, np.pi, (int(sys.argv[1]), 6))
 t0 = time.perf_counter()
