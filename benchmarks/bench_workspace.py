@@ -12,6 +12,8 @@ Prints end-effector positions per second of :func:`jointlock.kinematics.ee_posit
 from __future__ import annotations
 
 import argparse
+import os
+import subprocess
 import sys
 from pathlib import Path
 
@@ -23,11 +25,40 @@ from jointlock.analysis.workspace import sample_configurations
 from jointlock.ik import ik_closed_form
 from jointlock.kinematics import ee_positions
 
+_MEM_CHILD = """
+import resource, sys, time, tracemalloc
+import numpy as np
+import jointlock as jl
+from jointlock.kinematics import ee_positions
+arm = jl.load_robot("puma6")
+ee_positions(arm, np.zeros((200_000, 6)))  # loads numba and the cached kernel
+tracemalloc.start()
+q = np.random.default_rng(0).uniform(-np.pi, np.pi, (int(sys.argv[1]), 6))
+t0 = time.perf_counter()
+ee_positions(arm, q)
+t = time.perf_counter() - t0
+print(t, tracemalloc.get_traced_memory()[1] / 2**20, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+"""
+
+
+def numpy_ee_positions(model: jl.ArmModel, q: np.ndarray, chunk: int = 65536) -> np.ndarray:
+    """The numpy reference of the kernel (the rows of :func:`jointlock._chain.ee_position_rows`)."""
+    from jointlock._chain import ee_position_rows, position_program
+
+    program = position_program(model)
+    out = np.empty((q.shape[0], 3))
+    for s0 in range(0, q.shape[0], chunk):
+        part = q[s0 : s0 + chunk]
+        for k, row in enumerate(ee_position_rows(program, part)):
+            out[s0 : s0 + part.shape[0], k] = 0.0 if row is None else row
+    return out
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--samples", type=int, default=1_000_000)
     parser.add_argument("--pin-subset", type=int, default=100_000)
+    parser.add_argument("--mem-samples", type=int, default=10_000_000, help="configurations of the memory run (0: skip)")
     args = parser.parse_args()
 
     print(machine_info())
@@ -37,13 +68,16 @@ def main() -> None:
     q = sample_configurations(arm, args.samples, rng=0)
     ql = sample_configurations(locked, args.samples, rng=1)
 
+    ee_positions(arm, q[:10])  # compile (or load) the kernel outside the timing
     t_fast = best_of(lambda: ee_positions(arm, q))
+    t_numpy = best_of(lambda: numpy_ee_positions(arm, q))
     t_fast_l = best_of(lambda: ee_positions(locked, ql))
     sub = q[: min(args.samples, 200_000)]
     t_chain = best_of(lambda: jl.chain_state(arm, sub), 1) * (args.samples / sub.shape[0])
     rate = args.samples / t_fast
     print(f"\nworkspace sampling, {args.samples:.0e} configurations:")
-    print(f"  ee_positions (full arm)      : {rate:12,.0f} points/s  ({t_fast:.3f} s)")
+    print(f"  ee_positions (full arm)      : {rate:12,.0f} points/s  ({t_fast:.3f} s, compiled kernel)")
+    print(f"  numpy reference (rows)       : {args.samples / t_numpy:12,.0f} points/s  (compiled / numpy {t_numpy / t_fast:.1f}x)")
     print(f"  ee_positions (joint 2 locked): {args.samples / t_fast_l:12,.0f} points/s")
     print(f"  chain_state (all frames)     : {args.samples / t_chain:12,.0f} points/s")
 
@@ -69,7 +103,14 @@ def main() -> None:
         assert np.abs(out - ee_positions(arm, q[:n])).max() < 1e-12
         pin_rate = n / t_pin
         print(f"  pinocchio FK loop ({n:.0e})   : {pin_rate:12,.0f} points/s")
-        print(f"  ratio ee_positions / pinocchio: {rate / pin_rate:.2f}x (target >= 3x)")
+        print(f"  ratio ee_positions / pinocchio: {rate / pin_rate:.2f}x (issue 13 target >= 20x)")
+    if args.mem_samples:
+        out = subprocess.run([sys.executable, "-c", _MEM_CHILD, str(args.mem_samples)], capture_output=True,
+                             text=True, check=True, env=dict(os.environ))
+        t, heap, rss = (float(x) for x in out.stdout.split())
+        print(f"  {args.mem_samples:.0e} configurations, fresh process: {t:.2f} s ({args.mem_samples / t:,.0f} points/s); "
+              f"peak arrays {heap:,.0f} MB (tracemalloc; q {args.mem_samples * 6 * 8 / 2**20:,.0f} MB and the "
+              f"result {args.mem_samples * 3 * 8 / 2**20:,.0f} MB included), peak RSS {rss:,.0f} MB")
 
     print("\nclosed-form IK (every branch), puma6:")
     for batch in (1, 100, 10_000, 100_000):

@@ -184,7 +184,7 @@ LOW_MODULES = {
     "_rows": set(),
     "spatial": set(),
     "_chain": {"_rows", "model"},
-    "forward": {"_chain", "errors", "model", "spatial"},
+    "forward": {"_chain", "errors", "model", "spatial", "_kernels"},
     "kinematics": {"_chain", "bounds", "errors", "forward", "model"},
 }
 

@@ -314,3 +314,38 @@ def ee_position_rows(program: tuple[list[tuple[FloatArray, list]], list], q: Flo
         v = [lc(((mat[k, 0], v[0]), (mat[k, 1], v[1]), (mat[k, 2], v[2])), nz(off[k])) for k in range(3)]
         v = [None if isinstance(x, float) and x == 0.0 else x for x in v]
     return v
+
+
+def kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The chain as the compiled kernels (:mod:`jointlock._kernels`) take it: ``E_i`` (n, 3, 3),
+    ``p_i`` (n, 3) [m], the tool point in the last ``z``-joint frame (3,) [m] (the numbers of
+    :func:`position_program`), and (n,) bool: joint ``i`` cannot move the tool point (the
+    joints :func:`ee_position_rows` skips)."""
+    steps, tool_rows = position_program(model)
+    rot = np.ascontiguousarray([mat for mat, _ in steps], dtype=float)
+    pos = np.array([[0.0 if x is None else x for x in off] for _, off in steps], dtype=float)
+    tool = np.array([0.0 if x is None else x for x in tool_rows], dtype=float)
+    skip = np.zeros(len(steps), dtype=bool)
+    zero = [x is None for x in tool_rows]  # which components are exactly zero for every q
+    for i in range(len(steps) - 1, -1, -1):
+        skip[i] = zero[0] and zero[1]
+        if not skip[i]:
+            zero[0] = zero[1] = False
+        mat, off = steps[i]
+        zero = [off[k] is None and all(mat[k, j] == 0.0 or zero[j] for j in range(3)) for k in range(3)]
+    return rot, pos, tool, skip
+
+
+def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """The masses for :func:`jointlock._kernels.generalized_jacobian`: per link mass (n,),
+    centre of mass (n, 3) [m] and inertia about it (n, 3, 3) [kg m^2] in its ``z``-joint
+    frame, and the spacecraft's mass, centre of mass and inertia (root frame) packed (13,)."""
+    links = link_constants(model, np.zeros(3))
+    root = model.root_body
+    packed = np.concatenate([[root.mass], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])
+    return (
+        np.array([link.mass for link in links], dtype=float),
+        np.ascontiguousarray([link.com for link in links], dtype=float),
+        np.ascontiguousarray([link.inertia for link in links], dtype=float),
+        packed.astype(float),
+    )

@@ -18,13 +18,18 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._chain import ee_position_rows, position_program
+from ._chain import ee_position_rows, kernel_program, position_program
 from .errors import ConfigurationError
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import pose, skew
 
 #: Default samples per vectorised pass of :func:`ee_positions` (keeps the working set in cache).
 DEFAULT_CHUNK = 65536
+#: Batches from this many configurations on go to the compiled kernels (:mod:`jointlock._kernels`)
+#: by default; smaller ones stay on numpy.  Importing numba and loading the cached kernels
+#: costs a process about 1-2 s (LLVM start-up), which the kernels win back only on large
+#: batches (HCOM's K = 36,000 saves ~0.1 s); the first compilation on a machine ~15 s.
+COMPILED_MIN_BATCH = 200_000
 
 
 @dataclass(frozen=True)
@@ -233,12 +238,15 @@ def state_at(model: ArmModel, q: ArrayLike | None, state: ChainState | None = No
 
 
 def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -> FloatArray:
-    """End-effector positions only, fast (several times faster than :func:`chain_state`).
+    """End-effector positions only, fast (compiled; several times faster than
+    :func:`chain_state`).
 
-    The chain is run from the tool back to the root on the three coordinate rows, constant
-    entries of the placements (the zeros and ones of DH tables) folded once per model, and
-    a joint that cannot move the tool point (e.g. the last joint of a spherical wrist) is
-    skipped.
+    The chain is run from the tool back to the root, by the compiled kernel
+    :func:`jointlock._kernels.ee_positions` for batches of :data:`COMPILED_MIN_BATCH`
+    configurations or more (SIMD across configurations, branch-free sine and cosine within
+    1 ulp of libm's), else by its numpy reference :func:`jointlock._chain.ee_position_rows`
+    (constant entries of the placements folded once per model); a joint that cannot move
+    the tool point (e.g. the last joint of a spherical wrist) is skipped.
 
     Parameters
     ----------
@@ -247,7 +255,7 @@ def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -
     q
         (..., n) joint angles [rad].
     chunk
-        Samples per vectorised pass (>= 1).
+        Samples per pass (>= 1); only the (N, 3) result grows with the batch.
 
     Returns
     -------
@@ -257,13 +265,20 @@ def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -
     q = as_joint_array(model, q)
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ConfigurationError(f"chunk must be an integer >= 1; got {chunk!r}")
-    flat = q.reshape(-1, model.dof)
-    program = position_program(model)
+    flat = np.ascontiguousarray(q.reshape(-1, model.dof))
     out = np.empty((flat.shape[0], 3))
-    for s0 in range(0, flat.shape[0], int(chunk)):  # chunks of samples, each fully vectorised
-        part = flat[s0 : s0 + chunk]
-        for k, row in enumerate(ee_position_rows(program, part)):
-            out[s0 : s0 + part.shape[0], k] = 0.0 if row is None else row
+    if flat.shape[0] >= COMPILED_MIN_BATCH:
+        from . import _kernels  # numba is imported on first use, not with the package
+
+        rot, pos, tool, skip = kernel_program(model)
+        for s0 in range(0, flat.shape[0], int(chunk)):
+            _kernels.ee_positions(flat[s0 : s0 + chunk], rot, pos, tool, skip, out[s0 : s0 + chunk])
+    else:  # the numpy reference of the kernel, row by row
+        program = position_program(model)
+        for s0 in range(0, flat.shape[0], int(chunk)):
+            part = flat[s0 : s0 + chunk]
+            for k, row in enumerate(ee_position_rows(program, part)):
+                out[s0 : s0 + part.shape[0], k] = 0.0 if row is None else row
     return out.reshape(q.shape[:-1] + (3,))
 
 

@@ -23,6 +23,7 @@ from ...analysis.ability import (
     fit_ability_model,
 )
 from ...errors import ConfigurationError, InfeasibleError
+from ...forward import COMPILED_MIN_BATCH
 from ...model import ArmModel, FloatArray, as_joint_array
 from ...progress import Progress
 from ._bound import ReachabilityBound, _readonly
@@ -161,7 +162,8 @@ def optimal_halt_configuration(
     ind = configuration_indices(
         model_locked,
         q,
-        method="gram",
+        # compiled one-sided Jacobi (as exact as LAPACK) where the batch pays numba's start-up
+        method="jacobi" if k >= COMPILED_MIN_BATCH else "gram",
         batch_size=batch_size,
         progress=progress,
         jacobian=jacobian,

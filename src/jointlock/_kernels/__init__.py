@@ -1,0 +1,65 @@
+"""Compiled batch kernels (numba): chain forward kinematics, the fixed-base geometric Jacobian,
+the free-floating generalized Jacobian, singular values by one-sided Jacobi (alone, or fused
+with either Jacobian), and end-effector positions.
+
+The numpy implementations (:mod:`jointlock.forward`, :mod:`jointlock.kinematics`,
+``np.linalg.svd``) are the reference these kernels are tested against
+(``tests/test_kernels.py``); the public functions call the kernels.
+
+Layout.  Configurations are processed in blocks of :data:`BLOCK` with the block as the
+innermost (contiguous) axis of every work array ("structure of arrays"), so that each step
+is a plain loop over the block that LLVM turns into SIMD code.  Nothing here calls LAPACK
+or allocates per configuration.
+
+Chain convention (the one of :func:`jointlock._chain.link_constants` and
+:func:`jointlock._chain.position_program`): every link in its ``z``-joint frame; link ``i``
+has the constant turn ``E_i`` (3, 3) and offset ``p_i`` (3,) from its parent, then turns by
+``Rot(z, q_i)``; the tool point ``t`` (3,) is given in the last link's frame.  Locked
+joints are already folded into the constants.
+
+Generalized Jacobian.  From the composite masses of the links outboard of each joint and the
+system's inertia about its centre of mass (a 3 x 3 solve per configuration instead of the
+6 x 6 one of :func:`jointlock.kinematics.base_jacobian`): see
+:func:`jointlock._kernels._arm._generalized_block`.
+
+Numba is imported with this package, and only the public functions that take these
+kernels import it (lazily), from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations
+on: loading numba and the cached kernels costs a process 1-2 s, the first compilation on a
+machine ~15-25 s (cached afterwards, ``cache=True``).
+
+Sines and cosines.  libm's scalar ``sin``/``cos`` cost ~25 ns each and block SIMD, so
+:func:`_sincos` evaluates them branch-free: Cody-Waite reduction by ``pi/2`` in three parts
+(musl's ``__rem_pio2`` constants; exact for ``|q| <`` :data:`TRIG_LIMIT`) and musl's
+``__sin``/``__cos`` minimax polynomials on ``[-pi/4, pi/4]`` (error below 1 ulp).  Angles
+beyond :data:`TRIG_LIMIT` (never joint angles in practice) take ``math.sin``/``math.cos``.
+
+Singular values.  :func:`_jacobi_block` is the one-sided (Hestenes) Jacobi method:
+columns of ``A`` are rotated pairwise, cyclically, until every pair is orthogonal to
+``m * eps`` relative (the stopping rule of LAPACK's ``dgesvj``); the singular values are
+then the column norms.  It computes every singular value to high relative accuracy
+(Demmel & Veselic, "Jacobi's method is more accurate than QR", SIAM J. Matrix Anal. Appl.
+13 (1992) 1204-1245), so in particular to ``~1e-15 * sigma_max`` absolute, as LAPACK's SVD.
+"""
+
+from ._arm import (
+    ee_positions,
+    fixed_singular_values,
+    generalized_jacobian,
+    generalized_singular_values,
+    jacobian,
+)
+from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
+from ._svd import singular_values
+
+__all__ = [
+    "BLOCK",
+    "MAX_SWEEPS",
+    "TRIG_LIMIT",
+    "ee_positions",
+    "fixed_singular_values",
+    "generalized_jacobian",
+    "generalized_singular_values",
+    "jacobian",
+    "sincos",
+    "singular_values",
+]
