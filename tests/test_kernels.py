@@ -81,7 +81,7 @@ def test_sincos_within_an_ulp() -> None:
 
 @pytest.mark.parametrize("name", ARMS)
 def test_ee_positions_and_jacobian_match_numpy(name: str, monkeypatch: pytest.MonkeyPatch) -> None:
-    monkeypatch.setattr(forward, "COMPILED_MIN_BATCH", 1)  # the kernel, whatever the batch
+    monkeypatch.setattr(forward, "COMPILED_MIN_POSITIONS", 1)  # the kernel, whatever the batch
     for base in ("fixed", "floating"):
         for model in _models(name, base):
             q = _singular_set(model, name)[:60] if base == "fixed" else np.random.default_rng(1).uniform(
@@ -168,7 +168,12 @@ def test_large_batches_take_the_kernels_by_default(monkeypatch: pytest.MonkeyPat
     small = configuration_indices(model, q, jacobian="fixed"), ee_positions(model, q)  # numpy + LAPACK
     assert calls == []
     monkeypatch.setattr(forward, "COMPILED_MIN_BATCH", 10)
+    monkeypatch.setattr(forward, "COMPILED_MIN_POSITIONS", 10)
     large = configuration_indices(model, q, jacobian="fixed"), ee_positions(model, q)  # kernels
     assert calls == ["fixed_singular_values", "ee_positions"]
+    ee_positions(model, q, compiled=False)
+    assert len(calls) == 2
+    ee_positions(model, q[:3], compiled=True)
+    assert calls[-1] == "ee_positions"
     np.testing.assert_allclose(large[0].sigma_min, small[0].sigma_min, rtol=0, atol=SV_TOL)  # sigma_max ~ 1
     np.testing.assert_allclose(large[1], small[1], rtol=0, atol=1e-12)

@@ -30,6 +30,10 @@ DEFAULT_CHUNK = 65536
 #: costs a process about 1-2 s (LLVM start-up), which the kernels win back only on large
 #: batches (HCOM's K = 36,000 saves ~0.1 s); the first compilation on a machine ~15 s.
 COMPILED_MIN_BATCH = 200_000
+#: ... and from this many for :func:`ee_positions`, whose numpy path is already ~0.4 us per
+#: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (1-2 s) only
+#: on millions of points (a 200,000-sample workspace stays on numpy).
+COMPILED_MIN_POSITIONS = 4_000_000
 
 
 @dataclass(frozen=True)
@@ -237,12 +241,14 @@ def state_at(model: ArmModel, q: ArrayLike | None, state: ChainState | None = No
     return state
 
 
-def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -> FloatArray:
+def ee_positions(
+    model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK, compiled: bool | None = None
+) -> FloatArray:
     """End-effector positions only, fast (compiled; several times faster than
     :func:`chain_state`).
 
     The chain is run from the tool back to the root, by the compiled kernel
-    :func:`jointlock._kernels.ee_positions` for batches of :data:`COMPILED_MIN_BATCH`
+    :func:`jointlock._kernels.ee_positions` for batches of :data:`COMPILED_MIN_POSITIONS`
     configurations or more (SIMD across configurations, branch-free sine and cosine within
     1 ulp of libm's), else by its numpy reference :func:`jointlock._chain.ee_position_rows`
     (constant entries of the placements folded once per model); a joint that cannot move
@@ -256,6 +262,9 @@ def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -
         (..., n) joint angles [rad].
     chunk
         Samples per pass (>= 1); only the (N, 3) result grows with the batch.
+    compiled
+        True: the compiled kernel at any size; False: the numpy reference; None (default):
+        the kernel from :data:`COMPILED_MIN_POSITIONS` configurations on.
 
     Returns
     -------
@@ -267,7 +276,9 @@ def ee_positions(model: ArmModel, q: ArrayLike, *, chunk: int = DEFAULT_CHUNK) -
         raise ConfigurationError(f"chunk must be an integer >= 1; got {chunk!r}")
     flat = np.ascontiguousarray(q.reshape(-1, model.dof))
     out = np.empty((flat.shape[0], 3))
-    if flat.shape[0] >= COMPILED_MIN_BATCH:
+    if compiled is None:
+        compiled = flat.shape[0] >= COMPILED_MIN_POSITIONS
+    if compiled:
         from . import _kernels  # numba is imported on first use, not with the package
 
         rot, pos, tool, skip = kernel_program(model)
