@@ -438,7 +438,7 @@ def _help(command: str) -> str:
         ("tolerance-angle", ["--q-target-deg DEG", "every joint of the arm [deg]", "puma6-family arms only"]),
         ("replan", ["start configuration, every joint of the arm [deg]", "goal configuration"]),
         ("replan", ["puma6-family arms only", ">= 1"]),
-        ("ik", ["closed-form: 002's analytic IK", "numeric: Levenberg", "auto (default)"]),
+        ("ik", ["closed-form: analytic IK", "spherical-wrist", "numeric: Levenberg", "auto (default)"]),
         ("workspace", ["voxel occupancy", "from half the samples", ">= 1000"]),
         ("jump", ["--kappa K", "rad^2/(s m^3)", "deg/s", "q0_deg"]),
     ],
