@@ -5,14 +5,14 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
 from ...errors import InfeasibleError
 from ...model import ArmModel, FloatArray
-from ._engine import _healthy_runs, _kappa_rows, _post_runs, _problem, _RunOut, _unsort
+from ._engine import _branched_runs, _kappa_rows, _problem
 from ._fit import KappaFit, fit_kappa
 from ._search import KappaSearch, search_kappa
 from ._simulate import LimitReport, _limit_report, _table, jump_reduction, uncompensated_violations
@@ -105,10 +105,8 @@ def jump_at_time(
                 f"with joint {sc.lock_joint} locking at {k * sc.dt:g} s; {_why_no_kappa(model, sc)}"
             )
     krows = _kappa_rows(prob, np.array([0.0, float(kappa)]))
-    healthy = _healthy_runs(prob, krows)
+    healthy, post = _branched_runs(prob, krows, np.array([0, 1]), np.array([k, k]))
     table = _table(prob, krows, healthy)
-    post, order = _post_runs(prob, krows, healthy, np.array([0, 1]), np.array([k, k]))
-    post = _RunOut(*(_unsort(getattr(post, f.name), order) for f in fields(_RunOut)[:5]))
     reps = []
     for r in range(2):
         sel = np.zeros(2, dtype=bool)
@@ -202,7 +200,7 @@ def study_jump(
         return progress_factory(total, desc) if progress_factory is not None else None
 
     t0 = time.perf_counter()
-    p = bar(2 * N, "kappa search")
+    p = bar(N, "kappa search")  # one update per control step of the grid pass
     search = search_kappa(model, sc, n_samples=n_samples, progress=p, **dict(search_options or {}))
     if p is not None:
         p.close()
@@ -214,7 +212,7 @@ def study_jump(
     if fit.search is not None:  # failure times added around the breaks of kappa(t)
         search = fit.search
     t2 = time.perf_counter()
-    p = bar(2 * N, "verification")
+    p = bar(N, "verification")
     ver = verify_kappa(model, sc, fit, search=search, progress=p)
     if p is not None:
         p.close()

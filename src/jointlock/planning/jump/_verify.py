@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from ...errors import InfeasibleError, ScenarioError
 from ...model import ArmModel, FloatArray
-from ._engine import LIMIT_RTOL, _healthy_runs, _ok, _post_runs, _Problem, _problem, _RunOut, _unsort
+from ._engine import LIMIT_RTOL, _branched_runs, _ok, _Problem, _problem, _RunOut
 from ._fit import KappaFit
 from ._search import KappaSearch
 from ._simulate import LimitReport, _limit_report, _table, jump_reduction
@@ -194,11 +194,10 @@ def verify_kappa(
         if "ramp" in fix:
             kap = ramp_schedule(kap, scenario.amax * scenario.dt / (2.0 * search.null_max))
     krows = np.stack([np.zeros(prob.N), kap])
-    healthy = _healthy_runs(prob, krows, progress=progress)
-    table = _table(prob, krows, healthy)
     steps = np.arange(prob.N)
-    post, order = _post_runs(prob, krows, healthy, np.ones(prob.N, dtype=int), steps, progress=progress)
-    post_ok = _unsort(_ok(prob, post), order)
+    healthy, post = _branched_runs(prob, krows, np.ones(prob.N, dtype=int), steps, progress)
+    table = _table(prob, krows, healthy)
+    post_ok = _ok(prob, post)
     prefix_ok = _step_limits(prob, healthy)[1]
     ok_steps = post_ok & prefix_ok
     h_ok = bool(table.healthy_limits_ok[1])
