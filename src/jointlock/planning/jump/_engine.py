@@ -15,7 +15,7 @@ from ...errors import InfeasibleError, ModelError, ScenarioError, SingularityWar
 from ...kinematics import base_jacobian, chain_state, generalized_jacobian, system_com
 from ...model import ArmModel, FloatArray
 from ...spatial import axis_angle_rotation
-from ._control import cross_first, law
+from ._frames import _FixedChain, _Frame
 from ._path import cartesian_trapezoid
 from ._task import JumpScenario
 
@@ -41,18 +41,16 @@ class _Problem:
     q0: FloatArray
     com0: FloatArray  # floating: system centre of mass at t=0 (inertial origin offset)
     lock_col: int
+    chain: _FixedChain | None  # fixed base: its forward kinematics, constants folded
 
     def frame(self, q: FloatArray, rb: FloatArray | None) -> _Frame:
         """Task-space quantities of B runs at joint angles ``q`` (B, n) [rad] and base attitudes
         ``rb`` (B, 3, 3) (floating base only), batch last for :func:`law`."""
+        if self.chain is not None:  # fixed base
+            return self.chain.frame(q)
+        assert rb is not None  # a floating base always carries its attitude
         model = self.model
         state = chain_state(model, q)
-        if not self.floating:
-            axes = state.soa_axes.transpose(1, 0, 2)  # (3, n, B)
-            x = state.soa_ee_position  # (3, B)
-            jac = cross_first(axes, x[:, None, :] - state.soa_positions.transpose(1, 0, 2))
-            return _Frame(x, jac, axes=axes)
-        assert rb is not None  # a floating base always carries its attitude
         jg = generalized_jacobian(model, q, state=state)[..., :3, :]
         djg = generalized_jacobian_derivatives(model, q)[..., :3, :]
         jb = base_jacobian(model, q, state)[..., 3:, :]
@@ -72,34 +70,6 @@ class _Problem:
         assert rb is not None  # a floating base always carries its attitude
         rel = state.ee_position - system_com(self.model, q, state)
         return self.com0 + np.einsum("...ij,...j->...i", rb, rel)
-
-
-@dataclass
-class _Frame:
-    """What the law needs at one control step, for B runs, batch last (see :func:`law`)."""
-
-    x: FloatArray  # (3, B) end-effector position [m]
-    jac: FloatArray  # (3, n, B) position Jacobian [m/rad]
-    axes: FloatArray | None = None  # (3, n, B) joint axes: fixed base, closed-form gradient
-    djac: FloatArray | None = None  # (n, 3, n, B) Jacobian derivatives: floating base
-    base_jac: FloatArray | None = None  # (B, 3, n) base angular-velocity Jacobian (floating)
-
-    def rates(
-        self, healthy: np.ndarray, xdot: FloatArray, kappa: FloatArray, rows: int | None = None
-    ) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """:func:`law` for the first ``rows`` runs (all when None): ``qdot`` (n, R) [rad/s],
-        ``w`` (R,) [m^3], null-space term (n, R)."""
-        if rows is None:
-            return law(self.jac, healthy, xdot, kappa, axes=self.axes, djac=self.djac)
-        r = slice(0, rows)
-        return law(
-            self.jac[..., r],
-            healthy[:, r],
-            xdot[:, r],
-            kappa[r],
-            axes=None if self.axes is None else self.axes[..., r],
-            djac=None if self.djac is None else self.djac[..., r],
-        )
 
 
 def _problem(model: ArmModel, scenario: JumpScenario) -> _Problem:
@@ -137,7 +107,18 @@ def _problem(model: ArmModel, scenario: JumpScenario) -> _Problem:
     else:
         xd_ff = path.xd[:-1]
     return _Problem(
-        model, scenario, floating, model.dof, scenario.n_steps, t, path.x, xd_ff, q0, com0, lock_col
+        model,
+        scenario,
+        floating,
+        model.dof,
+        scenario.n_steps,
+        t,
+        path.x,
+        xd_ff,
+        q0,
+        com0,
+        lock_col,
+        None if floating else _FixedChain.of(model),
     )
 
 
@@ -283,7 +264,11 @@ def _integrate(
         frame = prob.frame(q[sl], None if rb is None else rb[sl])
         err = prob.x_nom[k][:, None] - frame.x  # (3, m)
         xdc = prob.xd_nom[k][:, None] + sc.kp * err
-        qd_t, w, null = frame.rates(healthy, xdc, kappa[sl, k])
+        plus = None
+        if R and jump_col is not None:
+            plus = healthy[:, :R].copy()
+            plus[jump_col] = False
+        qd_t, w, null, qd_plus = frame.rates(healthy, xdc, kappa[sl, k], plus)
         qd = qd_t.T  # (m, n)
         dev = np.sqrt(np.einsum("rb,rb->b", err, err))
         np.maximum(out.max_dev[sl], dev, out=out.max_dev[sl])
@@ -296,7 +281,7 @@ def _integrate(
         check[new] = sc.rest_transitions and k == 0  # a run's first step starts from its parent's rates
         out.max_acc[sl] = np.where(check, np.maximum(out.max_acc[sl], acc), out.max_acc[sl])
         if R:
-            _record_step(out, frame, k, R, qd, dev, healthy, xdc, kappa[:R, k], jump_col)
+            _record_step(out, frame, k, R, qd, dev, qd_plus, jump_col)
         if m and np.abs(qd).max() > diverged_rate:
             _stop_diverged(qd, kappa[sl, k], k * dt, diverged_rate)
         qd_prev[sl] = qd
@@ -342,26 +327,22 @@ def _record_step(
     R: int,
     qd: FloatArray,
     dev: FloatArray,
-    healthy: np.ndarray,
-    xdc: FloatArray,
-    kappa: FloatArray,
+    qd_plus: FloatArray | None,
     jump_col: int | None,
 ) -> None:
-    """Store step ``k`` of the first ``R`` runs (and, with ``jump_col``, the law with that
-    column locked too, at the same state)."""
+    """Store step ``k`` of the first ``R`` runs: rates ``qd`` (B, n) [rad/s], deviation ``dev``
+    (B,) [m] and, with ``jump_col``, the rates ``qd_plus`` (n, R) with that joint locked too."""
     assert out.qd is not None and out.dev is not None and out.x is not None
     out.qd[:, k] = qd[:R]
     out.dev[:, k] = dev[:R]
     out.x[:, k] = frame.x[:, :R].T
     if jump_col is None:
         return
-    healthy2 = healthy[:, :R].copy()
-    healthy2[jump_col] = False
-    qd2 = frame.rates(healthy2, xdc, kappa, rows=R)[0].T  # (R, n)
+    assert qd_plus is not None
     assert out.qd_plus is not None and out.task_plus is not None and out.task_noreplan is not None
     jac = frame.jac[..., :R]
-    out.qd_plus[:, k] = qd2
-    out.task_plus[:, k] = np.einsum("rcb,bc->br", jac, qd2 - qd[:R])
+    out.qd_plus[:, k] = qd_plus.T
+    out.task_plus[:, k] = np.einsum("rcb,cb->br", jac, qd_plus - qd[:R].T)
     out.task_noreplan[:, k] = -(jac[:, jump_col] * qd[:R, jump_col]).T
 
 

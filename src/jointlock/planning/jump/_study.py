@@ -17,7 +17,7 @@ from ._fit import KappaFit, fit_kappa
 from ._search import KappaSearch, search_kappa
 from ._simulate import LimitReport, _limit_report, _table, jump_reduction, uncompensated_violations
 from ._task import JumpScenario
-from ._verify import Verification, verify_kappa
+from ._verify import Verification, _verify_fixes
 
 log = logging.getLogger(__package__)
 
@@ -213,15 +213,13 @@ def study_jump(
         search = fit.search
     t2 = time.perf_counter()
     p = bar(N, "verification")
-    ver = verify_kappa(model, sc, fit, search=search, progress=p)
+    # the fixed schedule does not depend on the first verification: both in one pass ("auto"
+    # drops the fixed one when the fit keeps every limit)
+    fixes: tuple[Any, ...] = (None,) if fix is None else (None, "clip+ramp" if fix == "auto" else fix)
+    ver, *more = _verify_fixes(model, sc, fit, search=search, fixes=fixes, progress=p)
     if p is not None:
         p.close()
-    ver_c = None
-    if fix == "auto":
-        if not ver.limits_ok:
-            ver_c = verify_kappa(model, sc, fit, search=search, fix="clip+ramp")
-    elif fix is not None:
-        ver_c = verify_kappa(model, sc, fit, search=search, fix=fix)
+    ver_c = more[0] if more and not (fix == "auto" and ver.limits_ok) else None
     t3 = time.perf_counter()
     log.info("jump study: search %.2fs fit %.2fs verify %.2fs", t1 - t0, t2 - t1, t3 - t2)
     return JumpStudy(search, fit, ver, ver_c, {"search": t1 - t0, "fit": t2 - t1, "verify": t3 - t2}, sc)
