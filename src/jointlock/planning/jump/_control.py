@@ -9,6 +9,8 @@ so a step of one run and a step of a thousand runs cost nearly the same number o
 
 from __future__ import annotations
 
+from typing import cast
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -20,34 +22,32 @@ from ...model import FloatArray
 SINGULAR_GRAM_RTOL = 1e-13
 
 
+#: Cyclic component indices: ``(a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}``.
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
+#: Flat indices (into a 3 x 3 matrix's 9 entries) of the two products of each cofactor:
+#: ``adj[r, c] = g[NEXT c, NEXT r] g[AFTER c, AFTER r] - g[NEXT c, AFTER r] g[AFTER c, NEXT r]``.
+_COF = tuple(
+    np.array([3 * i[c] + j[r] for r in range(3) for c in range(3)])
+    for i, j in ((_NEXT, _NEXT), (_AFTER, _AFTER), (_NEXT, _AFTER), (_AFTER, _NEXT))
+)
+
+
 def cross_first(a: FloatArray, b: FloatArray) -> FloatArray:
     """Cross product over the *first* axis: (3, ...) x (3, ...) -> (3, ...) (broadcast)."""
-    shape = np.broadcast_shapes(a.shape, b.shape)
-    out = np.empty(shape)
-    np.subtract(a[1] * b[2], a[2] * b[1], out=out[0])
-    np.subtract(a[2] * b[0], a[0] * b[2], out=out[1])
-    np.subtract(a[0] * b[1], a[1] * b[0], out=out[2])
-    return out
+    return cast(FloatArray, a[_NEXT] * b[_AFTER] - a[_AFTER] * b[_NEXT])
 
 
 def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatArray]:
     """``(J J^T)^-1 J`` (3, n, B) for well-conditioned Gram matrices by the adjugate of the
-    symmetric 3 x 3 ``gram`` (3, 3, B), with an SVD fallback for the (near-)singular ones;
-    returns it with ``det(J J^T)`` (B,)."""
-    g00, g01, g02 = gram[0, 0], gram[0, 1], gram[0, 2]
-    g11, g12, g22 = gram[1, 1], gram[1, 2], gram[2, 2]
-    c00 = g11 * g22 - g12 * g12
-    c01 = g02 * g12 - g01 * g22
-    c02 = g01 * g12 - g02 * g11
-    c11 = g00 * g22 - g02 * g02
-    c12 = g01 * g02 - g00 * g12
-    c22 = g00 * g11 - g01 * g01
-    det = g00 * c00 + g01 * c01 + g02 * c02
-    trace3 = (g00 + g11 + g22) / 3.0
-    singular = ~(det > SINGULAR_GRAM_RTOL * trace3 * trace3 * trace3)
+    ``gram`` (3, 3, B), with an SVD fallback for the (near-)singular ones; returns it with
+    ``det(J J^T)`` (B,)."""
+    g = gram.reshape(9, -1)
+    adj = g[_COF[0]] * g[_COF[1]] - g[_COF[2]] * g[_COF[3]]  # (9, B), row-major adj[r, c]
+    det = np.einsum("cb,cb->b", g[:3], adj[::3])  # along the first row of g
+    trace3 = g[::4].sum(axis=0) / 3.0
+    singular = ~(det > SINGULAR_GRAM_RTOL * trace3**3)
     inv_det = 1.0 / np.where(singular, 1.0, det)
-    adj = np.array([[c00, c01, c02], [c01, c11, c12], [c02, c12, c22]])  # (3, 3, B), symmetric
-    m = np.einsum("rsb,skb->rkb", adj, jac_h) * inv_det
+    m = np.einsum("rsb,skb->rkb", adj.reshape(gram.shape), jac_h) * inv_det
     if singular.any():
         # pinv(J^T) = (J^+)^T = (J J^T)^-1 J wherever the latter exists (rank 3)
         jt = np.moveaxis(jac_h[..., singular], -1, 0).swapaxes(-1, -2)  # (S, n, 3)

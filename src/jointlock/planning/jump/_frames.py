@@ -65,46 +65,46 @@ class _FixedChain:
     Joint ``i`` is described in its z-joint frame (turned by ``Q_i``, ``Q_i e_z`` = its axis):
     with ``R'_i = R_i Q_i``, ``R'_i = R'_{i-1} M_i Rz(q_i)`` where ``M_i = Q_{i-1}^T P_i Q_i``
     (``P_i`` the placement's rotation), the axis is ``R'_i e_z`` and the joint origin
-    ``p_i = p_{i-1} + R'_{i-1} u_i`` with ``u_i = Q_{i-1}^T t_i``.  Every joint then turns about
-    ``z``: two columns mix, the third is the axis.
+    ``p_i = p_{i-1} + R'_{i-1} u_i`` with ``u_i = Q_{i-1}^T t_i``.  ``[R'_i | p_i]`` (3 x 4) is
+    carried as one array: one product with the constant ``H_i = [[M_i, u_i], [0, 1]]`` gives both
+    the next rotation and the next origin, and ``Rz`` then mixes the first two columns only.
     """
 
-    rot_t: tuple[FloatArray, ...]  # (n,) M_i^T (3, 3), for the batch-last product R' M
-    trans: tuple[FloatArray, ...]  # (n,) u_i (3,) [m]
-    tool: FloatArray  # (3,) Q_n^T t_tool [m]
+    link_t: tuple[FloatArray, ...]  # (n,) H_i^T (4, 4), for the batch-last product [R'|p] H
+    tool: FloatArray  # (4,) homogeneous tool point in the last z-joint frame [m]
 
     @classmethod
     def of(cls, model: ArmModel) -> _FixedChain:
         """The constants of ``model`` (its joints and tool; the base is the root frame)."""
-        rot_t, trans = [], []
+        links = []
         q_prev = np.eye(3)
         for joint in model.joints:
             q_axis = axis_frame(joint.axis)
-            rot_t.append(np.ascontiguousarray((q_prev.T @ joint.placement[:3, :3] @ q_axis).T))
-            trans.append(q_prev.T @ joint.placement[:3, 3])
+            h = np.eye(4)
+            h[:3, :3] = q_prev.T @ joint.placement[:3, :3] @ q_axis
+            h[:3, 3] = q_prev.T @ joint.placement[:3, 3]
+            links.append(np.ascontiguousarray(h.T))
             q_prev = q_axis
-        return cls(tuple(rot_t), tuple(trans), q_prev.T @ model.tool[:3, 3])
+        return cls(tuple(links), np.append(q_prev.T @ model.tool[:3, 3], 1.0))
 
     def frame(self, q: FloatArray) -> _Frame:
         """Tool point, joint axes and position Jacobian at ``q`` (B, n) [rad], batch last."""
-        n, B = len(self.trans), q.shape[0]
-        cos, sin = np.cos(q.T), np.sin(q.T)  # (n, B)
-        rots = np.empty((n, 3, 3, B))  # R'_i
-        pos = np.empty((n, 3, B))  # p_i [m]
+        n, B = len(self.link_t), q.shape[0]
+        qt = q.T
+        cos = np.cos(qt)  # (n, B)
+        sin_pm = np.sin(qt)[:, None, :] * np.array([1.0, -1.0])[:, None]  # (n, 2, B): s, -s
+        links = np.empty((n, 3, 4, B))  # [R'_i | p_i]
         for i in range(n):
             if i == 0:
-                a = np.broadcast_to(self.rot_t[0].T[:, :, None], (3, 3, B))
-                pos[0] = self.trans[0][:, None]
+                a = np.broadcast_to(self.link_t[0].T[:3, :, None], (3, 4, B))
             else:
-                a = np.matmul(self.rot_t[i], rots[i - 1])  # R'_{i-1} M_i, row by row
-                np.add(pos[i - 1], self.trans[i] @ rots[i - 1], out=pos[i])
-            r = rots[i]
+                a = np.matmul(self.link_t[i], links[i - 1])  # [R'_{i-1} | p_{i-1}] H_i, row by row
+            r = links[i]
             # Rz(q) mixes the first two columns: (a0, a1) -> (a0 c + a1 s, a1 c - a0 s)
             np.multiply(a[:, :2], cos[i], out=r[:, :2])
-            r[:, 0] += a[:, 1] * sin[i]
-            r[:, 1] -= a[:, 0] * sin[i]
-            r[:, 2] = a[:, 2]
-        x = pos[-1] + self.tool @ rots[-1]  # (3, B)
-        axes = rots[:, :, 2].transpose(1, 0, 2)  # (3, n, B)
-        jac = cross_first(axes, x[:, None, :] - pos.transpose(1, 0, 2))
+            r[:, :2] += a[:, 1::-1] * sin_pm[i]
+            r[:, 2:] = a[:, 2:]  # the axis and the origin
+        x = self.tool @ links[-1]  # (3, B)
+        axes = links[:, :, 2].transpose(1, 0, 2)  # (3, n, B)
+        jac = cross_first(axes, x[:, None, :] - links[:, :, 3].transpose(1, 0, 2))
         return _Frame(x, jac, axes=axes)
