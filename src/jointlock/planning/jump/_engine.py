@@ -247,6 +247,8 @@ def _integrate(
             out.task_plus = np.zeros((R, N, 3))
             out.task_noreplan = np.zeros((R, N, 3))
     k0 = int(k_start.min()) if B else k_stop
+    if R and np.any(k_start[:R] != k0):
+        raise ValueError("_integrate: the recorded runs must all start at the first step")
     first_run = np.searchsorted(k_start, np.arange(k_stop + 1), side="left")  # first run started at k
     for k in range(k0, k_stop):
         m = int(first_run[k + 1])  # the runs started by now
