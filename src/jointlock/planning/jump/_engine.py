@@ -1,4 +1,10 @@
-"""Simulation engine: the batched explicit-Euler integrator of the law and its run outputs."""
+"""Simulation engine: the batched explicit-Euler integrator of the law and its run outputs.
+
+:func:`_integrate` steps B runs together (one :func:`~._control.law` call per control step for
+all of them); a run may start late and branch off another (``parent``), which is how the runs
+after a failure are stepped in the same pass as the healthy runs they leave
+(:func:`_branched_runs`).  Per-run arrays are batch-first here, ``(B, ...)``; the law's inputs
+are batch-last (:class:`~._frames._Frame`)."""
 
 from __future__ import annotations
 
