@@ -286,7 +286,7 @@ def _integrate(
             np.maximum(out.max_null[sl], np.abs(null).max(0), out=out.max_null[sl])
         acc = np.abs(qd - qd_prev[sl]).max(-1) / dt
         check = ~changed
-        check[new] = sc.rest_transitions and k == 0  # a run's first step starts from its parent's rates
+        check[new] = sc.rest_transitions and k == 0  # a run's first step: a jump, or the start from rest
         out.max_acc[sl] = np.where(check, np.maximum(out.max_acc[sl], acc), out.max_acc[sl])
         if R:
             _record_step(out, frame, k, R, qd, dev, qd_plus, jump_col)
