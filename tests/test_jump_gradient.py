@@ -1,9 +1,10 @@
 """The compensation law's manipulability gradient equals :mod:`jointlock.derivatives`' one.
 
-``compensated_rates`` computes ``grad w`` from the solve ``(J J^T)^-1 J`` it needs for ``J^+``;
-``manipulability_and_gradient`` uses an SVD.  Same formula (NOTES-001; 001 eq. 25), different
-round-off: they agree to 1e-12 relative away from singularities but not bit for bit, which is
-why the law keeps its own form (changing it moves the last digits of every jump output).
+``compensated_rates`` computes ``grad w`` from ``(J J^T)^-1 J`` (the adjugate of the Gram
+matrix), which it needs for ``J^+`` anyway; ``manipulability_and_gradient`` uses an SVD.  Same
+formula (NOTES-001; 001 eq. 25), different round-off: they agree to 1e-12 relative away from
+singularities but not bit for bit.  (The integrator's kernel takes the fixed-base gradient in
+closed form from the joint axes instead: tests/test_jump_batched.py.)
 """
 
 from __future__ import annotations

@@ -83,7 +83,7 @@ def run_jump_study(
 
     given = None if kappa is None else float(kappa)
     if fail_at is not None:
-        p = bar(2 * sc.n_steps, "kappa search")
+        p = bar(sc.n_steps, "kappa search")  # the grid pass updates once per control step
         res = jump_at_time(model, sc, fail_at, kappa=given, progress=p)
         p.close()
         return JumpJobResult("fail_at", model, sc, at_time=res, kappa=given)

@@ -42,8 +42,13 @@ Pipeline
 Batching (NOTES-001 property 4): the motion before a failure does not depend on when it
 happens, so one healthy run per kappa gives the jump at *every* control step (both laws are
 evaluated at each step of the healthy run).  The post-failure runs needed for the limits
-start from the healthy history and are integrated together: all kappa values and failure
-times are array dimensions; the only Python loop is over the integrator's time steps.
+branch off the healthy runs at their failure steps *in the same pass*: every kappa value and
+failure time is a column of one batch (batch axis last in the law's kernel), the law is
+evaluated once per control step for all of them, and the only Python loop is over the
+integrator's time steps (and the joints inside the kinematics).  What stays sequential is
+sequential by nature: the kappa scale (one run at kappa = 0) before the probe, the probe
+before the grid, each refinement iteration after the last, the check of the refined values
+after the refinement, the fit after the search, the verification after the fit.
 
 Choices where the paper is silent (arguments / scenario fields):
 
@@ -59,7 +64,8 @@ Choices where the paper is silent (arguments / scenario fields):
   of mass fixed, inertial frame = root frame at ``t = 0``).
 
 Modules (private; import from ``jointlock.planning.jump``): ``_task`` (scenario, task file),
-``_path`` (Cartesian path), ``_control`` (the law), ``_engine`` (batched integrator),
+``_path`` (Cartesian path), ``_control`` (the law, batched), ``_frames`` (its inputs per
+step: fixed-base kinematics), ``_engine`` (batched integrator),
 ``_simulate`` (runs, jump tables, limit reports), ``_search`` (kappa search), ``_pieces`` and
 ``_fit`` (kappa(t)), ``_verify`` (verification), ``_study`` (one failure time, whole pipeline).
 """

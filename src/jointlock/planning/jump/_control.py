@@ -1,13 +1,123 @@
-"""The resolved-rate law with global compensation (NOTES-001, "The control law")."""
+"""The resolved-rate law with global compensation (NOTES-001, "The control law").
+
+:func:`compensated_rates` is the public, batch-first form; :func:`law` is the kernel the
+integrator calls once per control step for every run at once.  The kernel keeps the batch as
+the *last* axis ("structure of arrays", as :class:`jointlock.kinematics.ChainState` stores its
+frames): each arithmetic step is then one ufunc call over a contiguous vector per matrix entry,
+so a step of one run and a step of a thousand runs cost nearly the same number of numpy calls.
+"""
 
 from __future__ import annotations
+
+from typing import cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
 from ...model import FloatArray
 
-# -- the control law ------------------------------------------------------------------------
+#: Gram matrices ``J_h J_h^T`` whose determinant is below this fraction of ``(tr/3)^3`` are
+#: treated as singular: ``J_h^+`` comes from an SVD (``np.linalg.pinv``) instead of the
+#: adjugate, whose entries would be round-off divided by round-off there [-].
+SINGULAR_GRAM_RTOL = 1e-13
+
+
+#: Cyclic component indices: ``(a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}``.
+_NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
+#: Flat indices (into a 3 x 3 matrix's 9 entries) of the two products of each cofactor:
+#: ``adj[r, c] = g[NEXT c, NEXT r] g[AFTER c, AFTER r] - g[NEXT c, AFTER r] g[AFTER c, NEXT r]``.
+_COF = tuple(
+    np.array([3 * i[c] + j[r] for r in range(3) for c in range(3)])
+    for i, j in ((_NEXT, _NEXT), (_AFTER, _AFTER), (_NEXT, _AFTER), (_AFTER, _NEXT))
+)
+
+
+def cross_first(a: FloatArray, b: FloatArray) -> FloatArray:
+    """Cross product over the *first* axis: (3, ...) x (3, ...) -> (3, ...) (broadcast)."""
+    return cast(FloatArray, a[_NEXT] * b[_AFTER] - a[_AFTER] * b[_NEXT])
+
+
+def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatArray]:
+    """``(J J^T)^-1 J`` (3, n, B) for well-conditioned Gram matrices by the adjugate of the
+    ``gram`` (3, 3, B), with an SVD fallback for the (near-)singular ones; returns it with
+    ``det(J J^T)`` (B,)."""
+    g = gram.reshape(9, -1)
+    adj = g[_COF[0]] * g[_COF[1]] - g[_COF[2]] * g[_COF[3]]  # (9, B), row-major adj[r, c]
+    det = np.einsum("cb,cb->b", g[:3], adj[::3])  # along the first row of g
+    trace3 = g[::4].sum(axis=0) / 3.0
+    singular = ~(det > SINGULAR_GRAM_RTOL * trace3**3)
+    inv_det = 1.0 / np.where(singular, 1.0, det)
+    m = np.einsum("rsb,skb->rkb", adj.reshape(gram.shape), jac_h) * inv_det
+    if singular.any():
+        # pinv(J^T) = (J^+)^T = (J J^T)^-1 J wherever the latter exists (rank 3)
+        jt = np.moveaxis(jac_h[..., singular], -1, 0).swapaxes(-1, -2)  # (S, n, 3)
+        m[..., singular] = np.moveaxis(np.linalg.pinv(jt), 0, -1)
+    return m, det
+
+
+def law(
+    jac: FloatArray,
+    healthy: np.ndarray,
+    xdot: FloatArray,
+    kappa: FloatArray,
+    *,
+    axes: FloatArray | None = None,
+    djac: FloatArray | None = None,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """The compensated resolved-rate law for B runs, batch last (the integrator's kernel).
+
+    ``qdot = J_h^+ xdot + kappa (I - J_h^+ J_h) grad w_h`` with ``J_h`` the position Jacobian
+    with the locked columns zeroed (``healthy``) and ``w_h = sqrt(det(J_h J_h^T))``.  The
+    gradient ``dw/dq_i = w tr((J J^T)^-1 J (dJ/dq_i)^T)`` (NOTES-001; 001 eq. 25) comes from
+
+    * ``axes`` (fixed base, closed form): with ``M = (J J^T)^-1 J`` and the columns' triple
+      products, ``dw/dq_i / w = z_i . sum_{k >= i} (J_k x M_k) + J_i . sum_{k < i} (M_k x z_k)``
+      (``dJ_k/dq_i = z_i x J_k`` for ``i <= k``, ``z_k x J_i`` for ``i > k``): O(n) per run
+      instead of the O(n^2) array of derivatives;
+    * ``djac`` (any Jacobian, e.g. the free-floating one by finite differences) otherwise.
+
+    Parameters
+    ----------
+    jac
+        (3, n, B) position Jacobian [m/rad], *all* columns.
+    healthy
+        (n, B) boolean mask of the joints that can move.
+    xdot
+        (3, B) commanded end-effector velocity [m/s].
+    kappa
+        (B,) compensation coefficient [rad^2/(s m^3)].
+    axes
+        (3, n, B) unit joint axes, root frame (fixed-base closed-form gradient).
+    djac
+        (n, 3, n, B) ``djac[i, :, k] = dJ[:, k]/dq_i`` [m/rad^2] (when ``axes`` is None).
+
+    Returns
+    -------
+    qdot
+        (n, B) joint rates [rad/s]; exactly 0 at the locked joints (NOTES-001 property 3).
+    w
+        (B,) manipulability of the healthy columns [m^3].
+    null
+        (n, B) the null-space term ``(I - J_h^+ J_h) grad w_h`` [m^3/rad] (``qdot`` at
+        ``xdot = 0``, ``kappa = 1``).
+    """
+    jac_h = jac * healthy
+    gram = np.einsum("rkb,skb->rsb", jac_h, jac_h)
+    m, det = _pinv_rows(jac_h, gram)  # m[:, k] = 0 where column k is locked
+    w = np.sqrt(np.maximum(det, 0.0))
+    if axes is not None:
+        suffix = np.cumsum(cross_first(jac_h, m)[:, ::-1], axis=1)[:, ::-1]  # sum_{k >= i} J_k x M_k
+        prefix = np.zeros_like(m)
+        np.cumsum(cross_first(m, axes)[:, :-1], axis=1, out=prefix[:, 1:])  # sum_{k < i} M_k x z_k
+        grad = w * (np.einsum("rib,rib->ib", axes, suffix) + np.einsum("rib,rib->ib", jac_h, prefix))
+    elif djac is not None:
+        grad = w * np.einsum("rcb,ircb->ib", m, djac)  # M's locked columns are 0: no need to mask djac
+    else:
+        raise TypeError("law() needs the joint axes or the Jacobian's derivatives")
+    grad = grad * healthy
+    null = grad - np.einsum("rib,rb->ib", m, np.einsum("rkb,kb->rb", jac_h, grad))
+    qdot = np.einsum("rib,rb->ib", m, xdot) + kappa * null
+    return qdot, w, null
 
 
 def compensated_rates(
@@ -21,7 +131,8 @@ def compensated_rates(
 
     ``qdot = J_h^+ xdot + kappa (I - J_h^+ J_h) grad w_h`` where ``J_h`` is the position
     Jacobian with the locked columns removed (``healthy`` mask) and ``w_h`` its
-    manipulability; locked entries of ``qdot`` are exactly 0 (NOTES-001 property 3).
+    manipulability; locked entries of ``qdot`` are exactly 0 (NOTES-001 property 3).  The
+    same law as the integrator's kernel (:func:`law`, fed the derivatives here).
 
     Parameters
     ----------
@@ -43,28 +154,25 @@ def compensated_rates(
     w
         (...) manipulability of the healthy columns [m^3].
     """
-    jac_h: FloatArray = np.asarray(jac, dtype=float)
-    djac_h: FloatArray = np.asarray(djac, dtype=float)
-    if healthy is not None:
-        mask = np.asarray(healthy, dtype=bool)
-        jac_h = jac_h * mask[..., None, :]
-        djac_h = djac_h * mask[..., None, None, :]
-    gram = jac_h @ np.swapaxes(jac_h, -1, -2)
-    det = np.linalg.det(gram)
-    w = np.sqrt(np.maximum(det, 0.0))
-    try:
-        m = np.linalg.solve(gram, jac_h)  # (J J^T)^-1 J, rows of J^+ transposed
-    except np.linalg.LinAlgError:
-        m = np.swapaxes(np.linalg.pinv(np.swapaxes(jac_h, -1, -2)), -1, -2)
-    # grad w = w tr((J J^T)^-1 J dJ_i^T), the formula of derivatives.manipulability_and_gradient,
-    # written again here on purpose: it reuses the solve above (needed for J^+ anyway), while
-    # derivatives uses an SVD.  Both agree to ~1e-13 relative away from singularities
-    # (tests/test_jump_gradient.py) but not bit for bit, and every recorded jump output used this one.
-    grad = w[..., None] * np.einsum("...rc,...irc->...i", m, djac_h)
-    if healthy is not None:
-        grad = grad * mask
-    pinv = np.swapaxes(m, -1, -2)  # (..., n, 3)
-    null = grad - np.einsum("...ir,...r->...i", pinv, np.einsum("...rc,...c->...r", jac_h, grad))
-    qdot = np.einsum("...ir,...r->...i", pinv, np.asarray(xdot, dtype=float))
-    qdot = qdot + np.asarray(kappa, dtype=float)[..., None] * null
-    return qdot, w
+    jac_a = np.asarray(jac, dtype=float)
+    djac_a = np.asarray(djac, dtype=float)
+    xdot_a = np.asarray(xdot, dtype=float)
+    kappa_a = np.asarray(kappa, dtype=float)
+    n = jac_a.shape[-1]
+    mask = np.ones(n, dtype=bool) if healthy is None else np.asarray(healthy, dtype=bool)
+    batch = np.broadcast_shapes(
+        jac_a.shape[:-2], djac_a.shape[:-3], xdot_a.shape[:-1], kappa_a.shape, mask.shape[:-1]
+    )
+    size = int(np.prod(batch))
+
+    def last(a: np.ndarray, core: tuple[int, ...]) -> np.ndarray:  # (..., *core) -> (*core, size)
+        return np.moveaxis(np.broadcast_to(a, batch + core).reshape((size,) + core), 0, -1)
+
+    qdot, w, _ = law(
+        last(jac_a, (3, n)),
+        last(mask, (n,)),
+        last(xdot_a, (3,)),
+        np.broadcast_to(kappa_a, batch).reshape(size),
+        djac=last(djac_a, (n, 3, n)),
+    )
+    return np.moveaxis(qdot, -1, 0).reshape(batch + (n,)), w.reshape(batch)

@@ -1,21 +1,27 @@
-"""Simulation engine: the batched explicit-Euler integrator of the law and its run outputs."""
+"""Simulation engine: the batched explicit-Euler integrator of the law and its run outputs.
+
+:func:`_integrate` steps B runs together (one :func:`~._control.law` call per control step for
+all of them); a run may start late and branch off another (``parent``), which is how the runs
+after a failure are stepped in the same pass as the healthy runs they leave
+(:func:`_branched_runs`).  Per-run arrays are batch-first here, ``(B, ...)``; the law's inputs
+are batch-last (:class:`~._frames._Frame`)."""
 
 from __future__ import annotations
 
 import warnings
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ...derivatives import cross3, generalized_jacobian_derivatives, linear_jacobian_derivatives
+from ...derivatives import generalized_jacobian_derivatives
 from ...errors import InfeasibleError, ModelError, ScenarioError, SingularityWarning
 from ...kinematics import base_jacobian, chain_state, generalized_jacobian, system_com
 from ...model import ArmModel, FloatArray
 from ...spatial import axis_angle_rotation
-from ._control import compensated_rates
+from ._frames import _FixedChain, _Frame
 from ._path import cartesian_trapezoid
 from ._task import JumpScenario
 
@@ -41,30 +47,29 @@ class _Problem:
     q0: FloatArray
     com0: FloatArray  # floating: system centre of mass at t=0 (inertial origin offset)
     lock_col: int
+    chain: _FixedChain | None  # fixed base: its forward kinematics, constants folded
 
-    def evaluate(
-        self, q: FloatArray, rb: FloatArray | None
-    ) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray | None]:
-        """x (B,3), J (B,3,n), dJ (B,n,3,n), base angular Jacobian (B,3,n) or None."""
-        model = self.model
-        if not self.floating:
-            state = chain_state(model, q)
-            lin = cross3(state.axes, state.ee_position[..., None, :] - state.positions)  # (B, n, 3)
-            jac = np.swapaxes(lin, -1, -2)
-            djac = linear_jacobian_derivatives(state.axes, jac)
-            return state.ee_position, jac, djac, None
+    def frame(self, q: FloatArray, rb: FloatArray | None) -> _Frame:
+        """Task-space quantities of B runs at joint angles ``q`` (B, n) [rad] and base attitudes
+        ``rb`` (B, 3, 3) (floating base only), batch last for :func:`law`."""
+        if self.chain is not None:  # fixed base
+            return self.chain.frame(q)
         assert rb is not None  # a floating base always carries its attitude
+        model = self.model
         state = chain_state(model, q)
         jg = generalized_jacobian(model, q, state=state)[..., :3, :]
         djg = generalized_jacobian_derivatives(model, q)[..., :3, :]
         jb = base_jacobian(model, q, state)[..., 3:, :]
         rel = state.ee_position - system_com(model, q, state)
-        x = self.com0 + np.einsum("...ij,...j->...i", rb, rel)
-        jac = rb @ jg
-        djac = np.einsum("...ab,...ibk->...iak", rb, djg)
-        return x, jac, djac, jb
+        x_bf = self.com0 + np.einsum("...ij,...j->...i", rb, rel)
+        jac_bf = rb @ jg
+        djac_bf = np.einsum("...ab,...ibk->...iak", rb, djg)
+        return _Frame(
+            np.moveaxis(x_bf, 0, -1), np.moveaxis(jac_bf, 0, -1), djac=np.moveaxis(djac_bf, 0, -1), base_jac=jb
+        )
 
     def position(self, q: FloatArray, rb: FloatArray | None) -> FloatArray:
+        """(B, 3) end-effector positions [m] (inertial frame)."""
         state = chain_state(self.model, q)
         if not self.floating:
             return state.ee_position
@@ -108,7 +113,18 @@ def _problem(model: ArmModel, scenario: JumpScenario) -> _Problem:
     else:
         xd_ff = path.xd[:-1]
     return _Problem(
-        model, scenario, floating, model.dof, scenario.n_steps, t, path.x, xd_ff, q0, com0, lock_col
+        model,
+        scenario,
+        floating,
+        model.dof,
+        scenario.n_steps,
+        t,
+        path.x,
+        xd_ff,
+        q0,
+        com0,
+        lock_col,
+        None if floating else _FixedChain.of(model),
     )
 
 
@@ -170,15 +186,43 @@ def _integrate(
     fail_steps: np.ndarray,
     fail_cols: Sequence[int],
     *,
-    record: bool = False,
+    parent: np.ndarray | None = None,
+    record: int = 0,
     jump_col: int | None = None,
     k_stop: int | None = None,
     null_norm: bool = False,
     progress: Any = None,
 ) -> _RunOut:
-    """Integrate B runs together.  Runs must be sorted by ``k_start`` (ascending); run ``b``
-    is idle before ``k_start[b]`` and then follows the law with the columns ``fail_cols[l]``
-    locked from step ``fail_steps[b, l]`` on.  ``kappa`` is (B, N)."""
+    """Integrate B runs together, one batched evaluation of the law per control step.
+
+    Parameters
+    ----------
+    prob
+        The problem.
+    kappa
+        (B, N) compensation schedules [rad^2/(s m^3)].
+    q_init, rb_init
+        (B, n) start angles [rad] and (B, 3, 3) base attitudes (floating base; None: identity).
+    k_start
+        (B,) first step of each run, ascending: run ``b`` is idle before ``k_start[b]``.
+    fail_steps, fail_cols
+        (B, L) steps from which the columns ``fail_cols[l]`` (L,) are locked in run ``b``.
+    parent
+        (B,) run whose state run ``b`` takes at its first step (-1: its own ``q_init``,
+        ``rb_init``); a parent must start no later than its child.  This steps the runs after
+        a failure together with the healthy runs they branch from.
+    record
+        Number of leading runs (all starting at the first step) whose histories are kept.
+    jump_col
+        Also record, for the recorded runs, the law with this column locked as well (the
+        rates right after it fails: ``qd_plus``, ``task_plus``, ``task_noreplan``).
+    k_stop
+        Stop before this step (default N).
+    null_norm
+        Keep the largest null-space term ``max_null`` (kappa = 1, no task velocity).
+    progress
+        ``update()`` once per control step.
+    """
     sc = prob.scenario
     n, N, dt = prob.n, prob.N, sc.dt
     B = q_init.shape[0]
@@ -190,103 +234,124 @@ def _integrate(
         else (np.broadcast_to(np.eye(3), (B, 3, 3)).copy() if rb_init is None else rb_init.copy())
     )
     qd_prev = np.zeros((B, n))
-    max_vel = np.zeros(B)
     diverged_rate = max(DIVERGED_RATE_MIN, DIVERGED_FACTOR * sc.vmax)
-    max_acc = np.zeros(B)
-    max_dev = np.zeros(B)
-    min_w = np.full(B, np.inf)
-    max_null = np.zeros(B)
+    out = _RunOut(np.zeros(B), np.zeros(B), np.zeros(B), np.full(B, np.inf), np.zeros(B))
     fail_steps = np.asarray(fail_steps, dtype=int).reshape(B, -1)
     onehot = np.zeros((len(fail_cols), n), dtype=bool)
     for l, c in enumerate(fail_cols):
         onehot[l, c] = True
-    out = _RunOut(max_vel, max_acc, max_dev, min_w, max_null)
-    if record:
-        out.q = np.repeat(q_init[:, None, :], N + 1, axis=1)
-        out.qd = np.zeros((B, N, n))
-        out.dev = np.zeros((B, N + 1))
-        out.x = np.zeros((B, N + 1, 3))
+    R = min(int(record), B)
+    if R:
+        out.q = np.repeat(q_init[:R, None, :], N + 1, axis=1)
+        out.qd = np.zeros((R, N, n))
+        out.dev = np.zeros((R, N + 1))
+        out.x = np.zeros((R, N + 1, 3))
         if rb is not None:  # prob.floating
-            out.rb = np.repeat(rb[:, None], N + 1, axis=1)
+            out.rb = np.repeat(rb[:R, None], N + 1, axis=1)
         if jump_col is not None:
-            out.qd_plus = np.zeros((B, N, n))
-            out.task_plus = np.zeros((B, N, 3))
-            out.task_noreplan = np.zeros((B, N, 3))
+            out.qd_plus = np.zeros((R, N, n))
+            out.task_plus = np.zeros((R, N, 3))
+            out.task_noreplan = np.zeros((R, N, 3))
     k0 = int(k_start.min()) if B else k_stop
+    if R and np.any(k_start[:R] != k0):
+        raise ValueError("_integrate: the recorded runs must all start at the first step")
+    first_run = np.searchsorted(k_start, np.arange(k_stop + 1), side="left")  # first run started at k
     for k in range(k0, k_stop):
-        m = int(np.searchsorted(k_start, k, side="right"))
+        m = int(first_run[k + 1])  # the runs started by now
         sl = slice(0, m)
+        new = slice(int(first_run[k]), m)  # the runs starting at this step
+        if parent is not None and new.start < m:
+            src = parent[new]
+            take = np.flatnonzero(src >= 0) + new.start
+            q[take] = q[parent[take]]
+            if rb is not None:
+                rb[take] = rb[parent[take]]
         failed = fail_steps[sl] <= k  # (m, L)
-        mask = ~np.any(failed[:, :, None] & onehot[None], axis=1)  # (m, n)
+        healthy = ~np.any(failed[:, :, None] & onehot[None], axis=1).T  # (n, m)
         changed = np.any(fail_steps[sl] == k, axis=1)
-        rbm = None if rb is None else rb[sl]
-        x, jac, djac, jb = prob.evaluate(q[sl], rbm)
-        err = prob.x_nom[k] - x
-        xdc = prob.xd_nom[k] + sc.kp * err
-        qd, w = compensated_rates(jac, djac, xdc, kappa[sl, k], mask)
-        dev = np.linalg.norm(err, axis=-1)
-        max_dev[sl] = np.maximum(max_dev[sl], dev)
-        max_vel[sl] = np.maximum(max_vel[sl], np.abs(qd).max(-1))
-        min_w[sl] = np.minimum(min_w[sl], w)
+        frame = prob.frame(q[sl], None if rb is None else rb[sl])
+        err = prob.x_nom[k][:, None] - frame.x  # (3, m)
+        xdc = prob.xd_nom[k][:, None] + sc.kp * err
+        plus = None
+        if R and jump_col is not None:
+            plus = healthy[:, :R].copy()
+            plus[jump_col] = False
+        qd_t, w, null, qd_plus = frame.rates(healthy, xdc, kappa[sl, k], plus)
+        qd = qd_t.T  # (m, n)
+        dev = np.sqrt(np.einsum("rb,rb->b", err, err))
+        np.maximum(out.max_dev[sl], dev, out=out.max_dev[sl])
+        np.maximum(out.max_vel[sl], np.abs(qd).max(-1), out=out.max_vel[sl])
+        np.minimum(out.min_w[sl], w, out=out.min_w[sl])
         if null_norm:
-            null, _ = compensated_rates(jac, djac, np.zeros(3), np.ones(m), mask)
-            max_null[sl] = np.maximum(max_null[sl], np.abs(null).max(-1))
+            np.maximum(out.max_null[sl], np.abs(null).max(0), out=out.max_null[sl])
         acc = np.abs(qd - qd_prev[sl]).max(-1) / dt
-        first = k_start[sl] == k
-        check = ~first & ~changed
-        if sc.rest_transitions:
-            check |= first & (k == 0)
-        max_acc[sl] = np.where(check, np.maximum(max_acc[sl], acc), max_acc[sl])
-        if record:
-            assert out.qd is not None and out.dev is not None and out.x is not None
-            out.qd[sl, k] = qd
-            out.dev[sl, k] = dev
-            out.x[sl, k] = x
-            if jump_col is not None:
-                mask2 = mask.copy()
-                mask2[:, jump_col] = False
-                qd2, _ = compensated_rates(jac, djac, xdc, kappa[sl, k], mask2)
-                assert out.qd_plus is not None and out.task_plus is not None
-                assert out.task_noreplan is not None
-                out.qd_plus[sl, k] = qd2
-                out.task_plus[sl, k] = np.einsum("...rc,...c->...r", jac, qd2 - qd)
-                out.task_noreplan[sl, k] = -jac[..., jump_col] * qd[:, jump_col, None]
+        check = ~changed
+        check[new] = sc.rest_transitions and k == 0  # a run's first step: a jump, or the start from rest
+        out.max_acc[sl] = np.where(check, np.maximum(out.max_acc[sl], acc), out.max_acc[sl])
+        if R:
+            _record_step(out, frame, k, R, qd, dev, qd_plus, jump_col)
         if m and np.abs(qd).max() > diverged_rate:
             _stop_diverged(qd, kappa[sl, k], k * dt, diverged_rate)
         qd_prev[sl] = qd
-        q[sl] = q[sl] + dt * qd
+        q[sl] += dt * qd
         if rb is not None:
-            assert jb is not None  # evaluate() returns it for a floating base
-            omega = np.einsum("...ij,...j->...i", jb, qd) * dt
+            assert frame.base_jac is not None  # frame() gives it for a floating base
+            omega = np.einsum("...ij,...j->...i", frame.base_jac, qd) * dt
             angle = np.linalg.norm(omega, axis=-1)
             axis = omega / np.where(angle > 0, angle, 1.0)[:, None]
             rb[sl] = rb[sl] @ axis_angle_rotation(axis, angle)
-        if record:
+        if R:
             assert out.q is not None
-            out.q[sl, k + 1] = q[sl]
+            out.q[:, k + 1] = q[:R]
             if rb is not None:
                 assert out.rb is not None
-                out.rb[sl, k + 1] = rb[sl]
+                out.rb[:, k + 1] = rb[:R]
         if progress is not None:
             progress.update()
     if k_stop == N and B:
         x_end = prob.position(q, rb)
         dev_end = np.linalg.norm(prob.x_nom[N] - x_end, axis=-1)
-        max_dev[:] = np.maximum(max_dev, dev_end)
-        if record:
+        np.maximum(out.max_dev, dev_end, out=out.max_dev)
+        if R:
             assert out.dev is not None and out.x is not None
-            out.dev[:, N] = dev_end
-            out.x[:, N] = x_end
+            out.dev[:, N] = dev_end[:R]
+            out.x[:, N] = x_end[:R]
         if sc.rest_transitions:
-            max_acc[:] = np.maximum(max_acc, np.abs(qd_prev).max(-1) / dt)
-    if np.any(min_w < SINGULAR_W):
+            np.maximum(out.max_acc, np.abs(qd_prev).max(-1) / dt, out=out.max_acc)
+    if np.any(out.min_w < SINGULAR_W):
         warnings.warn(
-            f"{int(np.sum(min_w < SINGULAR_W))} of {B} runs passed within w < {SINGULAR_W:g} of a "
+            f"{int(np.sum(out.min_w < SINGULAR_W))} of {B} runs passed within w < {SINGULAR_W:g} of a "
             "singular configuration; they are marked infeasible",
             SingularityWarning,
             stacklevel=3,
         )
     return out
+
+
+def _record_step(
+    out: _RunOut,
+    frame: _Frame,
+    k: int,
+    R: int,
+    qd: FloatArray,
+    dev: FloatArray,
+    qd_plus: FloatArray | None,
+    jump_col: int | None,
+) -> None:
+    """Store step ``k`` of the first ``R`` runs: rates ``qd`` (B, n) [rad/s], deviation ``dev``
+    (B,) [m] and, with ``jump_col``, the rates ``qd_plus`` (n, R) with that joint locked too."""
+    assert out.qd is not None and out.dev is not None and out.x is not None
+    out.qd[:, k] = qd[:R]
+    out.dev[:, k] = dev[:R]
+    out.x[:, k] = frame.x[:, :R].T
+    if jump_col is None:
+        return
+    assert qd_plus is not None
+    assert out.qd_plus is not None and out.task_plus is not None and out.task_noreplan is not None
+    jac = frame.jac[..., :R]
+    out.qd_plus[:, k] = qd_plus.T
+    out.task_plus[:, k] = np.einsum("rcb,cb->br", jac, qd_plus - qd[:R].T)
+    out.task_noreplan[:, k] = -(jac[:, jump_col] * qd[:R, jump_col]).T
 
 
 def _kappa_rows(prob: _Problem, kappa: ArrayLike) -> FloatArray:
@@ -335,7 +400,7 @@ def _healthy_runs(
         np.zeros(K, dtype=int),
         np.full((K, 1), prob.N + 1),
         [prob.lock_col],
-        record=True,
+        record=K,
         jump_col=prob.lock_col,
         k_stop=k_stop,
         progress=progress,
@@ -359,6 +424,41 @@ def _post_runs(
     rb_init = None if healthy.rb is None else healthy.rb[ks, fs]
     out = _integrate(prob, krows[ks], q_init, rb_init, fs, fs[:, None], [prob.lock_col], progress=progress)
     return out, order
+
+
+def _branched_runs(
+    prob: _Problem, krows: FloatArray, kidx: np.ndarray, fsteps: np.ndarray, progress: Any = None
+) -> tuple[_RunOut, _RunOut]:
+    """The healthy runs of ``krows`` (K, N) and the runs after a failure of the lock joint at
+    ``fsteps`` (R,), each branching off healthy run ``kidx`` (R,) at its failure step, stepped
+    together in one pass (the same runs as :func:`_healthy_runs` then :func:`_post_runs`).
+
+    Returns the healthy outputs (K runs, recorded) and the post-failure outputs (R runs, in the
+    order of ``fsteps``, not recorded).
+    """
+    K, N = krows.shape[0], prob.N
+    kidx = np.asarray(kidx, dtype=int)
+    order = np.argsort(fsteps, kind="stable")  # the healthy runs start at 0, before every branch
+    ks, fs = kidx[order], np.asarray(fsteps, dtype=int)[order]
+    out = _integrate(
+        prob,
+        np.concatenate([krows, krows[ks]]),
+        np.repeat(prob.q0[None], K + ks.size, axis=0),
+        None,
+        np.concatenate([np.zeros(K, dtype=int), fs]),
+        np.concatenate([np.full(K, N + 1), fs])[:, None],
+        [prob.lock_col],
+        parent=np.concatenate([np.full(K, -1), ks]),
+        record=K,
+        jump_col=prob.lock_col,
+        progress=progress,
+    )
+    scalars = [f.name for f in fields(_RunOut)[:5]]
+    healthy = _RunOut(*(getattr(out, name)[:K] for name in scalars))
+    for f in fields(_RunOut)[5:]:
+        setattr(healthy, f.name, getattr(out, f.name))
+    post = _RunOut(*(_unsort(getattr(out, name)[K:], order) for name in scalars))
+    return healthy, post
 
 
 def _unsort(values: FloatArray, order: np.ndarray) -> FloatArray:

@@ -204,10 +204,11 @@ def fit_kappa(
         rtol=rtol,
         span=(0.0, sc.duration),
     )
-    kap, kept, decisions, used = _decide_segments(
+    kap, kept, decisions, used, obj_fit = _decide_segments(
         prob, merged, pieces, order=order, max_order=max_order, threshold=threshold, rtol=rtol
     )
-    obj_fit = _jumps(prob, merged.fail_steps, [kap], int(merged.fail_steps.max()) + 1)[0]
+    if obj_fit is None:
+        obj_fit = _jumps(prob, merged.fail_steps, [kap], int(merged.fail_steps.max()) + 1)[0]
     seg_pts = np.array([kept[0].start, kept[-1].end]) if kept else np.array([np.nan, np.nan])
     if kept:
         ordr = max(pc.order for pc in kept)

@@ -12,7 +12,7 @@ from numpy.typing import ArrayLike
 
 from ...errors import ScenarioError
 from ...model import ArmModel, FloatArray
-from ._engine import _healthy_runs, _integrate, _kappa_rows, _ok, _post_runs, _Problem, _problem, _unsort
+from ._engine import _branched_runs, _healthy_runs, _integrate, _kappa_rows, _ok, _Problem, _problem
 from ._simulate import _table, jump_reduction
 from ._task import JumpScenario
 
@@ -191,16 +191,14 @@ def search_kappa(
     ph = _healthy_runs(prob, _kappa_rows(prob, probe))
     pok = _ok(prob, ph)
     a, b = _probe_band(probe, pok)
-    grid = np.unique(np.concatenate([np.linspace(a, b, n_grid), [0.0]])) if b > a else np.array([0.0])
+    grid = _grid(a, b, n_grid)
     K = grid.size
     krows = _kappa_rows(prob, grid)
-    healthy = _healthy_runs(prob, krows, progress=progress)
+    # one pass: the K healthy runs and the K F runs branching off them at the failure times
+    healthy, post = _branched_runs(prob, krows, np.repeat(np.arange(K), F), np.tile(fsteps, K), progress)
     table = _table(prob, krows, healthy)
     objective = table.joint_jump_norm[:, fsteps]  # (K, F)
-    kidx = np.repeat(np.arange(K), F)
-    fidx = np.tile(fsteps, K)
-    post, order = _post_runs(prob, krows, healthy, kidx, fidx, progress=progress)
-    post_ok = _unsort(_ok(prob, post), order).reshape(K, F)
+    post_ok = _ok(prob, post).reshape(K, F)
     feasible = post_ok & table.healthy_limits_ok[:, None]
     g0 = int(np.flatnonzero(grid == 0.0)[0])
     zero_feasible = feasible[g0].copy()
@@ -254,21 +252,37 @@ def _probe_band(probe: FloatArray, pok: np.ndarray) -> tuple[float, float]:
     return a, b
 
 
+def _grid(a: float, b: float, n_grid: int) -> FloatArray:
+    """``n_grid`` kappa values over ``[a, b]`` and 0 (:func:`search_kappa` step 2), ascending.
+
+    A value within round-off of 0 (``|kappa| <= 1e-12 (b - a)``, e.g. -4e-19 when 0 lies on the
+    grid) is set to exactly 0 rather than kept beside it: two values 1e-18 apart make a bracket
+    of the refinement whose parabola is drawn through round-off, and which one of the pair comes
+    first -- hence the refined kappa -- then depended on the last bits of ``a`` and ``b``.
+    """
+    if not b > a:
+        return np.array([0.0])
+    grid = np.linspace(a, b, n_grid)
+    grid[np.abs(grid) <= 1e-12 * (b - a)] = 0.0
+    return np.unique(np.concatenate([grid, [0.0]]))
+
+
 def _grid_starts(
     grid: FloatArray, objective: FloatArray, feasible: np.ndarray, n_starts: int
 ) -> tuple[FloatArray, FloatArray, FloatArray, tuple[list, ...]]:
     """Grid optimum per failure time and the refinement starts (:func:`search_kappa` step 2).
 
     Returns ``interval`` (F, 2), ``kappa_opt`` (F,), ``obj_opt`` (F,) (NaN where no grid value is
-    feasible) and the starts ``(s_f, s_lo, s_x, s_hi, s_fx, s_run)``: failure-time index, bracket,
-    grid value, its objective and the contiguous feasible run around it.
+    feasible) and the starts ``(s_f, s_lo, s_x, s_hi, s_fx, s_run, s_flo, s_fhi)``: failure-time
+    index, bracket, grid value, its objective, the contiguous feasible run around it and the
+    objective at the bracket's ends (grid values too).
     """
     F = feasible.shape[1]
     interval = np.full((F, 2), np.nan)
     kappa_opt = np.full(F, np.nan)
     obj_opt = np.full(F, np.nan)
     # refinement starts: up to n_starts feasible local minima of the grid objective per time
-    s_f, s_lo, s_x, s_hi, s_fx, s_run = [], [], [], [], [], []
+    s_f, s_lo, s_x, s_hi, s_fx, s_run, s_flo, s_fhi = [], [], [], [], [], [], [], []
     for f in range(F):  # reads off contiguous feasible runs; no simulation in this loop
         feas = feasible[:, f]
         if not feas.any():
@@ -288,12 +302,15 @@ def _grid_starts(
         for i in map(int, minima):
             rlo, rhi = _contiguous(feas, i)
             s_f.append(f)
-            s_lo.append(grid[max(i - 1, rlo)])
+            ilo, ihi = max(i - 1, rlo), min(i + 1, rhi)
+            s_lo.append(grid[ilo])
             s_x.append(grid[i])
-            s_hi.append(grid[min(i + 1, rhi)])
+            s_hi.append(grid[ihi])
             s_fx.append(objective[i, f])
             s_run.append((grid[rlo], grid[rhi]))
-    return interval, kappa_opt, obj_opt, (s_f, s_lo, s_x, s_hi, s_fx, s_run)
+            s_flo.append(objective[ilo, f])
+            s_fhi.append(objective[ihi, f])
+    return interval, kappa_opt, obj_opt, (s_f, s_lo, s_x, s_hi, s_fx, s_run, s_flo, s_fhi)
 
 
 def _refine_starts(
@@ -308,7 +325,7 @@ def _refine_starts(
     """Refine the starts of :func:`_grid_starts` (:func:`search_kappa` step 3); a refined value
     replaces ``kappa_opt``, ``obj_opt`` and ``interval`` (in place) where it lowers the
     objective and keeps every limit."""
-    s_f, s_lo, s_x, s_hi, s_fx, s_run = starts
+    s_f, s_lo, s_x, s_hi, s_fx, s_run, s_flo, s_fhi = starts
     sf = np.asarray(s_f)
     cand, fcand = _refine(
         prob,
@@ -318,14 +335,15 @@ def _refine_starts(
         np.asarray(s_hi),
         np.asarray(s_fx),
         refine_iter,
+        fa=np.asarray(s_flo),
+        fb=np.asarray(s_fhi),
     )
     better = fcand < obj_opt[sf]
     if better.any():
         rows = np.flatnonzero(better)
         krows_c = _kappa_rows(prob, cand[rows])
-        h = _healthy_runs(prob, krows_c)
-        p, order_c = _post_runs(prob, krows_c, h, np.arange(rows.size), fsteps[sf[rows]])
-        ok = _unsort(_ok(prob, p), order_c) & _ok(prob, h)
+        h, p = _branched_runs(prob, krows_c, np.arange(rows.size), fsteps[sf[rows]])
+        ok = _ok(prob, p) & _ok(prob, h)
         for r in rows[ok][np.argsort(-fcand[rows[ok]], kind="stable")]:  # best written last
             f = sf[r]
             if fcand[r] < obj_opt[f]:
@@ -372,9 +390,15 @@ def _refine(
     b: FloatArray,
     fx: FloatArray,
     iters: int,
+    *,
+    fa: FloatArray | None = None,
+    fb: FloatArray | None = None,
 ) -> tuple[FloatArray, FloatArray]:
     """Safeguarded parabolic minimisation of ``||dqdot||^2`` in ``[a, b]`` (one per failure
-    time, all batched); ``x`` is the best known point with value ``fx``."""
+    time, all batched); ``x`` is the best known point with value ``fx``, ``fa`` and ``fb`` the
+    values at ``a`` and ``b`` when known (the grid's: one pass of healthy runs fewer each).
+    Each iteration is one pass of every row's healthy run; the iterations are sequential by
+    nature (each bracket follows from the last value)."""
     k_stop = int(fsteps.max()) + 1
     rows = np.arange(fsteps.size)
 
@@ -384,8 +408,8 @@ def _refine(
         return np.linalg.norm(out.qd_plus - out.qd, axis=-1)[rows, fsteps]
 
     a, b, x, fx = a.copy(), b.copy(), x.copy(), fx.copy()
-    fa = obj(a)
-    fb = obj(b)
+    fa = obj(a) if fa is None else fa.copy()
+    fb = obj(b) if fb is None else fb.copy()
     for _ in range(iters):
         ya, yx, yb = fa**2, fx**2, fb**2
         num = (x - a) ** 2 * (yx - yb) - (x - b) ** 2 * (yx - ya)

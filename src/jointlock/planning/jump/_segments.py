@@ -28,12 +28,14 @@ def _decide_segments(
     max_order: int,
     threshold: float | None,
     rtol: float,
-) -> tuple[FloatArray, list[KappaPiece], list[tuple[float, float, str]], np.ndarray]:
+) -> tuple[FloatArray, list[KappaPiece], list[tuple[float, float, str]], np.ndarray, FloatArray | None]:
     """Per segment, in time order: own piece (trimmed or not), previous piece continued, or
     kappa = 0 (:func:`fit_kappa` step 4).
 
-    Returns the schedule (N,), the kept pieces, the decisions ``(start, end, choice)`` and the
-    (F,) mask of the samples the kept pieces were fitted to.
+    Returns the schedule (N,), the kept pieces, the decisions ``(start, end, choice)``, the
+    (F,) mask of the samples the kept pieces were fitted to and the (F,) ``||dqdot||`` [rad/s]
+    at every sample with the schedule (the last segment's winning candidate *is* the schedule,
+    and its jumps were computed at every sample; None when there is no piece).
     """
     t_all = merged.fail_times
     steps = prob.t[:-1]
@@ -43,6 +45,7 @@ def _decide_segments(
     kept: list[KappaPiece] = []
     decisions = []
     used = np.zeros(t_all.size, dtype=bool)
+    jumps_kap: FloatArray | None = None
     for s, pc in enumerate(pieces):
         on = (steps >= pc.start) & ((steps < pc.end) | (s == len(pieces) - 1))
         here = (seg_of == s) & feasible_in
@@ -86,6 +89,7 @@ def _decide_segments(
         win = min(pref, key=lambda i: (score[i], pref.index(i)))
         choice = names[win]
         kap = cands[win]
+        jumps_kap = jm[win]
         if choice == "fit":
             kept.append(best_piece)
             used[idx[np.isfinite(merged.kappa_opt[idx])]] = True
@@ -103,7 +107,7 @@ def _decide_segments(
         elif choice == "continued":
             kept[-1] = dataclasses.replace(kept[-1], end=pc.end, source="continued")
         decisions.append((float(pc.start), float(pc.end), choice))
-    return kap, kept, decisions, used
+    return kap, kept, decisions, used, jumps_kap
 
 
 def _trimmed_candidate(

@@ -152,7 +152,7 @@ def simulate(
     fail_steps = np.array([steps], dtype=int).reshape(1, -1) if steps else np.full((1, 1), prob.N + 1)
     fail_cols = cols if cols else [0]
     out = _integrate(
-        prob, krow, prob.q0[None], None, np.zeros(1, dtype=int), fail_steps, fail_cols, record=True
+        prob, krow, prob.q0[None], None, np.zeros(1, dtype=int), fail_steps, fail_cols, record=1
     )
     healthy = np.ones((prob.N, prob.n), dtype=bool)
     for c, k in zip(cols, steps):

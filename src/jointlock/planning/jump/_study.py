@@ -5,19 +5,19 @@ from __future__ import annotations
 import logging
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field, fields
+from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 
 from ...errors import InfeasibleError
 from ...model import ArmModel, FloatArray
-from ._engine import _healthy_runs, _kappa_rows, _post_runs, _problem, _RunOut, _unsort
+from ._engine import _branched_runs, _kappa_rows, _problem
 from ._fit import KappaFit, fit_kappa
 from ._search import KappaSearch, search_kappa
 from ._simulate import LimitReport, _limit_report, _table, jump_reduction, uncompensated_violations
 from ._task import JumpScenario
-from ._verify import Verification, verify_kappa
+from ._verify import Verification, _verify_fixes
 
 log = logging.getLogger(__package__)
 
@@ -105,10 +105,8 @@ def jump_at_time(
                 f"with joint {sc.lock_joint} locking at {k * sc.dt:g} s; {_why_no_kappa(model, sc)}"
             )
     krows = _kappa_rows(prob, np.array([0.0, float(kappa)]))
-    healthy = _healthy_runs(prob, krows)
+    healthy, post = _branched_runs(prob, krows, np.array([0, 1]), np.array([k, k]))
     table = _table(prob, krows, healthy)
-    post, order = _post_runs(prob, krows, healthy, np.array([0, 1]), np.array([k, k]))
-    post = _RunOut(*(_unsort(getattr(post, f.name), order) for f in fields(_RunOut)[:5]))
     reps = []
     for r in range(2):
         sel = np.zeros(2, dtype=bool)
@@ -202,7 +200,7 @@ def study_jump(
         return progress_factory(total, desc) if progress_factory is not None else None
 
     t0 = time.perf_counter()
-    p = bar(2 * N, "kappa search")
+    p = bar(N, "kappa search")  # one update per control step of the grid pass
     search = search_kappa(model, sc, n_samples=n_samples, progress=p, **dict(search_options or {}))
     if p is not None:
         p.close()
@@ -214,16 +212,14 @@ def study_jump(
     if fit.search is not None:  # failure times added around the breaks of kappa(t)
         search = fit.search
     t2 = time.perf_counter()
-    p = bar(2 * N, "verification")
-    ver = verify_kappa(model, sc, fit, search=search, progress=p)
+    p = bar(N, "verification")
+    # the fixed schedule does not depend on the first verification: both in one pass ("auto"
+    # drops the fixed one when the fit keeps every limit)
+    fixes: tuple[Any, ...] = (None,) if fix is None else (None, "clip+ramp" if fix == "auto" else fix)
+    ver, *more = _verify_fixes(model, sc, fit, search=search, fixes=fixes, progress=p)
     if p is not None:
         p.close()
-    ver_c = None
-    if fix == "auto":
-        if not ver.limits_ok:
-            ver_c = verify_kappa(model, sc, fit, search=search, fix="clip+ramp")
-    elif fix is not None:
-        ver_c = verify_kappa(model, sc, fit, search=search, fix=fix)
+    ver_c = more[0] if more and not (fix == "auto" and ver.limits_ok) else None
     t3 = time.perf_counter()
     log.info("jump study: search %.2fs fit %.2fs verify %.2fs", t1 - t0, t2 - t1, t3 - t2)
     return JumpStudy(search, fit, ver, ver_c, {"search": t1 - t0, "fit": t2 - t1, "verify": t3 - t2}, sc)

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Any, Literal
 
@@ -12,11 +12,14 @@ from numpy.typing import ArrayLike
 
 from ...errors import InfeasibleError, ScenarioError
 from ...model import ArmModel, FloatArray
-from ._engine import LIMIT_RTOL, _healthy_runs, _ok, _post_runs, _Problem, _problem, _RunOut, _unsort
+from ._engine import LIMIT_RTOL, _branched_runs, _ok, _Problem, _problem, _RunOut
 from ._fit import KappaFit
 from ._search import KappaSearch
 from ._simulate import LimitReport, _limit_report, _table, jump_reduction
 from ._task import JumpScenario
+
+#: The fixes of a fitted kappa(t) that :func:`verify_kappa` offers.
+Fix = Literal["clip", "ramp", "clip+ramp"]
 
 # -- verification ---------------------------------------------------------------------------
 
@@ -145,7 +148,7 @@ def verify_kappa(
     schedule: KappaFit | Callable[[FloatArray], FloatArray] | float,
     *,
     search: KappaSearch | None = None,
-    fix: Literal["clip", "ramp", "clip+ramp"] | None = None,
+    fix: Fix | None = None,
     progress: Any = None,
 ) -> Verification:
     """Inject the failure at every control step with kappa(t) in the law (001 §4.4).
@@ -173,6 +176,20 @@ def verify_kappa(
     progress
         Optional progress reporter.
     """
+    return _verify_fixes(model, scenario, schedule, search=search, fixes=(fix,), progress=progress)[0]
+
+
+def _verify_fixes(
+    model: ArmModel,
+    scenario: JumpScenario | None,
+    schedule: KappaFit | Callable[[FloatArray], FloatArray] | float,
+    *,
+    search: KappaSearch | None,
+    fixes: Sequence[Fix | None],
+    progress: Any = None,
+) -> list[Verification]:
+    """:func:`verify_kappa` of one schedule under several ``fixes``, in one pass: the kappa = 0
+    run, one healthy run per fix and, branching off each, its N runs with the failure."""
     if scenario is None:
         if search is None:
             raise ScenarioError("verify_kappa: give a scenario or a search")
@@ -183,44 +200,58 @@ def verify_kappa(
         kap = np.asarray(schedule(t), dtype=float) * np.ones(prob.N)
     else:
         kap = np.full(prob.N, float(schedule))
+    kaps = [_fixed(kap, fix, search, scenario, t) for fix in fixes]
+    S, N = len(kaps), prob.N
+    krows = np.stack([np.zeros(N), *kaps])
+    steps = np.arange(N)
+    healthy, post = _branched_runs(prob, krows, np.repeat(np.arange(1, S + 1), N), np.tile(steps, S), progress)
+    table = _table(prob, krows, healthy)
+    post_ok = _ok(prob, post).reshape(S, N)
+    prefix_ok = _step_limits(prob, healthy)
+    before = table.joint_jump_norm[0]
+    sampled_ok = bool(search is not None and np.all(np.isfinite(search.kappa_opt)))
+    results = []
+    for j, (fix, kap_j) in enumerate(zip(fixes, kaps), start=1):  # one per schedule, a handful
+        ok_steps = post_ok[j - 1] & prefix_ok[j]
+        sel = np.arange(S + 1) == j
+        post_sel = np.repeat(np.arange(1, S + 1), N) == j
+        after = table.joint_jump_norm[j]
+        results.append(
+            Verification(
+                t,
+                kap_j,
+                before,
+                after,
+                table.task_jump_noreplan[0],
+                table.task_jump_noreplan[j],
+                float(max(table.task_jump_replan[0].max(), table.task_jump_replan[j].max())),
+                jump_reduction(before.mean(), after.mean()),
+                float(np.mean(after < before)),
+                _limit_report(prob, [healthy, post], [sel, post_sel]),
+                bool(table.healthy_limits_ok[j]),
+                ok_steps,
+                t[~ok_steps],
+                sampled_ok,
+                fix,
+                scenario,
+            )
+        )
+    return results
+
+
+def _fixed(
+    kap: FloatArray, fix: Fix | None, search: KappaSearch | None, scenario: JumpScenario, t: FloatArray
+) -> FloatArray:
+    """The (N,) schedule ``kap`` after ``fix`` (see :func:`verify_kappa`)."""
     if fix not in (None, "clip", "ramp", "clip+ramp"):
         raise ScenarioError(f"fix must be None, 'clip', 'ramp' or 'clip+ramp'; got {fix!r}")
-    if fix is not None:
-        if search is None:
-            raise ScenarioError(f"verify_kappa: fix={fix!r} needs the search (feasible band, kappa scale)")
-        if "clip" in fix:
-            band = feasible_band(search, t)
-            kap = np.clip(kap, band[:, 0], band[:, 1])
-        if "ramp" in fix:
-            kap = ramp_schedule(kap, scenario.amax * scenario.dt / (2.0 * search.null_max))
-    krows = np.stack([np.zeros(prob.N), kap])
-    healthy = _healthy_runs(prob, krows, progress=progress)
-    table = _table(prob, krows, healthy)
-    steps = np.arange(prob.N)
-    post, order = _post_runs(prob, krows, healthy, np.ones(prob.N, dtype=int), steps, progress=progress)
-    post_ok = _unsort(_ok(prob, post), order)
-    prefix_ok = _step_limits(prob, healthy)[1]
-    ok_steps = post_ok & prefix_ok
-    h_ok = bool(table.healthy_limits_ok[1])
-    sel = np.array([False, True])
-    limits = _limit_report(prob, [healthy, post], [sel, None])
-    before, after = table.joint_jump_norm[0], table.joint_jump_norm[1]
-    sampled_ok = bool(search is not None and np.all(np.isfinite(search.kappa_opt)))
-    return Verification(
-        t,
-        kap,
-        before,
-        after,
-        table.task_jump_noreplan[0],
-        table.task_jump_noreplan[1],
-        float(table.task_jump_replan.max()),
-        jump_reduction(before.mean(), after.mean()),
-        float(np.mean(after < before)),
-        limits,
-        h_ok,
-        ok_steps,
-        t[~ok_steps],
-        sampled_ok,
-        fix,
-        scenario,
-    )
+    if fix is None:
+        return kap
+    if search is None:
+        raise ScenarioError(f"verify_kappa: fix={fix!r} needs the search (feasible band, kappa scale)")
+    if "clip" in fix:
+        band = feasible_band(search, t)
+        kap = np.clip(kap, band[:, 0], band[:, 1])
+    if "ramp" in fix:
+        kap = ramp_schedule(kap, scenario.amax * scenario.dt / (2.0 * search.null_max))
+    return kap

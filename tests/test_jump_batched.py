@@ -1,0 +1,106 @@
+"""Batched time stepping of the jump study (issue 13): stepping runs together -- different
+failure times and kappa in one batch, and runs after a failure branching off the healthy runs
+in the same pass -- gives each run what stepping it alone gives (round-off only)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.derivatives import jacobian_derivatives
+from jointlock.kinematics import chain_state, jacobian
+from jointlock.planning.jump import JumpScenario, compensated_rates, simulate
+from jointlock.planning.jump._control import law
+from jointlock.planning.jump._engine import _branched_runs, _healthy_runs, _integrate, _post_runs, _problem
+
+#: Agreement of a run stepped in a batch and alone, relative to the largest entry [-].
+RTOL = 1e-12
+#: A shorter task keeps the test fast (40 steps; same law).
+TASK = JumpScenario(duration=2.0, blend=0.5, dx=(0.1, -0.12, 0.06))
+#: Runs of the batch: (kappa [rad^2/(s m^3)], failure step).
+RUNS = [(0.0, 0), (3e-3, 7), (-2e-3, 19), (8e-3, 33), (1e-3, 39)]
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _close(a: np.ndarray, b: np.ndarray) -> bool:
+    return bool(np.all(np.abs(a - b) <= RTOL * max(np.abs(b).max(), 1e-300)))
+
+
+@pytest.fixture(scope="module")
+def prob():
+    return _problem(jl.load_robot("canadarm7"), TASK)
+
+
+def test_a_batch_of_runs_equals_each_run_stepped_alone(prob):
+    kap = np.array([k for k, _ in RUNS])
+    steps = np.array([s for _, s in RUNS])
+    B = len(RUNS)
+    out = _integrate(
+        prob,
+        np.repeat(kap[:, None], prob.N, axis=1),
+        np.repeat(prob.q0[None], B, axis=0),
+        None,
+        np.zeros(B, dtype=int),
+        steps[:, None],
+        [prob.lock_col],
+        record=B,
+    )
+    assert out.q is not None and out.qd is not None and out.x is not None
+    for b, (k, step) in enumerate(RUNS):
+        alone = simulate(prob.model, TASK, k, failures=[(TASK.lock_joint, step * TASK.dt)])
+        assert _close(out.q[b], alone.q) and _close(out.qd[b], alone.qd) and _close(out.x[b], alone.x)
+        assert np.all(out.qd[b, step:, prob.lock_col] == 0.0)  # locked from its failure step on
+
+
+def test_runs_branching_off_in_the_same_pass_equal_them_stepped_after(prob):
+    krows = np.repeat(np.array([[0.0], [4e-3], [-1e-3]]), prob.N, axis=1)
+    kidx = np.array([1, 0, 2, 1, 2, 0])
+    fsteps = np.array([25, 3, 0, 38, 12, 25])
+    healthy, post = _branched_runs(prob, krows, kidx, fsteps)
+    # the former way: the healthy runs first, then the post-failure runs from their records
+    h_ref = _healthy_runs(prob, krows)
+    p_ref, order = _post_runs(prob, krows, h_ref, kidx, fsteps)
+    for name in ("q", "qd", "qd_plus", "task_plus", "task_noreplan", "dev", "x"):
+        assert _close(getattr(healthy, name), getattr(h_ref, name)), name
+    for name in ("max_vel", "max_acc", "max_dev", "min_w"):
+        ref = np.empty_like(getattr(p_ref, name))
+        ref[order] = getattr(p_ref, name)
+        assert _close(getattr(post, name), ref), name
+        # and each post-failure run alone, from its own healthy history
+        for r in range(kidx.size):
+            one, _ = _post_runs(prob, krows, h_ref, kidx[r : r + 1], fsteps[r : r + 1])
+            assert _close(getattr(post, name)[r : r + 1], getattr(one, name)), (name, r)
+
+
+def test_the_fixed_base_frames_equal_the_library_kinematics():
+    # arm5 has joints about x and y: the z-joint frames of _FixedChain are not the identity
+    for arm in (jl.load_robot("canadarm7"), jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")):
+        rng = np.random.default_rng(3)
+        q0 = tuple(rng.uniform(-1.0, 1.0, arm.dof))
+        p = _problem(arm, JumpScenario(q0=q0))
+        q = np.asarray(q0) + rng.uniform(-0.5, 0.5, (9, arm.dof))
+        frame = p.frame(q, None)
+        state = chain_state(p.model, q)
+        assert _close(frame.x.T, state.ee_position)
+        assert _close(np.moveaxis(frame.jac, -1, 0), jacobian(p.model, q)[:, :3])
+        assert _close(np.moveaxis(frame.axes, -1, 0), np.swapaxes(state.axes, -1, -2))
+
+
+def test_the_closed_form_gradient_equals_the_derivatives_one():
+    arm = jl.load_robot("canadarm7").fixed()
+    rng = np.random.default_rng(5)
+    q = np.asarray(JumpScenario().q0) + rng.uniform(-0.4, 0.4, (12, arm.dof))
+    healthy = np.ones((12, arm.dof), dtype=bool)
+    healthy[np.arange(12), rng.integers(0, arm.dof, 12)] = False  # one joint locked per run
+    xdot, kappa = rng.normal(size=(12, 3)), rng.normal(size=12)
+    jac = jacobian(arm, q)[:, :3]
+    ref, w_ref = compensated_rates(jac, jacobian_derivatives(arm, q)[:, :, :3], xdot, kappa, healthy)
+    state = chain_state(arm, q)
+    qdot, w, _ = law(np.moveaxis(jac, 0, -1), healthy.T, xdot.T, kappa, axes=np.moveaxis(state.axes, 0, -1).swapaxes(0, 1))
+    assert np.all(np.abs(qdot.T - ref) <= 1e-12 * np.abs(ref).max(axis=1, keepdims=True))
+    assert _close(w, w_ref)
+    assert np.all(qdot.T[~healthy] == 0.0)
