@@ -11,6 +11,7 @@ the user asked for (``--quiet``, ``--json``, whether stderr is a terminal).
 from __future__ import annotations
 
 import importlib.util
+import math
 import shutil
 import sys
 import time
@@ -67,7 +68,7 @@ class Progress:
         self.done = int(initial)
         self._initial = int(initial)
         self._start = time.perf_counter()
-        self._last = 0.0
+        self._last = -math.inf  # the first update logs (perf_counter's zero is arbitrary: boot, on Linux)
         self._bar: Any = None
         if self.enabled:
             # a terminal that reports no size (a fresh pty) would hide the bar or draw it empty
