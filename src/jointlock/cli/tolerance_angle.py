@@ -6,9 +6,8 @@ import argparse
 from pathlib import Path
 
 from ..errors import ScenarioError
-from ..jobs.tolerance_angle import MAX_GAMMA_SAMPLES, find_tolerance_angle, gamma_sample_count
-from ..robots import load_robot
 from ._common import add_robot_arguments, check_out_dir, deg_arg, field_arg, print_json, single_lock
+from ._constants import MAX_GAMMA_SAMPLES
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -59,6 +58,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.tolerance_angle import find_tolerance_angle, gamma_sample_count
+    from ..robots import load_robot
+
     check_out_dir(args.out)
     joint, angle = single_lock(args)
     model = load_robot(args.robot, base=args.base)

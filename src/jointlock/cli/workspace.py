@@ -6,12 +6,9 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..analysis.workspace import MIN_SAMPLES
 from ..errors import ScenarioError
-from ..jobs.workspace import VoxelTooSmallError, study_workspace
-from ..locking import lock_joints
-from ..robots import load_robot
 from ._common import add_robot_arguments, check_out_dir, field_arg, lock_map, print_json, seed_arg
+from ._constants import WORKSPACE_MIN_SAMPLES as MIN_SAMPLES
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -52,6 +49,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.workspace import VoxelTooSmallError, study_workspace
+    from ..locking import lock_joints
+    from ..robots import load_robot
+
     check_out_dir(args.out)
     model = load_robot(args.robot, base=args.base)
     lock_map(args.lock)  # each joint once
