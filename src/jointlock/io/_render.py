@@ -1,11 +1,13 @@
 """One figure, rendered once for its PNG and once for its SVG (issue 13).
 
 ``savefig(..., bbox_inches="tight")`` lays the figure out and draws it twice per file (a dry
-run to measure the drawn content, then the real draw): four draws for a PNG and its SVG, and
-text layout and tick formatting dominate each.  Here the PNG is drawn once by Agg, the tight
-box is measured on that same renderer (its text metrics cached by the draw) and the pixels are
-cropped to it; the SVG is then drawn once inside the same box.  The crop is whole pixels where
-``savefig`` shifts by a fraction of one, so the images agree to within that sub-pixel offset.
+run to measure the artists' extents, then the real draw): four draws for a PNG and its SVG,
+and text layout and tick formatting dominate each.  Here the PNG is drawn once by Agg and
+cropped to the box of the pixels drawn (plus ``savefig.pad_inches``); the SVG is then drawn
+once inside the same box.  The crop is whole pixels and follows the ink rather than the text
+boxes (which include blank ascent and descent), so the images agree with ``savefig``'s to
+within a few pixels of margin.  Content reaching the canvas's edge is measured as ``savefig``
+measures it.
 """
 
 from __future__ import annotations
@@ -73,6 +75,17 @@ def _png_bytes(rgba: np.ndarray, dpi: float) -> bytes:
     return buf.getvalue()
 
 
+def _ink_box(rgba: np.ndarray, face: np.ndarray) -> tuple[int, int, int, int] | None:
+    """(top, bottom, left, right) [pixel, bottom and right exclusive] of what is drawn on the
+    figure's face; None when nothing is, or when the ink reaches the canvas's edge (the content
+    may go on beyond it)."""
+    ink = (rgba != face).any(axis=2)
+    rows, cols = np.flatnonzero(ink.any(axis=1)), np.flatnonzero(ink.any(axis=0))
+    if rows.size == 0 or rows[0] == 0 or cols[0] == 0 or rows[-1] == ink.shape[0] - 1 or cols[-1] == ink.shape[1] - 1:
+        return None
+    return int(rows[0]), int(rows[-1]) + 1, int(cols[0]), int(cols[-1]) + 1
+
+
 def render_png(fig: Any, dpi: float, *, tight: bool = True) -> tuple[bytes, Any]:
     """The figure as PNG bytes, drawn once, and the box it was cropped to.
 
@@ -84,7 +97,9 @@ def render_png(fig: Any, dpi: float, *, tight: bool = True) -> tuple[bytes, Any]
         Resolution [dots per inch].
     tight
         Crop to the drawn content plus ``savefig.pad_inches`` (as ``bbox_inches="tight"``);
-        else the figure's own size.
+        else the figure's own size.  The content is the box of the pixels drawn (not the
+        artists' extents: no second pass over every tick label), unless they reach the
+        canvas's edge.
 
     Returns
     -------
@@ -101,18 +116,22 @@ def render_png(fig: Any, dpi: float, *, tight: bool = True) -> tuple[bytes, Any]
         rgba = np.asarray(canvas.buffer_rgba())
         if not tight:
             return _png_bytes(rgba.copy(), dpi), None
-        content = fig.get_tightbbox(canvas.get_renderer())
         face = np.round(255 * np.asarray(to_rgba(fig.get_facecolor()))).astype(np.uint8)
+        ink = _ink_box(rgba, face)
+        content = None if ink is not None else fig.get_tightbbox(canvas.get_renderer())
     height, width = rgba.shape[:2]
-    # content [pixel, top-left origin]; the crop adds savefig.pad_inches around it
-    left, right = int(np.floor(content.x0 * dpi)), int(np.ceil(content.x1 * dpi))
-    top, bottom = height - int(np.ceil(content.y1 * dpi)), height - int(np.floor(content.y0 * dpi))
-    if left < 0 or top < 0 or right > width or bottom > height:
-        # drawn content beyond the figure's edge: the Agg draw clipped it; savefig grows the canvas
-        box = content.padded(matplotlib.rcParams["savefig.pad_inches"])
-        buf = io.BytesIO()
-        fig.savefig(buf, format="png", dpi=dpi, bbox_inches=box, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
-        return buf.getvalue(), box
+    if ink is not None:
+        top, bottom, left, right = ink
+    else:  # ink at the canvas's edge: the artists' own extents say how far it goes
+        assert content is not None
+        left, right = int(np.floor(content.x0 * dpi)), int(np.ceil(content.x1 * dpi))
+        top, bottom = height - int(np.ceil(content.y1 * dpi)), height - int(np.floor(content.y0 * dpi))
+        if left < 0 or top < 0 or right > width or bottom > height:
+            # drawn content beyond the figure's edge, clipped by the Agg draw: savefig grows the canvas
+            box = content.padded(matplotlib.rcParams["savefig.pad_inches"])
+            buf = io.BytesIO()
+            fig.savefig(buf, format="png", dpi=dpi, bbox_inches=box, pil_kwargs={"compress_level": PNG_COMPRESS_LEVEL})
+            return buf.getvalue(), box
     pad = int(round(matplotlib.rcParams["savefig.pad_inches"] * dpi))
     left, top, right, bottom = left - pad, top - pad, right + pad, bottom + pad
     # the padding may reach past the figure's edge: the figure's face colour there, as savefig
