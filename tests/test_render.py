@@ -103,3 +103,32 @@ def test_a_layout_engine_lays_out_once_and_stays():
     png, svg = figure_files(fig)
     assert fig.get_layout_engine() is engine
     assert ET.fromstring(svg).tag.endswith("svg") and _image(png).size
+
+
+def test_ticks_computed_once_draw_the_same_bytes_and_are_given_back(monkeypatch):
+    """The ticks held fixed while the PNG and the SVG are drawn: the same files as without,
+    and each axis gets its own locator and formatter back (shared axes too)."""
+    import contextlib
+
+    from matplotlib.ticker import ScalarFormatter
+
+    import jointlock.io._render as render
+
+    def make():
+        fig = offscreen_figure((6, 4))
+        axes = fig.subplots(2, 2, sharex=True)
+        for i, ax in enumerate(axes.flat):
+            ax.plot(np.linspace(0, 1e-3, 50), np.sin(np.arange(50) / (i + 2)) * 10 ** (4 * i), label=f"curve {i}")
+            ax.set_ylabel("y [m]")
+        axes[0, 0].legend()
+        fig.tight_layout()
+        return fig
+
+    fig = make()
+    before = [(a.get_major_locator(), a.get_major_formatter()) for ax in fig.axes for a in (ax.xaxis, ax.yaxis)]
+    frozen = render.render_files(fig, PNG_DPI)
+    after = [(a.get_major_locator(), a.get_major_formatter()) for ax in fig.axes for a in (ax.xaxis, ax.yaxis)]
+    assert all(b[0] is a[0] and b[1] is a[1] for b, a in zip(before, after))
+    assert isinstance(fig.axes[3].yaxis.get_major_formatter(), ScalarFormatter)
+    monkeypatch.setattr(render, "_frozen_ticks", lambda fig: contextlib.nullcontext())
+    assert render.render_files(make(), PNG_DPI) == frozen  # offset texts (1e8, 1e-3) included

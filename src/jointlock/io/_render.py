@@ -60,6 +60,36 @@ def _agg_canvas(fig: Any, dpi: float) -> Iterator[Any]:
 PNG_COMPRESS_LEVEL = 3
 
 
+@contextmanager
+def _frozen_ticks(fig: Any) -> Iterator[None]:
+    """Each axis's major ticks and labels computed once, as the draw would compute them, and
+    held fixed while the figure is drawn (undone after).  A draw asks for them about ten times
+    per axis (the axis, its label, the title, the shared axes' boxes), each time running the
+    locator and formatting every label again; the drawn figure is the same, byte for byte.
+    Only plain 2-D axes of a figure without a layout engine (which would move them in the draw)."""
+    from matplotlib.ticker import FixedFormatter, FixedLocator
+
+    undo: list[tuple[Any, Any, Any]] = []
+    if fig.get_layout_engine() is None:
+        for ax in fig.axes:
+            if ax.name != "rectilinear" or ax.get_aspect() != "auto":  # a draw may change their limits
+                continue
+            for axis in (ax.xaxis, ax.yaxis):
+                locator, formatter = axis.get_major_locator(), axis.get_major_formatter()
+                locs = list(locator())
+                fixed = FixedFormatter(formatter.format_ticks(locs))
+                fixed.set_offset_string(formatter.get_offset())
+                undo.append((axis, locator, formatter))
+                axis.set_major_locator(FixedLocator(locs))
+                axis.set_major_formatter(fixed)
+    try:
+        yield
+    finally:
+        for axis, locator, formatter in reversed(undo):  # shared axes share one ticker: last set, first undone
+            axis.set_major_locator(locator)
+            axis.set_major_formatter(formatter)
+
+
 def _png_bytes(rgba: np.ndarray, dpi: float) -> bytes:
     """PNG of an RGBA pixel array with ``savefig``'s metadata; RGB when every pixel is opaque
     (a figure on its white face: a quarter fewer bytes to compress, the same picture)."""
@@ -111,7 +141,7 @@ def render_png(fig: Any, dpi: float, *, tight: bool = True) -> tuple[bytes, Any]
     from matplotlib.colors import to_rgba
     from matplotlib.transforms import Bbox
 
-    with _agg_canvas(fig, dpi) as canvas:
+    with _agg_canvas(fig, dpi) as canvas, _frozen_ticks(fig):
         canvas.draw()
         rgba = np.asarray(canvas.buffer_rgba())
         if not tight:
@@ -172,6 +202,15 @@ def render_svg(fig: Any, dpi: float, bbox: Any | None) -> bytes:
 
     buf = io.BytesIO()
     # no date and fixed element ids: the same figure gives the same bytes (diffable, reproducible)
-    with _dense_rasterized(fig), _no_layout_engine(fig), matplotlib.rc_context({"svg.hashsalt": "jointlock"}):
+    with _dense_rasterized(fig), _no_layout_engine(fig), _frozen_ticks(fig), \
+            matplotlib.rc_context({"svg.hashsalt": "jointlock"}):  # fmt: skip
         fig.savefig(buf, format="svg", dpi=dpi, metadata={"Date": None}, bbox_inches=bbox)
     return buf.getvalue()
+
+
+def render_files(fig: Any, dpi: float, *, tight: bool = True) -> tuple[bytes, bytes]:
+    """The figure as PNG (:func:`render_png`) and SVG (:func:`render_svg`) of the same extent,
+    the ticks computed once for both."""
+    with _frozen_ticks(fig):
+        png, bbox = render_png(fig, dpi, tight=tight)
+        return png, render_svg(fig, dpi, bbox)

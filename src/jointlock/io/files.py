@@ -24,7 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..bounds import shorten  # noqa: F401  (used here, and by the readers)
-from ._render import SVG_RASTER_POINTS, render_png, render_svg  # noqa: F401  (SVG_RASTER_POINTS re-exported)
+from ._render import SVG_RASTER_POINTS, render_files, render_png, render_svg  # noqa: F401  (SVG_RASTER_POINTS re-exported)
 
 #: Resolution of every PNG written [dots per inch].
 PNG_DPI = 110
@@ -304,6 +304,8 @@ def figure_files(fig: Any, *, dpi: int = PNG_DPI, tight: bool = True) -> tuple[b
     """The figure as PNG and SVG bytes of the same extent, each drawn once (the SVG's box is
     the one measured on the PNG's draw).  ``tight``: crop to the drawn content (else the
     figure's own size).  The figure is left as it was."""
+    if dpi == PNG_DPI:
+        return render_files(fig, dpi, tight=tight)
     png, bbox = render_png(fig, dpi, tight=tight)
     return png, render_svg(fig, PNG_DPI, bbox)
 
@@ -324,10 +326,12 @@ def write_figure(fig: Any, folder: str | Path, name: str, *, dpi: int = PNG_DPI,
 def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = PNG_DPI, svg: bool = True) -> bytes:
     """Write ``folder/stem.png`` (and ``folder/stem.svg`` unless ``svg=False``) atomically;
     returns the PNG bytes (to embed in a report).  The figure is left open."""
-    png, bbox = render_png(fig, dpi)
+    if not svg:
+        png = render_png(fig, dpi)[0]
+    else:
+        png, svg_bytes = figure_files(fig, dpi=dpi)
+        atomic_write_bytes(Path(folder) / f"{stem}.svg", svg_bytes)
     atomic_write_bytes(Path(folder) / f"{stem}.png", png)
-    if svg:
-        atomic_write_bytes(Path(folder) / f"{stem}.svg", render_svg(fig, PNG_DPI, bbox))
     return png
 
 
