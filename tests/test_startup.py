@@ -5,6 +5,7 @@ it needs them.  (What it costs is measured in benchmarks/, not asserted here.)""
 from __future__ import annotations
 
 import argparse
+import os
 import subprocess
 import sys
 
@@ -14,7 +15,10 @@ from jointlock.cli import COMMANDS, build_parser
 def _imported_after(code: str) -> set[str]:
     """The modules imported by ``code`` in a fresh interpreter (printed one per line)."""
     script = f"import sys\n{code}\nprint('\\n'.join(sorted(sys.modules)))"
-    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env={"MPLBACKEND": "Agg", "PATH": ""})
+    env = {"MPLBACKEND": "Agg", "PATH": ""}
+    if "PYTHONPATH" in os.environ:  # the checkout under test, not an installed copy
+        env["PYTHONPATH"] = os.environ["PYTHONPATH"]
+    out = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120, env=env)
     return set(out.stdout.split())
 
 
@@ -55,3 +59,53 @@ def test_only_the_named_command_is_parsed_in_full():
     parsers = _subparsers(build_parser(["robots", "--json"]))
     assert any("--json" in a.option_strings for a in parsers["robots"]._actions)
     assert not any("--samples" in a.option_strings for a in parsers["halt-config"]._actions)  # a listing
+
+
+def test_no_command_s_help_imports_numpy():
+    """A command's parser is built from the light modules only; the library (numpy, scipy,
+    matplotlib behind it) is imported once its options are parsed."""
+    code = (
+        "from jointlock.cli import COMMANDS, main\n"
+        "import contextlib, io\n"
+        "for name in COMMANDS:\n"
+        "    with contextlib.suppress(SystemExit), contextlib.redirect_stdout(io.StringIO()):\n"
+        "        main([name, '--help'])"
+    )
+    mods = _imported_after(code)
+    assert all(f"jointlock.cli.{module}" in mods for module, _ in COMMANDS.values())
+    assert "numpy" not in mods, sorted(m for m in mods if m.startswith("jointlock"))
+
+
+def test_the_parsers_constants_are_the_library_s():
+    """jointlock.cli._constants copies what the parsers print (no drift)."""
+    from jointlock.analysis import singularity as sg
+    from jointlock.analysis.workspace import MIN_SAMPLES
+    from jointlock.cli import _constants as c
+    from jointlock.cli.halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG
+    from jointlock.jobs import halt, jump
+    from jointlock.jobs.reproduction import PAPERS
+    from jointlock.jobs.tolerance_angle import MAX_GAMMA_SAMPLES
+    from jointlock.planning.replan import DEFAULT_STEP_WEIGHT
+    from jointlock.robots import BUILTIN_ROBOTS
+    from jointlock.scenario import JOB_ORDER, MAX_ABS_DEG
+
+    assert c.BUILTIN_ROBOTS == BUILTIN_ROBOTS and c.MIN_N_SAMPLES == halt.MIN_N_SAMPLES
+    assert (c.KAPPA_UNIT, c.MAX_ORDER, c.DEFAULT_ORDER, c.DEFAULT_SWEEP) == (
+        jump.KAPPA_UNIT, jump.MAX_ORDER, jump.DEFAULT_ORDER, jump.DEFAULT_SWEEP)  # fmt: skip
+    assert (c.DEFAULT_STEP_WEIGHT, c.MAX_ABS_DEG, c.JOB_ORDER, c.PAPERS) == (
+        DEFAULT_STEP_WEIGHT, MAX_ABS_DEG, JOB_ORDER, PAPERS)  # fmt: skip
+    assert (c.SINGULAR_BASE_KINDS, c.RANK_TOL, c.WORKSPACE_MIN_SAMPLES) == (sg.BASE_KINDS, sg.RANK_TOL, MIN_SAMPLES)
+    assert (DEFAULT_VMAX_DEG, DEFAULT_AMAX_DEG) == (halt.DEFAULT_VMAX_DEG, halt.DEFAULT_AMAX_DEG)
+    assert c.MAX_GAMMA_SAMPLES == MAX_GAMMA_SAMPLES
+
+
+def test_the_former_imports_of_the_command_modules_still_resolve():
+    from jointlock.cli import _common, demo
+    from jointlock.cli import halt as cli_halt
+    from jointlock.cli import jump as cli_jump
+    from jointlock.jobs import halt, jump
+
+    assert cli_halt.resolve_limits is halt.resolve_limits and cli_halt.plan_halt is halt.plan_halt
+    assert cli_jump._points_text is jump._points_text and callable(cli_jump.load_scenario)
+    assert callable(demo.run_demo) and callable(_common.joint_vector_deg) and callable(_common.json_text)
+    assert _common.deg_arg("12") == 12.0 and _common.seed_arg("3") == 3 and _common.seed_arg.__name__ == "int"

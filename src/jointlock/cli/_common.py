@@ -4,22 +4,45 @@ output folders, JSON output and atomic figure files."""
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import math
 import sys
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from ..bounds import MAX_OPTION_DEG
+from .._lazy import lazy_attributes
+from ..bounds import MAX_OPTION_DEG, shorten
 from ..errors import ScenarioError
-from ..io.files import json_text, shorten, write_png  # noqa: F401  (write_png re-exported)
-from ..io.files import to_plain as _plain  # noqa: F401  (old name)
-from ..jobs._common import format_matrix, joint_vector_deg, locked_deg, locked_text  # noqa: F401  (re-exported)
-from ..locking import lock_joints
-from ..model import ArmModel
-from ..robots import BUILTIN_ROBOTS, UrdfChain, load_robot
-from ..scenario import ALL_TABLES, TOP_FIELDS, Field, check_value
+from ._constants import BUILTIN_ROBOTS
+
+if TYPE_CHECKING:
+    from ..model import ArmModel
+    from ..robots import UrdfChain
+    from ..scenario import Field
+
+# The library (numpy behind it) is imported on first use, never to build a parser: these names
+# are re-exported for the subcommands' run functions and older callers.
+__getattr__, __dir__ = lazy_attributes(
+    __name__,
+    {
+        "json_text": "jointlock.io.files",
+        "write_png": "jointlock.io.files",
+        "format_matrix": "jointlock.jobs._common",
+        "joint_vector_deg": "jointlock.jobs._common",
+        "locked_deg": "jointlock.jobs._common",
+        "locked_text": "jointlock.jobs._common",
+        "load_robot": "jointlock.robots",
+        "lock_joints": "jointlock.locking",
+    },
+    namespace=globals(),
+)
+
+
+def _plain(obj: Any) -> Any:
+    """Former name of :func:`jointlock.io.files.to_plain`."""
+    from ..io.files import to_plain
+
+    return to_plain(obj)
 
 
 def parse_lock(text: str) -> tuple[int, float]:
@@ -56,11 +79,18 @@ def int_at_least(minimum: int) -> Callable[[str], int]:
 def field_arg(table: str, name: str) -> Callable[[str], Any]:
     """An argparse type checking an option against its scenario field ``[table] name``: the
     same kind, bounds and unit as in a scenario file (so ``--samples``, ``--T``, ``--voxel``
-    ... refuse what ``jointlock run`` refuses).  A list field is checked value by value."""
-    spec = ALL_TABLES[table][name] if table else TOP_FIELDS[name]
-    if spec.kind == "numbers":
-        spec = dataclasses.replace(spec, kind="number", length=None)
-    return _spec_arg(spec)
+    ... refuse what ``jointlock run`` refuses).  A list field is checked value by value.  The
+    field is looked up when a value is parsed (the schema is not needed to print ``--help``)."""
+
+    def spec() -> Field:
+        import dataclasses
+
+        from ..scenario import ALL_TABLES, TOP_FIELDS
+
+        field = ALL_TABLES[table][name] if table else TOP_FIELDS[name]
+        return dataclasses.replace(field, kind="number", length=None) if field.kind == "numbers" else field
+
+    return _SpecArg(spec)
 
 
 def number_arg(
@@ -73,11 +103,43 @@ def number_arg(
 ) -> Callable[[str], Any]:
     """An argparse type: a finite number (an integer with ``integer=True``) within the bounds."""
     kind = "int" if integer else "number"
-    return _spec_arg(Field(kind, lo=lo, hi=hi, lo_open=lo_open, unit=unit))
+
+    def spec() -> Field:
+        from ..scenario import Field
+
+        return Field(kind, lo=lo, hi=hi, lo_open=lo_open, unit=unit)
+
+    return _SpecArg(spec, kind)
 
 
-def _spec_arg(spec: Field) -> Callable[[str], Any]:
-    def parse(text: str) -> Any:
+class _SpecArg:
+    """An argparse type checking a value against a scenario :class:`~jointlock.scenario.Field`
+    made on first use by ``spec``; named by the field's kind once known (argparse names the
+    type in its own messages)."""
+
+    def __init__(self, spec: Callable[[], Field], kind: str | None = None) -> None:
+        self._make = spec
+        self._spec: Field | None = None
+        self._kind = kind
+
+    @property
+    def spec(self) -> Field:
+        if self._spec is None:
+            self._spec = self._make()
+        return self._spec
+
+    @property
+    def __name__(self) -> str:
+        # argparse asks for it when it expands any help text, before a value is parsed: the
+        # field is not looked up for that (its kind names the type once it has been)
+        if self._kind is None and self._spec is not None:
+            self._kind = self._spec.kind
+        return self._kind or "value"
+
+    def __call__(self, text: str) -> Any:
+        from ..scenario import check_value
+
+        spec = self.spec
         try:
             value: Any = int(text) if spec.kind == "int" else float(text)
         except ValueError:
@@ -86,9 +148,6 @@ def _spec_arg(spec: Field) -> Callable[[str], Any]:
             return check_value(value, spec, "value")
         except ScenarioError:  # said with the text as typed (not as converted: 1e400 -> inf)
             raise argparse.ArgumentTypeError(f"must be {spec.allowed()}; got {shorten(text)!r}") from None
-
-    parse.__name__ = spec.kind  # argparse names the type in its own messages
-    return parse
 
 
 #: argparse type of every joint-space vector option in degrees (``--q-deg``, ``--from-deg`` ...):
@@ -210,6 +269,7 @@ def chain_from_args(args: argparse.Namespace) -> UrdfChain | None:
         what = "a built-in robot" if robot in BUILTIN_ROBOTS else "not a .urdf file (a .toml model file names its chain itself)"
         raise ScenarioError(f"--root, --tip and --freeze choose the chain of a URDF robot; ROBOT {shorten(robot)!r} is {what}")
     from ..io.urdf import urdf_joint_types
+    from ..robots import UrdfChain
 
     types = urdf_joint_types(robot)
     seen: dict[str, float] = {}
@@ -223,6 +283,11 @@ def chain_from_args(args: argparse.Namespace) -> UrdfChain | None:
 
 
 def model_from_args(args: argparse.Namespace) -> ArmModel:
+    """The robot of ``args`` (ROBOT, ``--base``, ``--root``/``--tip``/``--freeze``), with its
+    ``--lock`` joints locked."""
+    from ..locking import lock_joints
+    from ..robots import load_robot
+
     model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     locks = lock_map(getattr(args, "lock", []))
     return lock_joints(model, locks) if locks else model
@@ -230,4 +295,6 @@ def model_from_args(args: argparse.Namespace) -> ArmModel:
 
 def print_json(obj: Any) -> None:
     """Print one JSON object (non-finite floats become null)."""
+    from ..io.files import json_text
+
     sys.stdout.write(json_text(obj))

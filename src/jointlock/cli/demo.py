@@ -10,7 +10,14 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..run._demo import DEMO_SCENARIO, REFERENCE_Q_DEG, lock_equivalence, run_demo  # noqa: F401  (re-exported)
+from .._lazy import lazy_attributes
+
+# re-exported, imported on first use (the parser is built without the library)
+__getattr__, __dir__ = lazy_attributes(
+    __name__,
+    {name: "jointlock.run._demo" for name in ("DEMO_SCENARIO", "REFERENCE_Q_DEG", "lock_equivalence", "run_demo")},
+    namespace=globals(),
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -21,6 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..run._demo import run_demo
+
     out = Path(args.out)
     demo = run_demo(progress=not args.quiet and sys.stderr.isatty())
     demo.write(out)

@@ -9,7 +9,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-from ..io.urdf_export import write_urdf
 from ._common import add_robot_arguments, model_from_args, print_json
 
 
@@ -34,6 +33,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..io.urdf_export import write_urdf
+
     model = model_from_args(args)
     path = write_urdf(model, args.out)
     facts: dict[str, Any] = {

@@ -13,37 +13,45 @@ import math
 import sys
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from .._lazy import lazy_attributes
 from ..errors import ScenarioError
-from ..jobs.halt import (
-    CLI_NAMES,
-    DEFAULT_AMAX_DEG,
-    DEFAULT_VMAX_DEG,
-    MIN_N_SAMPLES,
-    FailureState,
-    HaltPlan,
-    check_halt_settings,
-    halt_model,
-    is_000_failure,
-    limits_text,  # noqa: F401  (re-exported)
-    plan_halt,
-    resolve_limits,  # noqa: F401  (re-exported)
-)
 from ..papers import p000
-from ..planning.ga import GASettings
 from ._common import (
     add_robot_arguments,
     chain_from_args,
     check_out_dir,
     deg_arg,
     field_arg,
-    joint_vector_deg,
     lock_map,
-    locked_text,
     print_json,
     seed_arg,
 )
+from ._constants import MIN_N_SAMPLES
+
+if TYPE_CHECKING:
+    from ..jobs.halt import HaltPlan
+
+# The library is imported once the options are parsed (not to print --help); these names,
+# formerly imported here, are re-exported on first use.
+__getattr__, __dir__ = lazy_attributes(
+    __name__,
+    {
+        **{name: "jointlock.jobs.halt" for name in (
+            "CLI_NAMES", "FailureState", "HaltPlan", "check_halt_settings", "halt_model", "is_000_failure",
+            "limits_text", "plan_halt", "resolve_limits")},
+        "GASettings": "jointlock.planning.ga",
+        "joint_vector_deg": "jointlock.jobs._common",
+        "locked_text": "jointlock.jobs._common",
+    },
+    namespace=globals(),
+)  # fmt: skip
+
+#: 000's speed and acceleration limits, the halt's defaults where a model gives none
+#: (:data:`jointlock.jobs.halt.DEFAULT_VMAX_DEG`, ``DEFAULT_AMAX_DEG``) [deg/s, deg/s^2].
+DEFAULT_VMAX_DEG = p000.VELOCITY_LIMIT_DEG_S
+DEFAULT_AMAX_DEG = p000.ACCELERATION_LIMIT_DEG_S2
 
 #: 000 §5.1-5.2 scenario on halt7 (healthy joints 1, 2, 3, 5, 6, 7) [deg, deg/s, deg/s^2, s].
 PAPER_SCENARIO: dict[str, Any] = {
@@ -219,6 +227,17 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     """The options as :func:`plan_halt`'s inputs (errors name the options), and its result."""
+    from ..jobs._common import joint_vector_deg, locked_text
+    from ..jobs.halt import (
+        CLI_NAMES,
+        FailureState,
+        check_halt_settings,
+        halt_model,
+        is_000_failure,
+        plan_halt,
+    )
+    from ..planning.ga import GASettings
+
     ga = GASettings(n_pop=args.population, n_gen=args.generations)
     check_halt_settings(args.T, args.n_samples, args.samples, args.solver, ga, CLI_NAMES)
     paper_lock = {j: math.radians(a) for j, a in PAPER_SCENARIO["lock"].items()}

@@ -5,21 +5,22 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from ..errors import ScenarioError
-from ..jobs.halt import CLI_LIMIT_NAMES, DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, FailureState
-from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, ReachabilitySettings, study_halt_configuration
 from ..papers import p000
 from ._common import (
     add_robot_arguments,
     deg_arg,
     field_arg,
-    joint_vector_deg,
     model_from_args,
     print_json,
     seed_arg,
 )
-from .halt import LIMITS_HELP
+from .halt import DEFAULT_AMAX_DEG, DEFAULT_VMAX_DEG, LIMITS_HELP
+
+if TYPE_CHECKING:
+    from ..jobs.halt_config import ReachabilitySettings
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -125,8 +126,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _reachability(args: argparse.Namespace, model) -> ReachabilitySettings | None:
+def _reachability(args: argparse.Namespace, model: Any) -> ReachabilitySettings | None:
     """The reachability options as typed settings (checked and named as options), or None."""
+    from ..jobs._common import joint_vector_deg
+    from ..jobs.halt import FailureState
+    from ..jobs.halt_config import ReachabilitySettings
+
     given = [args.from_q_deg is not None, args.halt_time is not None]
     if not any(given):
         if args.from_dq_deg is not None or getattr(args, "from_ddq_deg", None) is not None:
@@ -148,6 +153,9 @@ def _reachability(args: argparse.Namespace, model) -> ReachabilitySettings | Non
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.halt import CLI_LIMIT_NAMES
+    from ..jobs.halt_config import PROGRESS_MIN_SAMPLES, study_halt_configuration
+
     model = model_from_args(args)
     if not model.locked:
         raise ScenarioError("halt-config needs a locked joint: add --lock J=DEG (e.g. --lock 4=0)")

@@ -4,13 +4,10 @@
 from __future__ import annotations
 
 import argparse
-
-import numpy as np
+from typing import Any
 
 from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M
 from ..errors import ScenarioError
-from ..ik import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, pose_from_zyx
-from ..jobs.ik import inverse_kinematics
 from ._common import add_robot_arguments, model_from_args, number_arg, print_json, seed_arg
 
 
@@ -78,7 +75,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-def _target(args: argparse.Namespace) -> np.ndarray:
+def _target(args: argparse.Namespace) -> Any:
+    """The target pose (4x4) of ``--pose`` or ``--matrix`` (checked, re-orthonormalised)."""
+    import numpy as np
+
+    from ..ik import pose_from_zyx
+
     if args.pose is not None:
         vals = np.asarray(args.pose, dtype=float)
         return pose_from_zyx(vals[:3], np.radians(vals[3:]))
@@ -99,6 +101,11 @@ def _target(args: argparse.Namespace) -> np.ndarray:
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ..ik import EXACT_POSITION_TOL, EXACT_ROTATION_TOL
+    from ..jobs.ik import inverse_kinematics
+
     model = model_from_args(args)
     tolerance = None
     if args.tol_mm is not None or args.tol_deg is not None:  # the one not given: exact

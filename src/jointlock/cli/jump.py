@@ -14,25 +14,31 @@ from __future__ import annotations
 
 import argparse
 import warnings
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
+from .._lazy import lazy_attributes
 from ..errors import ScenarioError
-from ..io.files import read_toml_file
-from ..jobs.jump import (  # noqa: F401  (KAPPA_UNIT, MAX_ORDER and the text helpers re-exported)
-    DEFAULT_ORDER,
-    DEFAULT_SWEEP,
-    KAPPA_UNIT,
-    MAX_ORDER,
-    _interval_text,
-    _less,
-    _points_text,
-    run_jump_study,
-)
 from ..papers import p001
-from ..planning.jump import JumpScenario, scenario_from_mapping
-from ..planning.jump import load_jump_task as load_scenario
-from ..robots import load_robot
 from ._common import add_robot_arguments, chain_from_args, check_out_dir, field_arg, number_arg, print_json
+from ._constants import DEFAULT_ORDER, DEFAULT_SWEEP, KAPPA_UNIT, MAX_ORDER
+
+if TYPE_CHECKING:
+    from ..planning.jump import JumpScenario
+
+# The library is imported once the options are parsed (not to print --help); the text helpers,
+# formerly imported here, are re-exported on first use.
+__getattr__, __dir__ = lazy_attributes(
+    __name__,
+    {"_interval_text": "jointlock.jobs.jump", "_less": "jointlock.jobs.jump", "_points_text": "jointlock.jobs.jump"},
+    namespace=globals(),
+)
+
+
+def load_scenario(path: str) -> JumpScenario:
+    """:func:`jointlock.planning.jump.load_jump_task` (this module's former name for it)."""
+    from ..planning.jump import load_jump_task
+
+    return load_jump_task(path)
 
 #: A start of the example task shown when a robot needs its own q0_deg (NOTES-001's start,
 #: cut or padded with zeros to the robot's joints).
@@ -132,6 +138,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _scenario(args: argparse.Namespace) -> JumpScenario:
+    from ..planning.jump import JumpScenario, scenario_from_mapping
+
     sc = load_scenario(args.scenario) if args.scenario else JumpScenario()
     fields = sc.to_fields()
     if args.lock_joint is not None:
@@ -169,6 +177,8 @@ def _check_q0(args: argparse.Namespace, sc: JumpScenario, model: Any) -> None:
 
 
 def _file_fields(path: str) -> set[str]:
+    from ..io.files import read_toml_file
+
     try:
         return set(read_toml_file(path, "scenario file", ScenarioError))
     except ScenarioError:  # read before, by load_jump_task
@@ -199,6 +209,9 @@ def _warn_ignored(args: argparse.Namespace) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.jump import run_jump_study
+    from ..robots import load_robot
+
     out_dir = check_out_dir(args.out)
     sc = _scenario(args)
     model = load_robot(args.robot, base=sc.base, chain=chain_from_args(args))

@@ -5,8 +5,7 @@ from __future__ import annotations
 
 import argparse
 
-from ..jobs.kinematics import describe_configuration
-from ._common import add_robot_arguments, deg_arg, joint_vector_deg, model_from_args, print_json
+from ._common import add_robot_arguments, deg_arg, model_from_args, print_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -28,6 +27,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs._common import joint_vector_deg
+    from ..jobs.kinematics import describe_configuration
+
     model = model_from_args(args)
     report = describe_configuration(model, joint_vector_deg(model, args.q_deg, "--q-deg"))
     if args.json:

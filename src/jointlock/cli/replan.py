@@ -6,14 +6,8 @@ import argparse
 import math
 from pathlib import Path
 
-import numpy as np
-
 from ..bounds import MAX_LENGTH_M
 from ..errors import ScenarioError
-from ..jobs.replan import plan_replan
-from ..planning.replan import DEFAULT_STEP_WEIGHT
-from ..robots import load_robot
-from ..scenario import MAX_ABS_DEG
 from ._common import (
     add_robot_arguments,
     chain_from_args,
@@ -24,6 +18,7 @@ from ._common import (
     print_json,
     single_lock,
 )
+from ._constants import DEFAULT_STEP_WEIGHT, MAX_ABS_DEG
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -101,6 +96,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    import numpy as np
+
+    from ..jobs.replan import plan_replan
+    from ..robots import load_robot
+
     check_out_dir(args.out)
     joint, angle = single_lock(args)
     full = load_robot(args.robot, base=args.base, chain=chain_from_args(args))

@@ -9,8 +9,8 @@ from __future__ import annotations
 
 import argparse
 
-from ..jobs.reproduction import PAPERS, reproduce
 from ._common import print_json
+from ._constants import PAPERS
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -30,6 +30,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.reproduction import reproduce
+
     result = reproduce(args.paper or PAPERS)
     if args.json:
         print_json(result.to_dict())

@@ -4,9 +4,6 @@ from __future__ import annotations
 
 import argparse
 
-import numpy as np
-
-from ..robots import BUILTIN_ROBOTS, load_robot
 from ._common import print_json
 
 
@@ -17,6 +14,11 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def describe(name: str) -> dict:
+    """One built-in arm's row: DOF, link masses and lengths, reach, spacecraft mass, reading."""
+    import numpy as np
+
+    from ..robots import load_robot
+
     fixed = load_robot(name)
     floating = load_robot(name, base="floating")
     lengths = [float(np.linalg.norm(j.placement[:3, 3])) for j in fixed.joints[1:]] + [
@@ -34,6 +36,8 @@ def describe(name: str) -> dict:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..robots import BUILTIN_ROBOTS
+
     rows = [describe(name) for name in BUILTIN_ROBOTS]
     if args.json:
         print_json({"robots": rows})

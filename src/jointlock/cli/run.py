@@ -14,10 +14,8 @@ import sys
 from typing import Any
 
 from ..errors import ScenarioError
-from ..run import default_out_dir, run_scenario
-from ..run._summary import summary_lines
-from ..scenario import JOB_ORDER, load_scenario, parse_set
 from ._common import check_out_dir, parse_lock, print_json, seed_arg
+from ._constants import JOB_ORDER
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -61,6 +59,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
     """Command-line options as ``{"table.field": value}`` overrides of the file."""
+    from ..scenario import parse_set
+
     out: dict[str, Any] = dict(parse_set(s) for s in args.set)
     if args.robot is not None:
         out["robot"] = args.robot
@@ -84,6 +84,10 @@ def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..run import default_out_dir, run_scenario
+    from ..run._summary import summary_lines
+    from ..scenario import load_scenario
+
     scenario = load_scenario(args.scenario, overrides_from_args(args))
     out = default_out_dir(scenario)
     check_out_dir(out, "--out" if args.out is not None else "output folder (out)")

@@ -11,32 +11,25 @@ import argparse
 import sys
 import warnings
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from ..analysis import singularity as sg
 from ..errors import ScenarioError
-from ..jobs.singular import (
-    SEARCH_SAMPLES,
-    VERIFY_SAMPLES,
-    SingularitySearchResult,
-    SingularJobResult,
-    search_singularities,
-    singular_model,
-    study_singularity,
-    verify_singularity_conditions,
-)
-from ..locking import lock_joints
-from ..model import ArmModel
 from ._common import (
     add_robot_arguments,
     chain_from_args,
     check_out_dir,
     deg_arg,
     field_arg,
-    joint_vector_deg,
     lock_map,
     print_json,
     seed_arg,
 )
+from ._constants import RANK_TOL, SINGULAR_BASE_KINDS
+
+if TYPE_CHECKING:
+    from ..analysis.singularity import BaseKind
+    from ..jobs.singular import SingularJobResult
+    from ..model import ArmModel
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -52,7 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     add_robot_arguments(
         p,
-        base_choices=sg.BASE_KINDS,
+        base_choices=SINGULAR_BASE_KINDS,
         base_default=None,
         base_help="fixed, floating (generalized Jacobian) or virtual (virtual manipulator); "
         "default: virtual with --verify-conditions, fixed otherwise",
@@ -69,8 +62,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--tol",
         type=field_arg("singular", "tol"),
-        default=sg.RANK_TOL,
-        help=f"rank tolerance on singular values (default {sg.RANK_TOL:g})",
+        default=RANK_TOL,
+        help=f"rank tolerance on singular values (default {RANK_TOL:g})",
     )
     p.add_argument(
         "--length",
@@ -102,6 +95,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def _model(args: argparse.Namespace, base: str) -> ArmModel:
+    from ..jobs.singular import singular_model
+    from ..locking import lock_joints
+
     model = singular_model(args.robot, None, base, chain=chain_from_args(args))
     locks = lock_map(args.lock)
     return lock_joints(model, locks) if locks else model
@@ -112,11 +108,21 @@ def _progress(args: argparse.Namespace) -> bool:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs._common import joint_vector_deg
+    from ..jobs.singular import (
+        SEARCH_SAMPLES,
+        VERIFY_SAMPLES,
+        SingularitySearchResult,
+        search_singularities,
+        study_singularity,
+        verify_singularity_conditions,
+    )
+
     check_out_dir(args.out)
     if args.out is not None and not args.search:
         warnings.warn("--out: nothing written (only --search writes files: search.json and plots)", UserWarning, stacklevel=1)
     if args.verify_conditions:
-        base: sg.BaseKind = args.base or "virtual"
+        base: BaseKind = args.base or "virtual"
         if base == "floating":
             raise ScenarioError(
                 "--verify-conditions needs --base virtual (004's case) or fixed; got floating"

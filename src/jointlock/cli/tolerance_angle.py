@@ -6,8 +6,6 @@ import argparse
 from pathlib import Path
 
 from ..errors import ScenarioError
-from ..jobs.tolerance_angle import MAX_GAMMA_SAMPLES, find_tolerance_angle, gamma_sample_count
-from ..robots import load_robot
 from ._common import (
     add_robot_arguments,
     chain_from_args,
@@ -17,6 +15,7 @@ from ._common import (
     print_json,
     single_lock,
 )
+from ._constants import MAX_GAMMA_SAMPLES
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -67,6 +66,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.tolerance_angle import find_tolerance_angle, gamma_sample_count
+    from ..robots import load_robot
+
     check_out_dir(args.out)
     joint, angle = single_lock(args)
     model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))

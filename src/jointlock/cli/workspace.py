@@ -6,11 +6,7 @@ import argparse
 import sys
 from pathlib import Path
 
-from ..analysis.workspace import MIN_SAMPLES
 from ..errors import ScenarioError
-from ..jobs.workspace import VoxelTooSmallError, study_workspace
-from ..locking import lock_joints
-from ..robots import load_robot
 from ._common import (
     add_robot_arguments,
     chain_from_args,
@@ -20,6 +16,7 @@ from ._common import (
     print_json,
     seed_arg,
 )
+from ._constants import WORKSPACE_MIN_SAMPLES as MIN_SAMPLES
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -60,6 +57,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from ..jobs.workspace import VoxelTooSmallError, study_workspace
+    from ..locking import lock_joints
+    from ..robots import load_robot
+
     check_out_dir(args.out)
     model = load_robot(args.robot, base=args.base, chain=chain_from_args(args))
     lock_map(args.lock)  # each joint once

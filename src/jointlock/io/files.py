@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from ..bounds import shorten  # noqa: F401  (used here, and by the readers)
+from ._render import SVG_RASTER_POINTS, render_files, render_png, render_svg  # noqa: F401  (SVG_RASTER_POINTS re-exported)
 
 #: Resolution of every PNG written [dots per inch].
 PNG_DPI = 110
@@ -281,42 +282,17 @@ def npz_bytes(*, compressed: bool = False, **arrays: Any) -> bytes:
 
 
 def figure_png(fig: Any, dpi: int = PNG_DPI) -> bytes:
-    """The figure as PNG bytes (tight bounding box)."""
-    buf = io.BytesIO()
-    fig.savefig(buf, format="png", dpi=dpi, bbox_inches="tight")
-    return buf.getvalue()
-
-
-#: A scatter of more points than this is drawn as an image inside the SVG (axes, labels and
-#: lines stay vector): a workspace cloud or 36,000 samples as vector marks would be megabytes.
-SVG_RASTER_POINTS = 2000
+    """The figure as PNG bytes (tight bounding box), drawn once (:func:`render_png`)."""
+    return render_png(fig, dpi)[0]
 
 
 def figure_svg(fig: Any, *, tight: bool = True) -> bytes:
     """The figure as SVG (text kept as paths, so it renders the same everywhere); scatters of
     more than :data:`SVG_RASTER_POINTS` points rasterized at the PNG's resolution (for this
-    file only: the figure is left as it was)."""
-    import matplotlib
-
-    undo: list[Any] = []
-    for ax in fig.axes:
-        dense = [a for a in ax.collections if len(getattr(a, "get_offsets", lambda: ())()) > SVG_RASTER_POINTS]
-        if dense and ax.name == "3d":  # mplot3d rasterizes by z-order only
-            undo.append((ax.set_rasterization_zorder, ax.get_rasterization_zorder()))
-            ax.set_rasterization_zorder(max(a.get_zorder() for a in dense) + 0.5)
-        for artist in dense if ax.name != "3d" else ():
-            undo.append((artist.set_rasterized, artist.get_rasterized()))
-            artist.set_rasterized(True)
-    buf = io.BytesIO()
-    try:
-        # no date and fixed element ids: the same figure gives the same bytes (diffable, reproducible)
-        with matplotlib.rc_context({"svg.hashsalt": "jointlock"}):
-            fig.savefig(buf, format="svg", dpi=PNG_DPI, metadata={"Date": None},
-                        **({"bbox_inches": "tight"} if tight else {}))  # fmt: skip
-    finally:
-        for setter, value in undo:
-            setter(value)
-    return buf.getvalue()
+    file only: the figure is left as it was).  With ``tight`` the box is measured by an Agg
+    draw first; :func:`write_figure` measures it on the PNG's draw instead."""
+    bbox = render_png(fig, PNG_DPI)[1] if tight else None
+    return render_svg(fig, PNG_DPI, bbox)
 
 
 def with_svg(names: list[str]) -> list[str]:
@@ -324,29 +300,38 @@ def with_svg(names: list[str]) -> list[str]:
     return [m for n in names for m in ((n, n[: -len(".png")] + ".svg") if n.endswith(".png") else (n,))]
 
 
+def figure_files(fig: Any, *, dpi: int = PNG_DPI, tight: bool = True) -> tuple[bytes, bytes]:
+    """The figure as PNG and SVG bytes of the same extent, each drawn once (the SVG's box is
+    the one measured on the PNG's draw).  ``tight``: crop to the drawn content (else the
+    figure's own size).  The figure is left as it was."""
+    if dpi == PNG_DPI:
+        return render_files(fig, dpi, tight=tight)
+    png, bbox = render_png(fig, dpi, tight=tight)
+    return png, render_svg(fig, PNG_DPI, bbox)
+
+
 def write_figure(fig: Any, folder: str | Path, name: str, *, dpi: int = PNG_DPI, tight: bool = True) -> list[str]:
     """Write the figure as ``folder/name`` (a ``.png`` name) and beside it as SVG (for print
-    and reviews: :func:`figure_svg`), atomically; returns both names.  ``tight``: crop to the
+    and reviews: :func:`figure_files`), atomically; returns both names.  ``tight``: crop to the
     drawn content (else the figure's own size, as :func:`write_png`).  The figure is left open."""
     if not name.endswith(".png"):
         raise ValueError(f"write_figure writes a .png name (and its .svg); got {name!r}")
     folder = Path(folder)
-    if tight:
-        atomic_write_bytes(folder / name, figure_png(fig, dpi=dpi))
-    else:
-        write_png(fig, folder / name, dpi=dpi)
-    svg = name[: -len(".png")] + ".svg"
-    atomic_write_bytes(folder / svg, figure_svg(fig, tight=tight))
-    return [name, svg]
+    png, svg = figure_files(fig, dpi=dpi, tight=tight)
+    atomic_write_bytes(folder / name, png)
+    atomic_write_bytes(folder / (name[: -len(".png")] + ".svg"), svg)
+    return [name, name[: -len(".png")] + ".svg"]
 
 
 def save_figure(fig: Any, folder: str | Path, stem: str, *, dpi: int = PNG_DPI, svg: bool = True) -> bytes:
     """Write ``folder/stem.png`` (and ``folder/stem.svg`` unless ``svg=False``) atomically;
     returns the PNG bytes (to embed in a report).  The figure is left open."""
-    png = figure_png(fig, dpi=dpi)
+    if not svg:
+        png = render_png(fig, dpi)[0]
+    else:
+        png, svg_bytes = figure_files(fig, dpi=dpi)
+        atomic_write_bytes(Path(folder) / f"{stem}.svg", svg_bytes)
     atomic_write_bytes(Path(folder) / f"{stem}.png", png)
-    if svg:
-        atomic_write_bytes(Path(folder) / f"{stem}.svg", figure_svg(fig))
     return png
 
 

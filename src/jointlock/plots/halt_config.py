@@ -110,10 +110,14 @@ def section_figures(result: Any, *, bins: int = SECTION_BINS) -> list[Any]:
     -------
     list of ``matplotlib.figure.Figure``, chain order (``result.joint_numbers``).
     """
-    figures = []
+    figures: list[Any] = []
     for number in _configuration(result).joint_numbers:
         fig = offscreen_figure(SECTION_FIGSIZE)
         plot_section(result, number, ax=fig.add_subplot(), bins=bins)
-        fig.tight_layout()
+        if not figures:
+            fig.tight_layout()
+        else:  # the same title, labels and CP axis on the same size: the first layout fits them all
+            pars = figures[0].subplotpars
+            fig.subplots_adjust(left=pars.left, right=pars.right, bottom=pars.bottom, top=pars.top)
         figures.append(fig)
     return figures

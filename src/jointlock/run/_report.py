@@ -350,6 +350,7 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         plot_halt_base_torque(
             ts["t"], ts["tau_b"], ts["tau_b_k0"], label=halt_k_label(jobs["halt"]["result"]), ax=fig.add_subplot()
         )
+        fig.tight_layout()  # else the x label reaches past the edge (a costlier crop)
         images.append(("base disturbance torque during the halt", save_figure(fig, figdir, "base_torque")))
     if "singular" in jobs and isinstance(jobs["singular"]["result"].get("conditions"), dict):
         r = jobs["singular"]["result"]

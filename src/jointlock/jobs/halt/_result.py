@@ -445,7 +445,8 @@ class HaltPlan(JobResult):
             (
                 "global_torque_vs_k.png",
                 (7, 4),
-                lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot()),
+                # laid out: the x label's superscript reaches past the edge (a costlier crop)
+                lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot()).figure.tight_layout(),
             ),
             ("joint_profiles.png", (3 * p.dof, 7), lambda fig: plot_joint_profiles(res, fig=fig)),
             (
