@@ -146,6 +146,7 @@ def test_a_scenario_names_the_chain_of_a_urdf_and_its_jobs_use_it(tmp_path, caps
         ('robot = "PANDA"\ntip_link = "panda_hand"\nfreeze_m = { panda_finger_joint1 = "a" }', ["freeze_m.panda_finger_joint1 must be"]),
         ('robot = "PANDA"\ntip_link = "panda_hand"\nfreeze_deg = { panda_finger_joint1 = 1 }', ["robot: cannot load", "joint 'panda_finger_joint1' is prismatic: give it in freeze_m"]),
         ('robot = "PANDA"\ntip_link = 3', ["tip_link must be a string"]),
+        ('robot = "PANDA"\ntip_link = ""', ["s.toml: tip_link must name a link of the URDF; got an empty string"]),
     ],
 )
 def test_a_scenario_s_chain_fields_are_checked(tmp_path, head, words):

@@ -143,3 +143,18 @@ def test_every_exact_eaik_branch_is_ours(name, joint):
                 checked += 1
                 assert _found(ours.q_full[k][ours.exact[k]], wrap_angle(qe)), (k, qe)
     assert checked >= (4 if joint is None else 1) * len(q)
+
+
+@pytest.mark.parametrize("q5", [1e-9, 1e-8, 1e-7, 3e-7, 1e-6, 1e-5])
+def test_near_the_wrist_singularity_every_branch_stays_exact(q5):
+    """q5 a hair off 0: subproblem 2's square root loses half the digits of z, yet joint 4 is
+    still solved (not taken as free) once q5 is past 1e-9, so every branch reaches the pose
+    and the configuration it came from is among them from q5 = 1e-7 on (below, every angle of
+    joint 4 reaches the pose within the 1e-7 tolerance)."""
+    arm = _arm("puma560")
+    q = np.random.default_rng(8).uniform(-np.pi, np.pi, (40, 6))
+    q[:, 4] = q5
+    br = ik_closed_form(arm, jl.ee_pose(arm, q))
+    assert br.exact.all()
+    if q5 >= 1e-7:
+        assert all(_found(br.q_full[k][br.exact[k]], wrap_angle(q[k])) for k in range(len(q)))

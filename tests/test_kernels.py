@@ -76,7 +76,8 @@ def test_sincos_within_an_ulp() -> None:
     big = np.array([1e6, -3e7, 1e300])  # beyond TRIG_LIMIT: libm's
     s, c = np.empty_like(big), np.empty_like(big)
     _kernels.sincos(big, s, c)
-    assert np.array_equal(s, np.sin(big)) and np.array_equal(c, np.cos(big))
+    for got, ref in ((s, np.sin(big)), (c, np.cos(big))):  # within 1 ulp: numpy may use its own SIMD sin
+        assert np.all(np.abs(got - ref) <= np.spacing(np.abs(ref)))
 
 
 @pytest.mark.parametrize("name", ARMS)

@@ -140,10 +140,16 @@ def from_dh(
     base_arr = np.eye(4) if base is None else np.asarray(base, dtype=float)
     if base_arr.shape != (4, 4) or not np.all(np.isfinite(base_arr)):
         raise ModelError(f"base must be a (4, 4) pose of DH frame 0 [m]; got shape {base_arr.shape}")
-    flips = [False] * n if flip is None else list(flip)
+    flips = [False] * n if flip is None else list(flip) if isinstance(flip, Sequence | np.ndarray) else [flip]
     if len(flips) != n or not all(isinstance(f, (bool, np.bool_)) for f in flips):
         raise ModelError(f"flip must hold {n} booleans (True: the joint turns about -z); got {shown(flip)}")
-    slides = [False] * n if prismatic is None else list(prismatic)
+    slides = (
+        [False] * n
+        if prismatic is None
+        else list(prismatic)
+        if isinstance(prismatic, Sequence | np.ndarray)
+        else [prismatic]
+    )
     if len(slides) != n or not all(isinstance(f, (bool, np.bool_)) for f in slides):
         raise ModelError(f"prismatic must hold {n} booleans (True: held at the row's d); got {shown(prismatic)}")
     if all(slides):

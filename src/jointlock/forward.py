@@ -278,6 +278,8 @@ def ee_positions(
     out = np.empty((flat.shape[0], 3))
     if compiled is None:
         compiled = flat.shape[0] >= COMPILED_MIN_POSITIONS
+    elif not isinstance(compiled, (bool, np.bool_)):
+        raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
     if compiled:
         from . import _kernels  # numba is imported on first use, not with the package
 

@@ -292,6 +292,9 @@ class UrdfChain:
     def from_fields(cls, data: Mapping[str, Any]) -> UrdfChain | None:
         """The chain named by :data:`CHAIN_FIELDS` of ``data`` (a validated scenario); None
         when it names none."""
+        for key in ("root_link", "tip_link"):
+            if data.get(key) is not None and not str(data[key]).strip():
+                raise ModelError(f"{key} must name a link of the URDF; got an empty string (leave it out for the default)")
         chain = cls(
             data.get("root_link") or None,
             data.get("tip_link") or None,

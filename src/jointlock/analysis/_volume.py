@@ -155,8 +155,9 @@ def estimate_volume(points: ArrayLike, half: ArrayLike | None = None) -> VolumeE
             v,
             vh,
             (),
-            f"too few samples ({n}) for a volume with a bounded error: no {WINDOW + 1} successive voxel "
-            f"sides where all and half the samples agree within {100 * SATURATED_GAP:g} %; use more samples",
+            f"too few samples ({n}) for a volume with a bounded error: fewer than two windows of {WINDOW} "
+            f"successive voxel sides where all and half the samples agree within {100 * SATURATED_GAP:g} %; "
+            "use more samples",
         )
     fits = []
     for w in windows[:2]:
@@ -170,4 +171,6 @@ def estimate_volume(points: ArrayLike, half: ArrayLike | None = None) -> VolumeE
     central = 1.0 / (2.0**MISSED_EXPONENT - 1.0)
     spread = d * max(1.0 / (2.0**lo_p - 1.0) - central, central - 1.0 / (2.0**hi_p - 1.0))
     error = abs(v0 - fits[1][0]) + 2.0 * se + spread
-    return VolumeEstimate(v0, error, h, v, vh, windows[0])
+    # a workspace without volume (a surface: a 2-DOF arm) extrapolates to about 0, possibly
+    # just below it: a volume is never negative, the error says how far from 0 it may be
+    return VolumeEstimate(max(v0, 0.0), error, h, v, vh, windows[0])

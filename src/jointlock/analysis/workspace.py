@@ -254,9 +254,10 @@ class WorkspaceComparison:
 
     @property
     def share_kept_error(self) -> float:
-        """Stated error of :attr:`share_kept` [-] (the relative errors of both volumes added)."""
+        """Stated error of :attr:`share_kept` [-]: ``(e_locked + share e_full) / V_full``, the
+        relative errors of both volumes added (finite for a locked volume of 0)."""
         ratio = self.volume_locked / self.volume_full
-        return abs(ratio) * (self.volume_locked_error / self.volume_locked + self.volume_full_error / self.volume_full)
+        return (self.volume_locked_error + abs(ratio) * self.volume_full_error) / abs(self.volume_full)
 
     @property
     def samples_per_voxel(self) -> float:

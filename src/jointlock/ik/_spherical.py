@@ -47,6 +47,10 @@ from ._pose import check_six_joints
 SPHERICAL_FIT_TOL = 1e-9
 #: Sines (or lengths relative to the arm's size) below this make a joint free in a branch.
 _FREE_TOL = 1e-12
+#: Subproblem 1 takes a joint as free when a vector's part off its axis is below this share of
+#: the vector's length (the sine of their angle): the pose error of any angle is then below
+#: it, while a larger one still fixes the angle (a wrist at q5 = 1e-7 keeps its q4).
+_FREE_SINE = 1e-9
 
 
 @dataclass(frozen=True)
@@ -138,11 +142,14 @@ def _turn_onto(axis: FloatArray, u: FloatArray, v: FloatArray, free: FloatArray)
     vp = v - (v @ axis)[..., None] * axis
     sin = np.cross(up, vp) @ axis
     cos = np.sum(up * vp, axis=-1)
-    scale = np.linalg.norm(up, axis=-1) * np.linalg.norm(vp, axis=-1)
-    return np.where(scale > _FREE_TOL, np.arctan2(sin, cos), free)
+    off_u = np.linalg.norm(up, axis=-1) > _FREE_SINE * np.linalg.norm(u, axis=-1)
+    off_v = np.linalg.norm(vp, axis=-1) > _FREE_SINE * np.linalg.norm(v, axis=-1)
+    return np.where(off_u & off_v, np.arctan2(sin, cos), free)
 
 
-def _two_roots(a: FloatArray, b: FloatArray, c: FloatArray, free: FloatArray, slack: float):
+def _two_roots(
+    a: FloatArray, b: FloatArray, c: FloatArray, free: FloatArray, slack: float
+) -> tuple[FloatArray, NDArray[np.bool_]]:
     """Both roots (..., 2) [rad] of ``a cos x + b sin x = c`` and whether they are real
     (``|c| <= r (1 + slack)``, ``r = hypot(a, b)``); where ``r`` vanishes any ``x`` solves
     ``c = 0`` and ``free`` is taken."""
@@ -242,7 +249,9 @@ def spherical_wrist_branches(
     return np.where(valid[..., None], q, np.nan), valid
 
 
-def _wrist(h4: FloatArray, h5: FloatArray, h6: FloatArray, m: FloatArray, lock: tuple[int, float] | None):
+def _wrist(
+    h4: FloatArray, h5: FloatArray, h6: FloatArray, m: FloatArray, lock: tuple[int, float] | None
+) -> tuple[FloatArray, FloatArray, FloatArray, NDArray[np.bool_]]:
     """Joints 4-6 (each (..., 2): the two roots of subproblem 2) from ``R4 R5 R6 = m``
     (..., 3, 3), and whether they are real.  A locked wrist joint is substituted and the
     other two solved by subproblem 1 (one root, given twice): exact at the wrist singularity,

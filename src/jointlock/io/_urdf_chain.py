@@ -189,8 +189,8 @@ def select_chain(
             scale, unit = (180.0 / math.pi, " deg") if deg else (1.0, " m" if j.kind == "prismatic" else " rad")
             raise ModelError(
                 f"{label}: joint {shown(j.name)} is frozen at {v * scale:g}{unit} (off the chain, or named in freeze), "
-                f"outside its limits [{j.lower * scale:g}, {j.upper * scale:g}]{unit}: give it a value with "
-                f"freeze = {{{j.name} = value}}"
+                f"outside its limits [{j.lower * scale:g}, {j.upper * scale:g}]{unit}: give it a value within "
+                f"them (--freeze {j.name}=VALUE, or freeze_deg / freeze_m in a scenario or model file)"
             )
         values[j.name] = v
         return v

@@ -63,7 +63,10 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
 def _load(out: dict[str, Any], base: str, source: str, cache: dict) -> Any:
     from ..robots import load_robot
 
-    chain = UrdfChain.from_fields(out)
+    try:
+        chain = UrdfChain.from_fields(out)
+    except JointlockError as exc:
+        raise ScenarioError(f"{source}: {exc}") from None
     key = (out["robot"], base, chain)
     if key not in cache:
         try:
