@@ -27,11 +27,13 @@ def register(sub: argparse._SubParsersAction) -> None:
             "Sample joint angles uniformly within the limits as given (a joint without limits: one "
             "turn), compute the "
             "end-effector positions of the full arm and, with --lock, of the arm with that joint "
-            "locked (002 Figs. 2-3), and estimate each volume by voxel occupancy on one common grid "
-            "(cubes of side --voxel holding at least one sample). The share of the full workspace "
-            "that the locked arm keeps is a Monte Carlo estimate that moves with --samples and "
-            "--voxel: it is printed next to the same estimate from half the samples, and a warning "
-            "says when the two differ or when many locked voxels fall outside the full cloud. With "
+            "locked (002 Figs. 2-3), and estimate each volume with its error: voxel occupancy at "
+            "several voxel sides, all and half the samples, extrapolated to a zero side (the full "
+            "arm's counting the locked arm's samples too, so the locked workspace is a subset). Too "
+            "few samples give no estimate and say so. The plain voxel occupancy on one common grid "
+            "(cubes of side --voxel holding at least one sample) and the share kept from it are "
+            "printed too, next to the same share from half the samples, and a warning says when "
+            "the two differ or when many locked voxels fall outside the full cloud. With "
             "--lock repeated, the last is the failure and the others were locked before it: the "
             "comparison is then before vs after the failure."
         ),
@@ -48,7 +50,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=field_arg("workspace", "voxel"),
         default=None,
         metavar="M",
-        help="voxel side [m] (default: automatic)",
+        help="voxel side of the plain occupancy and the figures [m] (default: automatic); the volume "
+        "estimates use their own ladder of sides",
     )
     p.add_argument("--seed", type=seed_arg, default=0, help="random seed, integer >= 0 (default 0)")
     p.add_argument("--json", action="store_true", help="print one JSON object")
