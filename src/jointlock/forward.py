@@ -27,11 +27,12 @@ from .spatial import pose, skew
 DEFAULT_CHUNK = 65536
 #: Batches from this many configurations on go to the compiled kernels (:mod:`jointlock._kernels`)
 #: by default; smaller ones stay on numpy.  Importing numba and loading the cached kernels
-#: costs a process about 1-2 s (LLVM start-up), which the kernels win back only on large
-#: batches (HCOM's K = 36,000 saves ~0.1 s); the first compilation on a machine ~15 s.
+#: costs a process 0.7 s on an idle core (about 2 s on a busy one; LLVM start-up), which the
+#: kernels win back only on large batches (HCOM's K = 36,000 saves ~0.1 s); the first
+#: compilation on a machine 9-25 s (README, "Speed").
 COMPILED_MIN_BATCH = 200_000
 #: ... and from this many for :func:`ee_positions`, whose numpy path is already ~0.4 us per
-#: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (1-2 s) only
+#: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (0.7-2 s) only
 #: on millions of points (a 200,000-sample workspace stays on numpy).
 COMPILED_MIN_POSITIONS = 4_000_000
 

@@ -24,8 +24,9 @@ system's inertia about its centre of mass (a 3 x 3 solve per configuration inste
 
 Numba is imported with this package, and only the public functions that take these
 kernels import it (lazily), from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations
-on: loading numba and the cached kernels costs a process 1-2 s, the first compilation on a
-machine ~15-25 s (cached afterwards, ``cache=True``).
+on: loading numba and the cached kernels costs a process 0.7 s on an idle core (about 2 s on
+a busy one), the first compilation on a machine 9-25 s (cached afterwards, ``cache=True``;
+README, "Speed").
 
 Sines and cosines.  libm's scalar ``sin``/``cos`` cost ~25 ns each and block SIMD, so
 :func:`_sincos` evaluates them branch-free: Cody-Waite reduction by ``pi/2`` in three parts
