@@ -4,9 +4,26 @@ both fused with the singular values (see :mod:`jointlock._kernels`)."""
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from ._common import BLOCK, _jit, _trig_block
 from ._svd import _jacobi6_block, _jacobi_block, _work
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _advance(frames, b, e, p0, p1, p2, c, s):
+    """Frame ``i`` of configuration ``b`` from frame ``i - 1`` (in place): ``F_i = F_{i-1}
+    [E_i, p_i] Rot(z, q_i)`` with ``c, s = cos q_i, sin q_i``; the rows of the rotation are
+    ``frames[3 r : 3 r + 3, b]``, the origin ``frames[9:12, b]``."""
+    for r in range(3):
+        r0, r1, r2 = frames[3 * r, b], frames[3 * r + 1, b], frames[3 * r + 2, b]
+        frames[9 + r, b] += r0 * p0 + r1 * p1 + r2 * p2
+        a0 = r0 * e[0, 0] + r1 * e[1, 0] + r2 * e[2, 0]
+        a1 = r0 * e[0, 1] + r1 * e[1, 1] + r2 * e[2, 1]
+        a2 = r0 * e[0, 2] + r1 * e[1, 2] + r2 * e[2, 2]
+        frames[3 * r, b] = a0 * c + a1 * s
+        frames[3 * r + 1, b] = a1 * c - a0 * s
+        frames[3 * r + 2, b] = a2
 
 
 @_jit
@@ -70,18 +87,9 @@ def _jacobian_block(q, s0, nb, rot, pos, tool, length, frames, sn, cs, axes, ori
         e = rot[i]
         p0, p1, p2 = pos[i, 0], pos[i, 1], pos[i, 2]
         for b in range(nb):
-            # frame i = frame (i-1) [E_i, p_i] Rot(z, q_i); rows of R are frames[3r:3r+3]
-            c, s = cs[b], sn[b]
+            _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
             for r in range(3):
-                r0, r1, r2 = frames[3 * r, b], frames[3 * r + 1, b], frames[3 * r + 2, b]
-                frames[9 + r, b] += r0 * p0 + r1 * p1 + r2 * p2
-                a0 = r0 * e[0, 0] + r1 * e[1, 0] + r2 * e[2, 0]
-                a1 = r0 * e[0, 1] + r1 * e[1, 1] + r2 * e[2, 1]
-                a2 = r0 * e[0, 2] + r1 * e[1, 2] + r2 * e[2, 2]
-                frames[3 * r, b] = a0 * c + a1 * s
-                frames[3 * r + 1, b] = a1 * c - a0 * s
-                frames[3 * r + 2, b] = a2
-                axes[i, r, b] = a2
+                axes[i, r, b] = frames[3 * r + 2, b]
                 origins[i, r, b] = frames[9 + r, b]
     t0, t1, t2 = tool[0], tool[1], tool[2]
     for b in range(nb):
@@ -182,17 +190,9 @@ def _generalized_block(q, s0, nb, rot, pos, tool, length, mass, com, inertia, ro
         c0, c1, c2 = com[i, 0], com[i, 1], com[i, 2]
         ii = inertia[i]
         for b in range(nb):
-            c, s = cs[b], sn[b]
+            _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
             for r in range(3):
-                r0, r1, r2 = frames[3 * r, b], frames[3 * r + 1, b], frames[3 * r + 2, b]
-                frames[9 + r, b] += r0 * p0 + r1 * p1 + r2 * p2
-                a0 = r0 * e[0, 0] + r1 * e[1, 0] + r2 * e[2, 0]
-                a1 = r0 * e[0, 1] + r1 * e[1, 1] + r2 * e[2, 1]
-                a2 = r0 * e[0, 2] + r1 * e[1, 2] + r2 * e[2, 2]
-                frames[3 * r, b] = a0 * c + a1 * s
-                frames[3 * r + 1, b] = a1 * c - a0 * s
-                frames[3 * r + 2, b] = a2
-                w[i, r, b] = a2
+                w[i, r, b] = frames[3 * r + 2, b]
                 w[i, 3 + r, b] = frames[9 + r, b]
             # centre of mass and inertia in the root frame: R c + o, R I R^T
             for r in range(3):
