@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import json
 import math
+import shlex
 
 import numpy as np
 import pytest
@@ -90,7 +91,9 @@ def test_export_urdf_of_baxter_s_left_arm_from_the_torso(tmp_path, capsys):
         (["export-urdf", "puma6", "--freeze", "j=1", "--out", "x.urdf"], ["'puma6' is a built-in robot"]),
         (["kinematics", "PANDA", "--freeze", "panda_finger_joint1=0.01", "--freeze", "panda_finger_joint1=0.02"], ["--freeze: joint 'panda_finger_joint1' given twice"]),
         (["kinematics", "PANDA", "--freeze", "nope=1"], ["freeze names joint 'nope', which is not in the robot"]),
-        (["kinematics", "PANDA", "--tip", "panda_leftfinger"], ["joint 'panda_finger_joint1' on the chain is prismatic"]),
+        (["kinematics", "PANDA", "--tip", "panda_leftfinger"], ["joint 'panda_finger_joint1' on the chain is prismatic", "--freeze panda_finger_joint1=METRES"]),
+        (["kinematics", "PANDA", "--tip", "panda_hnd"], ["tip_link 'panda_hnd' is not a link of the robot (did you mean 'panda_hand'?)"]),
+        (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_fingerjoint1=0.01"], ["which is not in the robot (did you mean 'panda_finger_joint1'?)"]),
         (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_finger_joint1=1"], ["'panda_finger_joint1' is frozen at 1 m", "outside its limits [0, 0.04] m"]),
         (["kinematics", "PANDA", "--freeze", "panda_finger_joint1"], ["--freeze must look like JOINT=VALUE"]),
         (["kinematics", "PANDA", "--tip", "panda_hand", "--freeze", "panda_joint4=10"], ["'panda_joint4' is frozen at 10 deg", "outside its limits [-176.", "] deg"]),
@@ -136,6 +139,15 @@ def test_a_scenario_names_the_chain_of_a_urdf_and_its_jobs_use_it(tmp_path, caps
     q = np.radians([10, -40, 20, -120, 15, 100, 45])
     jac = pin.computeFrameJacobian(reduced, data, q, reduced.getFrameId("panda_hand"), pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
     np.testing.assert_allclose(got, np.linalg.svd(jac, compute_uv=False), atol=1e-10)
+    # the command the run records for the job names the same chain, and gives the same values
+    command = results["jobs"]["singular"]["command"]
+    assert "--tip panda_hand" in command and "--freeze panda_finger_joint1=0.03" in command
+    argv = shlex.split(command)[1:]  # without "jointlock"
+    if "--out" in argv:  # the recorded run writes its files; here only its numbers are wanted
+        k = argv.index("--out")
+        del argv[k : k + 2]
+    again = _json(capsys, *[a for a in argv if a not in ("--json", "--quiet")])
+    np.testing.assert_allclose(again["singular_values"], got, atol=1e-12)
 
 
 @pytest.mark.parametrize(
@@ -156,3 +168,14 @@ def test_a_scenario_s_chain_fields_are_checked(tmp_path, head, words):
     assert "\n" not in str(info.value)
     for w in words:
         assert w in str(info.value), str(info.value)
+
+
+def test_the_header_names_the_joints_left_to_move(capsys):
+    """A joint frozen on the chain renumbers the others 1..n: the header says which URDF joint
+    each number is (a built-in's joints keep the plain header)."""
+    argv = ["kinematics", str(robot_file(PANDA)), "--tip", "panda_link7", "--freeze", "panda_joint4=-90"]
+    assert main(argv) == 0
+    first = capsys.readouterr().out.splitlines()[0]
+    assert "6 movable joints [1, 2, 3, 4, 5, 6] (panda_joint1, panda_joint2, panda_joint3, panda_joint5," in first
+    assert main(["kinematics", "puma6"]) == 0
+    assert capsys.readouterr().out.splitlines()[0] == "puma6: 6 movable joints [1, 2, 3, 4, 5, 6], locked: none, base: fixed"

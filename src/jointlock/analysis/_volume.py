@@ -157,7 +157,7 @@ def estimate_volume(points: ArrayLike, half: ArrayLike | None = None) -> VolumeE
             (),
             f"too few samples ({n}) for a volume with a bounded error: fewer than two windows of {WINDOW} "
             f"successive voxel sides where all and half the samples agree within {100 * SATURATED_GAP:g} %; "
-            "use more samples",
+            "use more samples (200,000 per arm, the default, give the built-in arms a volume)",
         )
     fits = []
     for w in windows[:2]:

@@ -274,7 +274,10 @@ class WorkspaceComparison:
         or the voxel holds fewer than :data:`MIN_SAMPLES_PER_VOXEL` samples on average."""
         out = [
             f"{which} arm volume: {est.warning}"
-            for which, est in (("full", self.estimate_full), ("locked", self.estimate_locked))
+            for which, est in (
+                ("full (counting both arms' positions)", self.estimate_full),
+                ("locked", self.estimate_locked),
+            )
             if est.warning
         ]
         if (

@@ -10,6 +10,7 @@ folded into those placements at their values, so that the bodies behind them mer
 
 from __future__ import annotations
 
+import difflib
 import math
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
@@ -37,6 +38,12 @@ class Chain:
     in_owner: dict[str, np.ndarray]
     frozen: dict[str, float] = field(default_factory=dict)  # movable-type joints frozen: value used
     left_out: list[str] = field(default_factory=list)  # links above root_link
+
+
+def _close(name: str, known: Mapping[str, Any]) -> str:
+    """`` (did you mean 'x'?)`` for the known name closest to a misspelt one, else ``""``."""
+    match = difflib.get_close_matches(str(name), [str(k) for k in known], n=1)
+    return f" (did you mean {shown(match[0])}?)" if match else ""
 
 
 def _some(names: Sequence[str], limit: int = 5) -> str:
@@ -108,12 +115,14 @@ def select_chain(
     by_name = {j.name: j for j in joints}
     root = tree_root if root_link is None else root_link
     if root not in children:
-        raise ModelError(f"{label}: root_link {shown(root)} is not a link of the robot (links: {_some(list(links))})")
+        raise ModelError(
+            f"{label}: root_link {shown(root)} is not a link of the robot{_close(root, children)} (links: {_some(list(links))})"
+        )
     freeze = dict(freeze or {})
     for name, given in freeze.items():
         j = by_name.get(name)
         if j is None:
-            raise ModelError(f"{label}: freeze names joint {shown(name)}, which is not in the robot")
+            raise ModelError(f"{label}: freeze names joint {shown(name)}, which is not in the robot{_close(name, by_name)}")
         if j.kind == "fixed":
             raise ModelError(f"{label}: freeze names joint {shown(name)}, which is fixed already")
         if isinstance(given, bool) or not isinstance(given, (int, float)) or not math.isfinite(given):
@@ -150,12 +159,14 @@ def select_chain(
         if j.mimic is not None:
             raise ModelError(
                 f"{label}: joint {shown(j.name)} on the chain mimics {shown(j.mimic[0])} (a coupled joint); "
-                f"jointlock's joints move independently: freeze it (freeze = {{{j.name} = value}})"
+                f"jointlock's joints move independently: freeze it (--freeze {j.name}=VALUE; freeze_deg or "
+                "freeze_m in a scenario or model file)"
             )
         if j.kind == "prismatic":
             raise ModelError(
                 f"{label}: joint {shown(j.name)} on the chain is prismatic; jointlock's chain has revolute joints "
-                f"only: freeze it (freeze = {{{j.name} = value}}) or end the chain before it (tip_link)"
+                f"only: freeze it (--freeze {j.name}=METRES; freeze_m in a scenario or model file) or end the "
+                "chain before it (--tip / tip_link)"
             )
     if not movable:
         raise ModelError(f"{label}: no movable joint between root_link {shown(root)} and tip_link {shown(tip)}")
@@ -226,7 +237,7 @@ def _tip(
     from ``root`` (then the unique run of fixed links after it)."""
     if tip_link is not None:
         if tip_link not in children:
-            raise ModelError(f"{label}: tip_link {shown(tip_link)} is not a link of the robot")
+            raise ModelError(f"{label}: tip_link {shown(tip_link)} is not a link of the robot{_close(tip_link, children)}")
         link = tip_link
         while link != root:
             if link not in above:

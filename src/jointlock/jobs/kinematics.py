@@ -83,8 +83,11 @@ class KinematicsReport(JobResult):
         """The lines ``jointlock kinematics`` prints."""
         m = self.model
         base = "floating" if m.floating else "fixed"
+        # a URDF chain or a DH table with held rows numbers its joints 1..n: say which is which
+        named = [j.name for j in m.joints]
+        names = "" if named == [f"joint{n}" for n in m.joint_numbers] else f" ({', '.join(named)})"
         text = [
-            f"{m.name}: {m.dof} movable joints {list(m.joint_numbers)}, locked: "
+            f"{m.name}: {m.dof} movable joints {list(m.joint_numbers)}{names}, locked: "
             f"{locked_text(locked_deg(m))}, base: {base}",
             "q [deg]: " + ", ".join(f"{v:.4f}" for v in np.degrees(self.q)),
             "",

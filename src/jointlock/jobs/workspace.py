@@ -234,6 +234,10 @@ class WorkspaceStudy(JobResult):
                 f"  {self._before + ' volume':<18}: {volume_text(ws.volume, ws.volume_error)} "
                 f"(occupancy at the voxel: {ws.occupancy:.3g} m^3)"
             )
+        lines.append(
+            "  volumes extrapolated to a zero voxel side; ± bounds the extrapolation's bias and the sampling "
+            "(not a standard deviation)"
+        )
         return lines
 
     def file_names(self) -> list[str]:

@@ -41,6 +41,19 @@ def _healthy_rates(scenario: Scenario, values: list[float]) -> list[float]:
     return [v for i, v in enumerate(values) if i + 1 not in locked]
 
 
+def _chain_args(data: Mapping[str, Any]) -> list[str]:
+    """``--root``, ``--tip`` and ``--freeze`` for a scenario naming the chain of a URDF robot
+    (every command taking ROBOT has them; ``--freeze`` values in the joint's unit, as given)."""
+    chain = UrdfChain.from_fields(data)
+    if chain is None:
+        return []
+    argv = ["--root", chain.root_link] if chain.root_link else []
+    argv += ["--tip", chain.tip_link] if chain.tip_link else []
+    for name, value in (*chain.freeze_deg, *chain.freeze_m):
+        argv += ["--freeze", f"{name}={_num(value)}"]
+    return argv
+
+
 def job_argv(
     job: str, scenario: Scenario, out: Path, previous: Mapping[str, dict], *, quiet: bool
 ) -> list[str]:  # one branch per job: the options of seven subcommands
@@ -52,7 +65,7 @@ def job_argv(
     robot, seed = d["robot"], d["seed"]
     st, lim = d["state"], d["limits"]
     job_out = str(out / job)
-    argv = [JOB_COMMAND[job], robot]
+    argv = [JOB_COMMAND[job], robot, *_chain_args(d)]
     if job == "halt_config":
         argv += job_lock_args(scenario) + ["--base", t["base"] or d["base"]]
         argv += ["--samples", str(t["samples"]), "--seed", str(seed), "--jacobian", t["jacobian"]]
