@@ -70,3 +70,16 @@ def pin_kinematics(pm, fid, q: np.ndarray, free_flyer: bool = False):
         out["jacobian"] = jac
         out["mass_matrix"] = mass
     return out
+
+
+def reduced_model(full, keep: list[str], values: dict[str, float]):
+    """Pinocchio's ``full`` model with every joint but ``keep`` locked at ``values`` (0
+    otherwise; Pinocchio ignores <mimic>, so a follower's value is given here), by its own
+    ``buildReducedModel``: the reduced ``pin.Model``, its joints exactly ``keep``."""
+    q_ref = pin.neutral(full)
+    for name, v in values.items():
+        q_ref[full.joints[full.getJointId(name)].idx_q] = v
+    lock = [full.getJointId(n) for n in full.names[1:] if n not in keep]
+    reduced = pin.buildReducedModel(full, lock, q_ref)
+    assert list(reduced.names[1:]) == keep
+    return reduced

@@ -27,12 +27,9 @@ def _pinocchio_tip(path, keep: list[str], values: dict[str, float], tip: str, q:
     """Pinocchio's pose (4, 4) of frame ``tip`` at ``q`` (the joints ``keep``), every other
     joint of the file locked at ``values`` (0 otherwise)."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromUrdf(str(path))
-    q_ref = pin.neutral(full)
-    for name, v in values.items():
-        q_ref[full.joints[full.getJointId(name)].idx_q] = v
-    reduced = pin.buildReducedModel(full, [full.getJointId(n) for n in full.names[1:] if n not in keep], q_ref)
-    assert list(reduced.names[1:]) == keep
+    from pin_oracle import reduced_model
+
+    reduced = reduced_model(pin.buildModelFromUrdf(str(path)), keep, values)
     data = reduced.createData()
     pin.framesForwardKinematics(reduced, data, q)
     return data.oMf[reduced.getFrameId(tip)].homogeneous
@@ -130,11 +127,10 @@ def test_a_scenario_names_the_chain_of_a_urdf_and_its_jobs_use_it(tmp_path, caps
     assert sc.data["tip_link"] == "panda_hand" and sc.data["freeze_m"] == {"panda_finger_joint1": 0.03}
     results = _json(capsys, "run", _scenario(tmp_path, head), "--out", str(tmp_path / "out"), "--quiet")
     got = results["jobs"]["singular"]["result"]["singular_values"]
-    full = pin.buildModelFromUrdf(str(path))
-    q_ref = pin.neutral(full)
-    for name in ("panda_finger_joint1", "panda_finger_joint2"):
-        q_ref[full.joints[full.getJointId(name)].idx_q] = 0.03
-    reduced = pin.buildReducedModel(full, [full.getJointId(n) for n in full.names[1:] if n not in PANDA_ARM], q_ref)
+    from pin_oracle import reduced_model
+
+    fingers = {"panda_finger_joint1": 0.03, "panda_finger_joint2": 0.03}
+    reduced = reduced_model(pin.buildModelFromUrdf(str(path)), PANDA_ARM, fingers)
     data = reduced.createData()
     q = np.radians([10, -40, 20, -120, 15, 100, 45])
     jac = pin.computeFrameJacobian(reduced, data, q, reduced.getFrameId("panda_hand"), pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)

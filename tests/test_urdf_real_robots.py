@@ -29,13 +29,9 @@ def _pinocchio_reduced(path, keep: list[str], values: dict[str, float]):
     """Pinocchio's own reading of the file with every joint but ``keep`` locked at ``values``
     (0 otherwise; mimic tags ignored, so a follower's value is given here): (model, data)."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromUrdf(str(path))
-    q_ref = pin.neutral(full)
-    for name, v in values.items():
-        q_ref[full.joints[full.getJointId(name)].idx_q] = v
-    lock = [full.getJointId(n) for n in full.names[1:] if n not in keep]
-    reduced = pin.buildReducedModel(full, lock, q_ref)
-    assert list(reduced.names[1:]) == keep
+    from pin_oracle import reduced_model
+
+    reduced = reduced_model(pin.buildModelFromUrdf(str(path)), keep, values)
     return reduced, reduced.createData()
 
 

@@ -74,13 +74,9 @@ def _pinocchio_chain(xml: str, keep: list[str], values: dict[str, float], tip: s
     """Pinocchio's own reading of ``xml`` with every joint but ``keep`` locked at ``values``
     (0 otherwise): (model, data, frame id of ``tip``)."""
     pin = pytest.importorskip("pinocchio")
-    full = pin.buildModelFromXML(xml)
-    q_ref = pin.neutral(full)
-    for name, v in values.items():
-        q_ref[full.joints[full.getJointId(name)].idx_q] = v
-    lock = [full.getJointId(n) for n in full.names[1:] if n not in keep]
-    reduced = pin.buildReducedModel(full, lock, q_ref)
-    assert list(reduced.names[1:]) == keep
+    from pin_oracle import reduced_model
+
+    reduced = reduced_model(pin.buildModelFromXML(xml), keep, values)
     return reduced, reduced.createData(), reduced.getFrameId(tip)
 
 

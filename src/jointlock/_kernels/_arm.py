@@ -11,6 +11,17 @@ from ._svd import _jacobi6_block, _jacobi_block, _work
 
 
 @njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _identity_frames(frames, nb):
+    """The root frame (identity rotation, zero origin) in ``frames[:, :nb]`` (12, BLOCK)."""
+    for b in range(nb):
+        for k in range(12):
+            frames[k, b] = 0.0
+        frames[0, b] = 1.0
+        frames[4, b] = 1.0
+        frames[8, b] = 1.0
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
 def _advance(frames, b, e, p0, p1, p2, c, s):
     """Frame ``i`` of configuration ``b`` from frame ``i - 1`` (in place): ``F_i = F_{i-1}
     [E_i, p_i] Rot(z, q_i)`` with ``c, s = cos q_i, sin q_i``; the rows of the rotation are
@@ -76,12 +87,7 @@ def _jacobian_block(q, s0, nb, rot, pos, tool, length, frames, sn, cs, axes, ori
     """Geometric Jacobian (6, n, :nb) of ``q[s0:s0 + nb]`` into ``jac``, the linear rows
     divided by ``length`` [m]; ``frames`` (12, BLOCK), ``axes``/``origins`` (n, 3, BLOCK) work."""
     n = q.shape[1]
-    for b in range(nb):
-        for k in range(12):
-            frames[k, b] = 0.0
-        frames[0, b] = 1.0
-        frames[4, b] = 1.0
-        frames[8, b] = 1.0
+    _identity_frames(frames, nb)
     for i in range(n):
         _trig_block(q, s0, nb, i, sn, cs)
         e = rot[i]
@@ -177,12 +183,7 @@ def _generalized_block(q, s0, nb, rot, pos, tool, length, mass, com, inertia, ro
     (9, row-major), root frame.  ``w`` (n, 15, BLOCK) work: per link axis (3), origin (3),
     centre of mass (3), world inertia (6: xx yy zz xy xz yz)."""
     n = q.shape[1]
-    for b in range(nb):
-        for k in range(12):
-            frames[k, b] = 0.0
-        frames[0, b] = 1.0
-        frames[4, b] = 1.0
-        frames[8, b] = 1.0
+    _identity_frames(frames, nb)
     for i in range(n):
         _trig_block(q, s0, nb, i, sn, cs)
         e = rot[i]

@@ -65,15 +65,7 @@ def _jacobi_block(a, nb, norms, gam, cosv, sinv, tanv, out, s0):
         for r in range(m):
             for b in range(nb):
                 norms[j, b] += a[r, j, b] * a[r, j, b]
-    for b in range(nb):
-        row = out[s0 + b]
-        for j in range(k):  # insertion sort, descending
-            v = math.sqrt(norms[j, b])
-            i = j
-            while i > 0 and row[i - 1] < v:
-                row[i] = row[i - 1]
-                i -= 1
-            row[i] = v
+    _sorted_roots(norms, nb, out, s0)
 
 
 @_jit
