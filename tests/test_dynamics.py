@@ -40,8 +40,9 @@ def _states(model, rng, shape=(5,)):
 
 
 @pytest.mark.oracle
+@pytest.mark.parametrize("compiled", [False, True])
 @pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "arm5"])
-def test_rnea_matches_pinocchio(name, rng):
+def test_rnea_matches_pinocchio(name, compiled, rng):
     po = pytest.importorskip("pin_oracle")
     pin = po.pin
     model = _arm(name)
@@ -49,7 +50,7 @@ def test_rnea_matches_pinocchio(name, rng):
     pm.gravity.linear[:] = [0.0, 0.0, -9.81]
     data = pm.createData()
     q, dq, ddq = _states(model, rng, (4,))
-    ours = rnea(model, q, dq, ddq, gravity=[0.0, 0.0, -9.81])
+    ours = rnea(model, q, dq, ddq, gravity=[0.0, 0.0, -9.81], compiled=compiled)
     c0 = model.root_body.com
     for i in range(q.shape[0]):
         qq = po.pin_q(pm, q[i], False)
@@ -63,8 +64,9 @@ def test_rnea_matches_pinocchio(name, rng):
 
 
 @pytest.mark.oracle
+@pytest.mark.parametrize("compiled", [False, True])
 @pytest.mark.parametrize("name", ["halt7", "arm5"])
-def test_floating_base_matches_pinocchio_free_flyer(name, rng):
+def test_floating_base_matches_pinocchio_free_flyer(name, compiled, rng):
     """With the base acceleration we solve for, Pinocchio's free-flyer rnea needs no base
     wrench (the spacecraft is free) and gives the same joint torques."""
     po = pytest.importorskip("pin_oracle")
@@ -74,7 +76,7 @@ def test_floating_base_matches_pinocchio_free_flyer(name, rng):
     pm.gravity.linear[:] = 0.0
     data = pm.createData()
     q, dq, ddq = _states(model, rng, (3,))
-    res = rnea(model, q, dq, ddq, base="floating")
+    res = rnea(model, q, dq, ddq, base="floating", compiled=compiled)
     c0 = model.root_body.com
     for i in range(3):
         v0, w0 = res.base_twist[i, :3], res.base_twist[i, 3:]

@@ -15,6 +15,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from . import forward as _fk
 from ._chain import SYM, composite, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
 from .bounds import check_overflow
@@ -285,6 +286,62 @@ def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
     return tau, force, moment, a0 + alpha0, v0 + w0
 
 
+#: Samples per pass of the compiled Newton-Euler kernels (bounds the flattened copies).
+_COMPILED_CHUNK = 65536
+
+
+def _link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:
+    """The links of :func:`jointlock._chain.link_constants` as the kernels of
+    :mod:`jointlock._kernels._dynamics` take them: ``E`` (n, 3, 3), ``p`` (n, 3), mass (n,),
+    centre of mass (n, 3), inertia (n, 3, 3)."""
+    links = link_constants(model, origin)
+    return (
+        np.ascontiguousarray([link.rot for link in links], dtype=float),
+        np.ascontiguousarray([link.pos for link in links], dtype=float),
+        np.array([link.mass for link in links], dtype=float),
+        np.ascontiguousarray([link.com for link in links], dtype=float),
+        np.ascontiguousarray([link.inertia for link in links], dtype=float),
+    )
+
+
+def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
+    """:func:`rnea` by the compiled kernels, in chunks of :data:`_COMPILED_CHUNK` samples:
+    (torques, base wrench, base acceleration, base twist) as (N, .) arrays."""
+    from . import _kernels  # numba is imported on first use, not with the package
+
+    n = shape[-1]
+    n_samples = int(np.prod(shape[:-1], dtype=np.int64))
+    tau = np.empty((n_samples, n))
+    wrench = np.empty((n_samples, 6))
+    acc = np.zeros((n_samples, 6))
+    twist = np.zeros((n_samples, 6))
+    bq, bdq, bddq = (np.broadcast_to(x, shape).reshape(-1, n) for x in (q, dq, ddq))
+    root = model.root_body
+    if base == "fixed":
+        links = _link_arrays(model, np.zeros(3))
+        base_acc = -g  # gravity as an upward base acceleration
+    else:
+        links = _link_arrays(model, root.com)
+        packed = np.concatenate([[root.mass], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])
+    bad = 0
+    for s0 in range(0, n_samples, _COMPILED_CHUNK):
+        part = slice(s0, s0 + _COMPILED_CHUNK)
+        cq, cdq, cddq = (np.ascontiguousarray(x[part], dtype=float) for x in (bq, bdq, bddq))
+        if base == "fixed":
+            _kernels.rnea_fixed(cq, cdq, cddq, *links, base_acc, point, tau[part], wrench[part])
+        else:
+            bad += _kernels.rnea_floating(
+                cq, cdq, cddq, *links, packed, point, tau[part], wrench[part], acc[part], twist[part]
+            )
+    if bad:
+        raise ModelError(
+            "the free-floating system's rotational inertia about its centre of "
+            "mass is singular (e.g. collinear point masses on a point-mass spacecraft); the base "
+            "reaction is undefined"
+        )
+    return tau, wrench, acc, twist
+
+
 def rnea(
     model: ArmModel,
     q: ArrayLike,
@@ -294,6 +351,7 @@ def rnea(
     base: BaseMode = "fixed",
     gravity: ArrayLike | None = None,
     moment_point: ArrayLike | None = None,
+    compiled: bool | None = None,
 ) -> InverseDynamics:
     """Recursive Newton-Euler inverse dynamics, batched, with the base reaction wrench.
 
@@ -326,6 +384,12 @@ def rnea(
         (3,) point of the root frame about which the base moment is taken [m]; default the
         root body's centre of mass (the spacecraft's for a free-floating model; the root
         origin for a fixed model without a base body).
+    compiled
+        True: the compiled kernels (:mod:`jointlock._kernels`, numba; the same numbers to
+        round-off); False: the numpy implementation (the reference the kernels are tested
+        against); None (default): the kernels from :data:`jointlock.forward.COMPILED_MIN_BATCH`
+        samples on, where they win back numba's start-up (0.7-2 s per process).  Pass True
+        when calling many times in one process (an optimiser scoring candidates).
 
     Returns
     -------
@@ -361,11 +425,28 @@ def rnea(
     if base == "floating" and np.any(g != 0):
         raise ModelError("gravity must be zero with base='floating' (a free-falling system feels none)")
 
+    n_samples = int(np.prod(batch, dtype=np.int64))
+    if compiled is None:
+        compiled = n_samples >= _fk.COMPILED_MIN_BATCH
+    elif not isinstance(compiled, (bool, np.bool_)):
+        raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
+    if compiled:
+        with np.errstate(over="ignore", invalid="ignore"):  # finite inputs whose products overflow: said below
+            tau_c, wrench_c, acc_c, twist_c = _rnea_compiled(model, q, dq, ddq, shape, base, g, point)
+        check_overflow((tau_c, wrench_c, acc_c, twist_c), "rnea", dq=dq, ddq=ddq)
+        return InverseDynamics(
+            tau_c.reshape(shape),
+            wrench_c[:, :3].reshape(batch + (3,)),
+            wrench_c[:, 3:].reshape(batch + (3,)),
+            acc_c.reshape(batch + (6,)),
+            twist_c.reshape(batch + (6,)),
+            point,
+        )
+
     def flat(x: FloatArray) -> FloatArray:
         return np.ascontiguousarray(np.broadcast_to(x, shape).reshape(-1, shape[-1]).T)
 
     qf, dqf, ddqf = flat(q), flat(dq), flat(ddq)
-    n_samples = qf.shape[1]
     with np.errstate(over="ignore", invalid="ignore"):  # finite inputs whose products overflow: said below
         rows = _rnea_rows(model, qf, dqf, ddqf, base, g, point)
     check_overflow(rows, "rnea", dq=dqf, ddq=ddqf)
@@ -388,9 +469,10 @@ def joint_torques(
     *,
     base: BaseMode = "fixed",
     gravity: ArrayLike | None = None,
+    compiled: bool | None = None,
 ) -> FloatArray:
     """(..., n) joint torques [N m] by :func:`rnea` (000 eqs. 28-29)."""
-    return rnea(model, q, dq, ddq, base=base, gravity=gravity).torques
+    return rnea(model, q, dq, ddq, base=base, gravity=gravity, compiled=compiled).torques
 
 
 def base_wrench(
@@ -402,7 +484,10 @@ def base_wrench(
     base: BaseMode = "fixed",
     gravity: ArrayLike | None = None,
     moment_point: ArrayLike | None = None,
+    compiled: bool | None = None,
 ) -> FloatArray:
     """(..., 6) wrench ``[f_d; n_d]`` [N, N m] the arm exerts on its base (000 eqs. 30-31),
     moment about the spacecraft's centre of mass, root frame.  See :func:`rnea`."""
-    return rnea(model, q, dq, ddq, base=base, gravity=gravity, moment_point=moment_point).base_wrench
+    return rnea(
+        model, q, dq, ddq, base=base, gravity=gravity, moment_point=moment_point, compiled=compiled
+    ).base_wrench

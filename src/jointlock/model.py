@@ -456,7 +456,11 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
             f"{name} must have shape (..., {model.dof}) for model {shown(model.name)} "
             f"(movable joints {list(model.joint_numbers)}); got shape {arr.shape}"
         )
-    if not np.all(np.isfinite(arr)):
+    # one pass without a temporary first: the sum is finite when every entry is (an overflowing
+    # sum of finite entries falls through to the exact test)
+    with np.errstate(over="ignore", invalid="ignore"):
+        finite_sum = math.isfinite(float(np.sum(arr)))
+    if not finite_sum and not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
         raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad}")
     return arr

@@ -50,6 +50,7 @@ from ._arm import (
     jacobian,
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
+from ._dynamics import rnea_fixed, rnea_floating
 from ._svd import singular_values
 
 __all__ = [
@@ -61,6 +62,8 @@ __all__ = [
     "generalized_jacobian",
     "generalized_singular_values",
     "jacobian",
+    "rnea_fixed",
+    "rnea_floating",
     "sincos",
     "singular_values",
 ]
