@@ -112,11 +112,42 @@ def main() -> None:
               f"peak arrays {heap:,.0f} MB (tracemalloc; q {args.mem_samples * 6 * 8 / 2**20:,.0f} MB and the "
               f"result {args.mem_samples * 3 * 8 / 2**20:,.0f} MB included), peak RSS {rss:,.0f} MB")
 
+    ik_speed(arm, locked, q, ql)
+
+
+def ik_speed(arm: jl.ArmModel, locked: jl.ArmModel, q: np.ndarray, ql: np.ndarray) -> None:
+    """Closed-form IK of puma6, every branch: with each branch's FK check (``ik_closed_form``)
+    and the branches alone (``puma6_branches``), against EAIK (C++, Ostermeier et al.) on the
+    same poses in the same run."""
+    from jointlock.ik import puma6_branches, puma6_geometry
+    from jointlock.spatial import invert
+
+    geom = puma6_geometry(arm)
     print("\nclosed-form IK (every branch), puma6:")
     for batch in (1, 100, 10_000, 100_000):
         t = jl.ee_pose(arm, q[:batch])
         tt = best_of(lambda t=t: ik_closed_form(arm, t))
         print(f"  batch {batch:>7}: {batch / tt:12,.0f} poses/s (8 branches, errors checked by FK)")
+    t = jl.ee_pose(arm, q[:10_000])
+    t06 = t @ invert(geom.tool)
+    t_branches = best_of(lambda: puma6_branches(geom, t06))
+    print(f"  batch   10000: {1e4 / t_branches:12,.0f} poses/s (8 branches alone: puma6_branches)")
+    try:
+        import eaik.IK_DH as eaik_dh
+    except ImportError:
+        print("  EAIK not installed: no ratio")
+    else:
+        alpha = np.radians([-90, 0, 90, -90, 90, 0])
+        robot = eaik_dh.DhRobot(alpha, np.array([0, geom.a2, 0, 0, 0, 0]), np.array([0, 0, 0, geom.d4, 0, geom.d6]))
+        poses = list(t06)
+        t_eaik = best_of(lambda: robot.IK_batched(poses, 1))
+        sol = robot.IK(t06[0])
+        assert any(np.allclose(np.asarray(x), np.asarray(y), atol=1e-9)
+                   for x in np.atleast_2d(sol.Q) for y in puma6_branches(geom, t06[0])[0])
+        print(
+            f"  EAIK IK_batched, 1 thread, batch 10000: {1e4 / t_eaik:12,.0f} poses/s -> ratio branches alone "
+            f"{t_eaik / t_branches:.2f}x, with the FK check {t_eaik / best_of(lambda: ik_closed_form(arm, t)):.2f}x"
+        )
     t = jl.ee_pose(arm, ql[:100_000, [0, 0, 1, 2, 3, 4]])
     tt = best_of(lambda: ik_closed_form(locked, t))
     print(f"  joint 2 locked, batch 100000: {1e5 / tt:12,.0f} poses/s (4 branches)")

@@ -13,7 +13,7 @@ from .._cache import cached_on
 from ..errors import ModelError
 from ..kinematics import ee_pose
 from ..model import ArmModel, FloatArray
-from ..spatial import invert, pose, pose_error, rot_x, rot_y, rot_z, turns_into_limits
+from ..spatial import invert, pose, pose_error, rot_x, rot_z, turns_into_limits
 from ._pose import EXACT_POSITION_TOL, EXACT_ROTATION_TOL, _as_poses, check_six_joints, wrap_angle
 from ._spherical import spherical_wrist_branches, spherical_wrist_geometry
 from ._ur import ur_branches, ur_geometry
@@ -142,8 +142,24 @@ def _fit_geometry(model: ArmModel) -> Puma6Geometry:
 
 
 def _rot03(a2: float, q1: FloatArray, q2: FloatArray, q3: FloatArray) -> FloatArray:
-    q = np.stack(np.broadcast_arrays(q1, q2, q3, q1 * 0, q1 * 0, q1 * 0), axis=-1)
-    return _dh_chain(a2, 0.0, 0.0, q)[..., 2, :3, :3]
+    """(..., 3, 3) ``R_0_3`` of the family: with twists -90, 0, 90 deg it is
+    ``Rot(z, q1) Rot(x, -90) Rot(z, q2 + q3) Rot(x, 90) = Rot(z, q1) Rot(y, q2 + q3)``
+    (``a2`` moves no frame's orientation)."""
+    c1, s1 = np.cos(q1), np.sin(q1)
+    q23 = q2 + q3
+    c23, s23 = np.cos(q23), np.sin(q23)
+    c1, s1, c23, s23 = np.broadcast_arrays(c1, s1, c23, s23)
+    out = np.empty(c1.shape + (3, 3))
+    out[..., 0, 0] = c1 * c23
+    out[..., 0, 1] = -s1
+    out[..., 0, 2] = c1 * s23
+    out[..., 1, 0] = s1 * c23
+    out[..., 1, 1] = c1
+    out[..., 1, 2] = s1 * s23
+    out[..., 2, 0] = -s23
+    out[..., 2, 1] = 0.0
+    out[..., 2, 2] = c23
+    return out
 
 
 def _position_branches(geom: Puma6Geometry, pw: FloatArray, lock: tuple[int, float] | None):
@@ -213,8 +229,10 @@ def _wrist_branches(m: FloatArray, lock: tuple[int, float] | None) -> FloatArray
         sign = np.broadcast_to(np.array([1.0, -1.0]), t5.shape)
     m_b = m[..., None, :, :]
     t4 = np.arctan2(sign * m_b[..., 1, 2], sign * m_b[..., 0, 2])  # eq. (11) (not (17))
-    n = rot_y(-t5)[..., :3, :3] @ rot_z(-t4)[..., :3, :3] @ m_b
-    t6 = np.arctan2(n[..., 1, 0], n[..., 0, 0])  # eqs. (13)-(15)
+    # eqs. (13)-(15): N = Rot(y, -t5) Rot(z, -t4) M, t6 = atan2(N_10, N_00), entries written out
+    c4, s4, c5, s5 = np.cos(t4), np.sin(t4), np.cos(t5), np.sin(t5)
+    m00, m10, m20 = m_b[..., 0, 0], m_b[..., 1, 0], m_b[..., 2, 0]
+    t6 = np.arctan2(c4 * m10 - s4 * m00, c5 * (c4 * m00 + s4 * m10) - s5 * m20)
     return np.stack([t4, t5, t6], axis=-1)
 
 
