@@ -30,7 +30,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-from _info import machine_info
+# one BLAS thread here too (the machine line reports this process's thread pools)
+for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
+
+from _info import machine_info  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 

@@ -178,3 +178,36 @@ def test_large_batches_take_the_kernels_by_default(monkeypatch: pytest.MonkeyPat
     assert calls[-1] == "ee_positions"
     np.testing.assert_allclose(large[0].sigma_min, small[0].sigma_min, rtol=0, atol=SV_TOL)  # sigma_max ~ 1
     np.testing.assert_allclose(large[1], small[1], rtol=0, atol=1e-12)
+
+
+@pytest.mark.parametrize("base", ["fixed", "floating"])
+def test_public_jacobians_take_the_kernels(base: str, monkeypatch: pytest.MonkeyPatch) -> None:
+    """jl.jacobian / jl.generalized_jacobian: the kernels (chunked, no chain state held) on
+    request or from COMPILED_MIN_BATCH configurations, equal to the numpy path to round-off."""
+    from jointlock import kinematics
+
+    model = jl.lock(jl.load_robot("canadarm7", base=base), 3, 0.4)
+    q = np.random.default_rng(9).uniform(-np.pi, np.pi, (3, 50, model.dof))
+    calls: list[str] = []
+    for name in ("jacobian", "generalized_jacobian"):
+        kernel = getattr(_kernels, name)
+        monkeypatch.setattr(_kernels, name, lambda *a, k=kernel, n=name: (calls.append(n), k(*a))[1])
+    for fn in (jacobian, generalized_jacobian):
+        ref = fn(model, q)  # 150 configurations: numpy
+        assert calls == []
+        ours = fn(model, q, compiled=True)
+        assert ours.shape == ref.shape == (3, 50, 6, model.dof)
+        np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
+        calls.clear()
+    monkeypatch.setattr(forward, "COMPILED_MIN_BATCH", 100)
+    monkeypatch.setattr(kinematics, "DEFAULT_CHUNK", 64)  # three chunks
+    np.testing.assert_allclose(jacobian(model, q), jacobian(model, q, compiled=False), rtol=0, atol=1e-12 * 30)
+    generalized_jacobian(model, q)
+    assert calls == ["jacobian"] * 3 + ["generalized_jacobian" if base == "floating" else "jacobian"] * 3
+    jacobian(model, q, frame="ee")  # the end-effector frame needs the frames: numpy
+    jacobian(model, q[0, :3])  # three configurations: numpy
+    assert len(calls) == 6
+    with pytest.raises(jl.ConfigurationError, match="compiled=True computes the Jacobian in the root frame"):
+        jacobian(model, q, frame="ee", compiled=True)
+    with pytest.raises(jl.ConfigurationError, match="compiled must be True, False or None"):
+        generalized_jacobian(model, q, compiled=1)

@@ -20,13 +20,15 @@ taking ``q`` and ``state=`` uses the state only at the angles it was computed at
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Literal, cast
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._chain import momentum_matrix_soa
+from . import forward as _fk
+from ._chain import kernel_mass_program, kernel_program, momentum_matrix_soa
 from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
 from .forward import DEFAULT_CHUNK, ChainState, chain_state, ee_pose, ee_positions, link_poses, state_at
@@ -64,12 +66,52 @@ def com_positions(model: ArmModel, q: ArrayLike | None, state: ChainState | None
     return s.positions + np.einsum("...nij,nj->...ni", s.rotations, coms)
 
 
+def _use_kernel(q: ArrayLike | None, frame: str, state: ChainState | None, compiled: bool | None) -> bool:
+    """Whether a Jacobian is computed by the compiled kernels: asked for (``compiled=True``),
+    or by default from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations, in the
+    root frame and without a precomputed state (which already holds the frames)."""
+    if compiled is not None and not isinstance(compiled, (bool, np.bool_)):
+        raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
+    if compiled and (frame != "base" or state is not None):
+        raise ConfigurationError(
+            "compiled=True computes the Jacobian in the root frame from q: use frame='base' and no state"
+        )
+    if compiled is None:
+        if frame != "base" or state is not None or q is None:
+            return False
+        shape = np.shape(q)  # validated afterwards, by whichever path runs
+        return len(shape) > 1 and math.prod(shape[:-1]) >= _fk.COMPILED_MIN_BATCH
+    return bool(compiled)
+
+
+def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool) -> FloatArray:
+    """(..., 6, n) Jacobian by :func:`jointlock._kernels.jacobian` or
+    :func:`jointlock._kernels.generalized_jacobian`, :data:`DEFAULT_CHUNK` configurations at a
+    time (no frames of the whole batch are held)."""
+    from . import _kernels  # numba is imported on first use, not with the package
+
+    arr = as_joint_array(model, q)
+    n = model.dof
+    flat = np.ascontiguousarray(arr.reshape(-1, n))
+    out = np.empty((flat.shape[0], 6, n))
+    rot, pos, tool, _skip = kernel_program(model)
+    masses = kernel_mass_program(model) if generalized else None
+    for s0 in range(0, flat.shape[0], DEFAULT_CHUNK):
+        part = slice(s0, s0 + DEFAULT_CHUNK)
+        if masses is None:
+            _kernels.jacobian(flat[part], rot, pos, tool, out[part])
+        else:
+            _kernels.generalized_jacobian(flat[part], rot, pos, tool, *masses, out[part])
+    return out.reshape(arr.shape[:-1] + (6, n))
+
+
 def jacobian(
     model: ArmModel,
     q: ArrayLike | None,
     *,
     frame: Literal["base", "ee"] = "base",
     state: ChainState | None = None,
+    compiled: bool | None = None,
 ) -> FloatArray:
     """Geometric Jacobian of the end effector, fixed base.
 
@@ -86,6 +128,12 @@ def jacobian(
         Precomputed :func:`chain_state` at ``q`` (optional, saves the forward kinematics).
         It must have been computed at ``q`` (:class:`~jointlock.errors.ConfigurationError`
         otherwise); with a state, ``q=None`` means ``state.q``.
+    compiled
+        True: the compiled kernel (:func:`jointlock._kernels.jacobian`; root frame, no
+        state), in chunks, so that memory holds the result and little else; False: numpy
+        from :func:`chain_state` (the reference the kernel is tested against); None
+        (default): the kernel from :data:`jointlock.forward.COMPILED_MIN_BATCH`
+        configurations on, in the root frame without a state.  Both agree to round-off.
 
     Returns
     -------
@@ -93,6 +141,9 @@ def jacobian(
     being the velocity of the end-effector frame's origin [m/s].  Column ``i`` is
     ``(z_i x (p_e - p_i), z_i)``.
     """
+    if _use_kernel(q, frame, state, compiled):
+        assert q is not None  # state is None here
+        return _kernel_jacobian(model, q, generalized=False)
     s = state_at(model, q, state)
     z, p, pe = s.soa_axes, s.soa_positions, s.soa_ee_position
     d = pe[None] - p  # (n, 3, N)
@@ -189,6 +240,7 @@ def generalized_jacobian(
     *,
     frame: Literal["base", "ee"] = "base",
     state: ChainState | None = None,
+    compiled: bool | None = None,
 ) -> FloatArray:
     """Generalized Jacobian of a free-floating arm with zero momentum (Umetani-Yoshida;
     000 eq. 5, ``J_F = J_theta + J_b J_btheta``).
@@ -206,6 +258,8 @@ def generalized_jacobian(
         Precomputed :func:`chain_state` at ``q`` (optional, saves the forward kinematics).
         It must have been computed at ``q`` (:class:`~jointlock.errors.ConfigurationError`
         otherwise); with a state, ``q=None`` means ``state.q``.
+    compiled
+        As for :func:`jacobian` (the kernel :func:`jointlock._kernels.generalized_jacobian`).
 
     Returns
     -------
@@ -213,6 +267,9 @@ def generalized_jacobian(
     frame (components in the current spacecraft frame), the spacecraft moving so that
     linear and angular momentum stay zero.
     """
+    if _use_kernel(q, frame, state, compiled):
+        assert q is not None  # state is None here
+        return _kernel_jacobian(model, q, generalized=model.floating)
     s = state_at(model, q, state)
     jm = jacobian(model, s.q, state=s)
     if model.floating:

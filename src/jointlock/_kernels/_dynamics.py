@@ -408,7 +408,7 @@ def rnea_floating(q, dq, ddq, rot, pos, mass, com, inertia, root, point, tau, wr
     moment = np.empty((n, 3, BLOCK))
     columns = np.empty((n, 5, BLOCK))
     sums = np.empty((15, BLOCK))
-    solver = np.empty((11, BLOCK))
+    solver = np.empty((6, BLOCK))  # the inverse Schur complement, entries xx yy zz xy xz yz
     m0 = root[0]
     z00, z01, z02, z10, z11, z12, z20, z21, z22 = _entries(root[4:13].reshape(3, 3))
     arm_mass = 0.0
