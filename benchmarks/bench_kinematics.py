@@ -129,6 +129,36 @@ else:
 """
 
 
+_JAC_CHILD = """
+import resource, sys, time
+import numpy as np
+import jointlock as jl
+model = jl.lock(jl.load_robot("halt7"), 4, 0.0)
+compiled = sys.argv[2] == "1"
+jl.jacobian(model, np.zeros((10, 6)), compiled=compiled)
+q = np.random.default_rng(0).uniform(-np.pi, np.pi, (int(sys.argv[1]), 6))
+t = time.perf_counter()
+jac = jl.jacobian(model, q, compiled=compiled)
+t = time.perf_counter() - t
+print(f"{t:.3f} {resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024:.0f} {jac.nbytes / 2**20:.0f}")
+"""
+
+
+def jacobian_memory(n: int) -> None:
+    """``jl.jacobian`` of ``n`` configurations of halt7 (joint 4 locked), compiled (chunked)
+    and numpy (whole-batch chain state), each in a fresh process: time and peak RSS."""
+    rows = []
+    for compiled in ("1", "0"):
+        out = subprocess.run([sys.executable, "-c", _JAC_CHILD, str(n), compiled], capture_output=True, text=True,
+                             check=True, env=dict(os.environ))  # fmt: skip
+        rows.append([float(x) for x in out.stdout.split()])
+    (tc, rc, size), (tn, rn, _) = rows
+    print(
+        f"  jl.jacobian, {n:.0e} configurations (halt7, joint 4 locked; the result {size:.0f} MB): compiled "
+        f"{tc:.2f} s, peak RSS {rc:,.0f} MB; numpy {tn:.2f} s, peak RSS {rn:,.0f} MB ({tn / tc:.0f}x)"
+    )
+
+
 def _child(base: str, n: int, cache_dir: str) -> list[float]:
     env = dict(os.environ, NUMBA_CACHE_DIR=cache_dir)
     out = subprocess.run(
@@ -168,6 +198,7 @@ def w1_compiled(args: argparse.Namespace) -> None:
             f"warm {warm[1]:.2f} s (cached); import jointlock {warm[0]:.2f} s"
         )
         if args.mem_samples:
+            jacobian_memory(min(args.mem_samples, 1_000_000))
             for base in ("fixed", "floating"):
                 _child(base, 0, cache)
                 r = _child(base, args.mem_samples, cache)

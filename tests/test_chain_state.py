@@ -185,7 +185,7 @@ LOW_MODULES = {
     "spatial": set(),
     "_chain": {"_rows", "model"},
     "forward": {"_chain", "errors", "model", "spatial", "_kernels"},
-    "kinematics": {"_chain", "bounds", "errors", "forward", "model"},
+    "kinematics": {"_chain", "bounds", "errors", "forward", "model", "_kernels"},
 }
 
 

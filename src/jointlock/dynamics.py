@@ -5,6 +5,10 @@ Mass matrices here are built from the centre-of-mass Jacobians (composite form).
 leading shape (time samples and candidate trajectories at once), giving the joint torques
 and the wrench the arm exerts on its base, with the base held fixed (000) or free-floating
 (zero momentum, the spacecraft reacts).
+
+:func:`rnea` runs in numpy, or in compiled kernels (numba, :mod:`jointlock._kernels`) from
+:data:`jointlock.forward.COMPILED_MIN_BATCH` samples on or with ``compiled=True``: 3-5x
+faster than numpy, the same numbers to round-off (README, "Speed").
 """
 
 from __future__ import annotations
@@ -217,11 +221,7 @@ def _base_solver(mass: float, first, inertia):
     czz = kxx * kyy - kxy * kxy
     det = kxx * cxx + kxy * cxy + kxz * cxz
     if np.any(np.asarray(det) <= 0):
-        raise ModelError(
-            "the free-floating system's rotational inertia about its centre of "
-            "mass is singular (e.g. collinear point masses on a point-mass spacecraft); the base "
-            "reaction is undefined"
-        )
+        raise ModelError(_SINGULAR_SYSTEM)
     inv_det = 1.0 / det
 
     def solve(rf, rn):
@@ -286,8 +286,23 @@ def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
     return tau, force, moment, a0 + alpha0, v0 + w0
 
 
-#: Samples per pass of the compiled Newton-Euler kernels (bounds the flattened copies).
+#: Samples per pass of the compiled Newton-Euler kernels: inputs that are not C-contiguous
+#: float64 (or not writable, e.g. broadcast views) are copied a chunk at a time.  (Inputs
+#: broadcast over several batch axes are expanded once, whole, by the flattening reshape.)
 _COMPILED_CHUNK = 65536
+
+#: What a free-floating system whose inertia about its centre of mass is singular gets.
+_SINGULAR_SYSTEM = (
+    "the free-floating system's rotational inertia about its centre of "
+    "mass is singular (e.g. collinear point masses on a point-mass spacecraft); the base "
+    "reaction is undefined"
+)
+
+
+def _kernel_input(x: FloatArray) -> FloatArray:
+    """``x`` as the kernels take it: C-contiguous, writable float64 (a copy only where it is
+    not), so that numba compiles one specialisation, not one per memory layout."""
+    return np.require(x, dtype=float, requirements=["C", "W"])
 
 
 def _link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:
@@ -317,6 +332,7 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     twist = np.zeros((n_samples, 6))
     bq, bdq, bddq = (np.broadcast_to(x, shape).reshape(-1, n) for x in (q, dq, ddq))
     root = model.root_body
+    point = np.array(point, dtype=float)  # writable, contiguous: one numba specialisation
     if base == "fixed":
         links = _link_arrays(model, np.zeros(3))
         base_acc = -g  # gravity as an upward base acceleration
@@ -326,7 +342,7 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     bad = 0
     for s0 in range(0, n_samples, _COMPILED_CHUNK):
         part = slice(s0, s0 + _COMPILED_CHUNK)
-        cq, cdq, cddq = (np.ascontiguousarray(x[part], dtype=float) for x in (bq, bdq, bddq))
+        cq, cdq, cddq = (_kernel_input(x[part]) for x in (bq, bdq, bddq))
         if base == "fixed":
             _kernels.rnea_fixed(cq, cdq, cddq, *links, base_acc, point, tau[part], wrench[part])
         else:
@@ -334,11 +350,7 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
                 cq, cdq, cddq, *links, packed, point, tau[part], wrench[part], acc[part], twist[part]
             )
     if bad:
-        raise ModelError(
-            "the free-floating system's rotational inertia about its centre of "
-            "mass is singular (e.g. collinear point masses on a point-mass spacecraft); the base "
-            "reaction is undefined"
-        )
+        raise ModelError(_SINGULAR_SYSTEM)
     return tau, wrench, acc, twist
 
 
@@ -360,8 +372,8 @@ def rnea(
     the spacecraft's centre of mass (eq. 30, ``n_d = n_1 + bP_1 x f_1``; eq. 31
     ``tau_b = n_d``).  Everything is computed in root-frame components with the spacecraft
     attitude taken as the root frame at each instant (the result does not depend on it).
-    Samples are flattened and processed in structure-of-arrays layout; the only Python
-    loop is over the joints.
+    Samples are flattened and processed in structure-of-arrays layout; the numpy path
+    loops in Python over the joints only, the compiled one over chunks of samples.
 
     Parameters
     ----------
@@ -388,7 +400,7 @@ def rnea(
         True: the compiled kernels (:mod:`jointlock._kernels`, numba; the same numbers to
         round-off); False: the numpy implementation (the reference the kernels are tested
         against); None (default): the kernels from :data:`jointlock.forward.COMPILED_MIN_BATCH`
-        samples on, where they win back numba's start-up (0.7-2 s per process).  Pass True
+        samples on, where they win back numba's start-up (0.4-2 s per process).  Pass True
         when calling many times in one process (an optimiser scoring candidates).
 
     Returns
@@ -431,7 +443,7 @@ def rnea(
     elif not isinstance(compiled, (bool, np.bool_)):
         raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
     if compiled:
-        with np.errstate(over="ignore", invalid="ignore"):  # finite inputs whose products overflow: said below
+        with np.errstate(over="ignore", invalid="ignore"):  # finite inputs that overflow: said below
             tau_c, wrench_c, acc_c, twist_c = _rnea_compiled(model, q, dq, ddq, shape, base, g, point)
         check_overflow((tau_c, wrench_c, acc_c, twist_c), "rnea", dq=dq, ddq=ddq)
         return InverseDynamics(

@@ -27,9 +27,9 @@ from .spatial import pose, skew
 DEFAULT_CHUNK = 65536
 #: Batches from this many configurations on go to the compiled kernels (:mod:`jointlock._kernels`)
 #: by default; smaller ones stay on numpy.  Importing numba and loading the cached kernels
-#: costs a process 0.7 s on an idle core (about 2 s on a busy one; LLVM start-up), which the
+#: costs a process 0.4-0.7 s on an idle core (about 2 s on a busy one; LLVM start-up), which the
 #: kernels win back only on large batches (HCOM's K = 36,000 saves ~0.1 s); the first
-#: compilation on a machine 9-25 s (README, "Speed").
+#: compilation on a machine 5-25 s (README, "Speed").
 COMPILED_MIN_BATCH = 200_000
 #: ... and from this many for :func:`ee_positions`, whose numpy path is already ~0.4 us per
 #: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (0.7-2 s) only
@@ -275,7 +275,7 @@ def ee_positions(
     q = as_joint_array(model, q)
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ConfigurationError(f"chunk must be an integer >= 1; got {chunk!r}")
-    flat = np.ascontiguousarray(q.reshape(-1, model.dof))
+    flat = np.require(q.reshape(-1, model.dof), requirements=["C", "W"])  # one numba specialisation
     out = np.empty((flat.shape[0], 3))
     if compiled is None:
         compiled = flat.shape[0] >= COMPILED_MIN_POSITIONS

@@ -16,6 +16,11 @@ The forward kinematics (:func:`chain_state`, :func:`ee_pose`, :func:`ee_position
 taking ``q`` and ``state=`` uses the state only at the angles it was computed at
 (:func:`state_at`).  The chain arithmetic shared with :mod:`jointlock.dynamics` lives in
 :mod:`jointlock._chain`: this module never imports the dynamics.
+
+:func:`jacobian` and :func:`generalized_jacobian` of large batches (from
+:data:`jointlock.forward.COMPILED_MIN_BATCH` configurations, or ``compiled=True``) run in
+compiled kernels (:mod:`jointlock._kernels`), chunk by chunk: memory holds the result and
+little else.
 """
 
 from __future__ import annotations
@@ -72,6 +77,8 @@ def _use_kernel(q: ArrayLike | None, frame: str, state: ChainState | None, compi
     root frame and without a precomputed state (which already holds the frames)."""
     if compiled is not None and not isinstance(compiled, (bool, np.bool_)):
         raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
+    if compiled and q is None:
+        raise ConfigurationError("compiled=True computes the Jacobian from q: give the joint angles q")
     if compiled and (frame != "base" or state is not None):
         raise ConfigurationError(
             "compiled=True computes the Jacobian in the root frame from q: use frame='base' and no state"
@@ -92,7 +99,7 @@ def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool) -> FloatA
 
     arr = as_joint_array(model, q)
     n = model.dof
-    flat = np.ascontiguousarray(arr.reshape(-1, n))
+    flat = np.require(arr.reshape(-1, n), requirements=["C", "W"])  # one numba specialisation
     out = np.empty((flat.shape[0], 6, n))
     rot, pos, tool, _skip = kernel_program(model)
     masses = kernel_mass_program(model) if generalized else None

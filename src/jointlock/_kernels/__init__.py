@@ -1,15 +1,19 @@
 """Compiled batch kernels (numba): chain forward kinematics, the fixed-base geometric Jacobian,
 the free-floating generalized Jacobian, singular values by one-sided Jacobi (alone, or fused
-with either Jacobian), and end-effector positions.
+with either Jacobian), end-effector positions, and the Newton-Euler joint torques and base
+wrench, fixed base and free-floating (:mod:`jointlock._kernels._dynamics`).
 
 The numpy implementations (:mod:`jointlock.forward`, :mod:`jointlock.kinematics`,
-``np.linalg.svd``) are the reference these kernels are tested against
-(``tests/test_kernels.py``); the public functions call the kernels.
+:func:`jointlock.dynamics.rnea`, ``np.linalg.svd``) are the reference these kernels are tested
+against (``tests/test_kernels.py``, ``tests/test_kernels_dynamics.py``); the public functions
+call the kernels.  Their inputs reach them as C-contiguous, writable float64 arrays (copied
+where they are not), so that numba compiles one specialisation per kernel.
 
 Layout.  Configurations are processed in blocks of :data:`BLOCK` with the block as the
 innermost (contiguous) axis of every work array ("structure of arrays"), so that each step
-is a plain loop over the block that LLVM turns into SIMD code.  Nothing here calls LAPACK
-or allocates per configuration.
+is a plain loop over the block, which LLVM turns into SIMD code where the body is simple
+enough (the sines and cosines, the Jacobi rotations; the Newton-Euler recursions run scalar).
+Nothing here calls LAPACK or allocates per configuration.
 
 Chain convention (the one of :func:`jointlock._chain.link_constants` and
 :func:`jointlock._chain.position_program`): every link in its ``z``-joint frame; link ``i``
@@ -24,8 +28,8 @@ system's inertia about its centre of mass (a 3 x 3 solve per configuration inste
 
 Numba is imported with this package, and only the public functions that take these
 kernels import it (lazily), from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations
-on: loading numba and the cached kernels costs a process 0.7 s on an idle core (about 2 s on
-a busy one), the first compilation on a machine 9-25 s (cached afterwards, ``cache=True``;
+on: loading numba and the cached kernels costs a process 0.4-0.7 s on an idle core (about 2 s
+on a busy one), the first compilation on a machine 5-25 s (cached afterwards, ``cache=True``;
 README, "Speed").
 
 Sines and cosines.  libm's scalar ``sin``/``cos`` cost ~25 ns each and block SIMD, so

@@ -127,10 +127,10 @@ def _forward(nb, sn, cs, qd, qdd, rot, pos, mass, com, inertia, state, force, mo
 
 
 @_jit
-def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, add, fn):
-    """Backward recursion (000 eq. 29): joint torques into ``tau[s0 : s0 + nb]`` (written,
-    or added to with ``add``), and into ``fn[0:6, :nb]`` the force and the moment about the
-    origin of link 1 that link 1 receives from its parent, in the parent's frame."""
+def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn):
+    """Backward recursion (000 eq. 29): joint torques into ``tau[s0 : s0 + nb]``, and into
+    ``fn[0:6, :nb]`` the force and the moment about the origin of link 1 that link 1 receives
+    from its parent, in the parent's frame."""
     n = rot.shape[0]
     for i in range(n - 1, -1, -1):
         c0, c1, c2 = com[i, 0], com[i, 1], com[i, 2]
@@ -160,10 +160,7 @@ def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, add, fn):
                 f2 += g2
             fn[0, b], fn[1, b], fn[2, b] = f0, f1, f2
             fn[3, b], fn[4, b], fn[5, b] = n0, n1, n2
-            if add:
-                tau[s0 + b, i] += n2
-            else:
-                tau[s0 + b, i] = n2
+            tau[s0 + b, i] = n2
 
 
 @_jit
@@ -215,7 +212,7 @@ def rnea_fixed(q, dq, ddq, rot, pos, mass, com, inertia, base_acc, point, tau, w
                 state[k, b] = 0.0
             state[6, b], state[7, b], state[8, b] = g0, g1, g2
         _forward(nb, sn, cs, qd, qdd, rot, pos, mass, com, inertia, state, force, moment)
-        _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, False, fn)
+        _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn)
         _to_parent(nb, sn, cs, rot, fn)
         for b in range(nb):
             f0, f1, f2 = fn[0, b], fn[1, b], fn[2, b]
@@ -462,7 +459,7 @@ def rnea_floating(q, dq, ddq, rot, pos, mass, com, inertia, root, point, tau, wr
                 state[k, b] = 0.0
             state[0, b], state[1, b], state[2, b] = om0, om1, om2
         _forward(nb, sn, cs, qd, qdd, rot, pos, mass, com, inertia, state, force, moment)
-        _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, False, fn)
+        _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn)
         _to_parent(nb, sn, cs, rot, fn)
         for b in range(nb):
             hx, hy, hz = sums[0, b], sums[1, b], sums[2, b]

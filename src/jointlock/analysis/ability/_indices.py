@@ -139,7 +139,8 @@ def _jacobi_values(arr: FloatArray) -> FloatArray:
     """Singular values by the compiled one-sided Jacobi kernel; LAPACK outside its range."""
     if arr.ndim < 2 or 0 in arr.shape[-2:]:
         return cast(FloatArray, np.linalg.svd(arr, compute_uv=False))
-    flat = np.ascontiguousarray(arr.reshape((-1,) + arr.shape[-2:]))
+    # C-contiguous and writable: one numba specialisation for any input layout
+    flat = np.require(arr.reshape((-1,) + arr.shape[-2:]), requirements=["C", "W"])
     big = np.max(np.abs(flat), initial=0.0)
     if not np.isfinite(big) or big > _COMPILED_RANGE[1] or 0.0 < big < _COMPILED_RANGE[0]:
         return cast(FloatArray, np.linalg.svd(arr, compute_uv=False))
@@ -347,7 +348,7 @@ def configuration_indices(
         raise ConfigurationError(f"batch_size must be >= 1; got {batch_size!r}")
     arr = as_joint_array(model, q)
     batch = arr.shape[:-1]
-    flat = np.ascontiguousarray(arr.reshape(-1, model.dof))
+    flat = np.require(arr.reshape(-1, model.dof), requirements=["C", "W"])  # one numba specialisation
     if method is None:
         from ...forward import COMPILED_MIN_BATCH
 
