@@ -239,3 +239,22 @@ def test_a_state_of_another_arm_is_refused():
 
     copy = pickle.loads(pickle.dumps(fourth))
     np.testing.assert_array_equal(jl.jacobian(copy, q, state=jl.chain_state(fourth, q)), jl.jacobian(fourth, q))
+
+
+def test_ee_pose_of_a_large_batch_is_computed_in_chunks(monkeypatch):
+    """Issue 13, bounded memory: ee_pose holds one chunk's frames at a time; the poses are
+    those of the whole-batch chain state."""
+    from jointlock import forward
+
+    model = jl.lock(jl.load_robot("canadarm7"), 2, 0.3)
+    q = np.random.default_rng(11).uniform(-np.pi, np.pi, (5, 13, model.dof))
+    s = forward.chain_state(model, q)
+    whole = jl.spatial.pose(s.ee_rotation, s.ee_position)
+    calls = []
+    real = forward.chain_state
+    monkeypatch.setattr(forward, "chain_state", lambda m, x: (calls.append(np.shape(x)), real(m, x))[1])
+    monkeypatch.setattr(forward, "DEFAULT_CHUNK", 20)
+    chunked = forward.ee_pose(model, q)
+    assert chunked.shape == (5, 13, 4, 4)
+    assert calls == [(20, model.dof)] * 3 + [(5, model.dof)]
+    np.testing.assert_allclose(chunked, whole, rtol=0, atol=1e-14)

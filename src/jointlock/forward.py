@@ -303,6 +303,18 @@ def link_poses(model: ArmModel, q: ArrayLike) -> FloatArray:
 
 
 def ee_pose(model: ArmModel, q: ArrayLike) -> FloatArray:
-    """(..., 4, 4) end-effector pose in the root frame [m]."""
-    s = chain_state(model, q)
-    return pose(s.ee_rotation, s.ee_position)
+    """(..., 4, 4) end-effector pose in the root frame [m].
+
+    Batches larger than :data:`DEFAULT_CHUNK` configurations are computed a chunk at a time,
+    so that memory holds the poses and one chunk's frames, not every frame of the batch
+    (:func:`chain_state` of 10^7 configurations of a 7-joint arm would take 8 GB)."""
+    arr = as_joint_array(model, q)
+    flat = arr.reshape(-1, model.dof)
+    if flat.shape[0] <= DEFAULT_CHUNK:
+        s = chain_state(model, arr)
+        return pose(s.ee_rotation, s.ee_position)
+    out = np.empty((flat.shape[0], 4, 4))
+    for s0 in range(0, flat.shape[0], DEFAULT_CHUNK):
+        s = chain_state(model, flat[s0 : s0 + DEFAULT_CHUNK])
+        out[s0 : s0 + DEFAULT_CHUNK] = pose(s.ee_rotation, s.ee_position)
+    return out.reshape(arr.shape[:-1] + (4, 4))
