@@ -85,7 +85,7 @@ def w2(model: jl.ArmModel, p: HaltProblem) -> None:
         import pin_oracle as po
     except ImportError:
         po = None
-    print("\nW2: halt7 joint 4 locked, joint torques + base wrench (best of 20 / 5)")
+    print("\nW2: halt7 joint 4 locked, joint torques + base wrench (best of 20 runs for one trajectory, 5 for 50)")
     print(
         f"  {'base':<9} {'samples':>14} {'numpy':>9} {'compiled':>9} {'Pinocchio':>10} "
         f"{'vs numpy':>9} {'vs Pinocchio':>13}"

@@ -207,15 +207,22 @@ def test_public_jacobians_take_the_kernels(base: str, monkeypatch: pytest.Monkey
     ref = generalized_jacobian(model, q, compiled=False)
     np.testing.assert_allclose(generalized_jacobian(model, q), ref, rtol=0, atol=1e-12 * np.max(np.abs(ref)))
     assert calls == ["jacobian"] * 3 + ["generalized_jacobian" if base == "floating" else "jacobian"] * 3
-    jacobian(model, q, frame="ee")  # the end-effector frame needs the frames: numpy
+    ref_ee = jacobian(model, q, frame="ee", compiled=False)
+    np.testing.assert_allclose(jacobian(model, q, frame="ee"), ref_ee, rtol=0, atol=3e-11)  # kernel, turned
+    assert len(calls) == 9
     jacobian(model, q[0, :3])  # three configurations: numpy
-    assert len(calls) == 6
-    with pytest.raises(jl.ConfigurationError, match="compiled=True computes the Jacobian in the root frame"):
-        jacobian(model, q, frame="ee", compiled=True)
+    jacobian(model, q, state=kinematics.chain_state(model, q))  # a state holds the frames: numpy
+    assert len(calls) == 9
+    with pytest.raises(jl.ConfigurationError, match="give q, and no state"):
+        jacobian(model, q, state=kinematics.chain_state(model, q), compiled=True)
+    with pytest.raises(jl.ConfigurationError, match="frame must be 'base' or 'ee'"):
+        jacobian(model, q, frame="tool", compiled=True)
     with pytest.raises(jl.ConfigurationError, match="compiled must be True, False or None"):
         generalized_jacobian(model, q, compiled=1)
-    with pytest.raises(jl.ConfigurationError, match="give the joint angles q"):
+    with pytest.raises(jl.ConfigurationError, match="give q, and no state"):
         jacobian(model, None, compiled=True)
+    with pytest.raises(jl.ConfigurationError, match="ragged"):
+        jacobian(model, [[0.0] * model.dof, [0.0] * (model.dof - 1)])
 
 
 def test_kernels_compile_once_for_any_input_layout() -> None:

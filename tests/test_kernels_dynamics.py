@@ -147,3 +147,15 @@ def test_kernel_refuses_a_singular_system_inertia() -> None:
     for compiled in (False, True):
         with pytest.raises(jl.ModelError, match="rotational inertia about its centre of mass is singular"):
             rnea(model, q, q + 0.1, q, base="floating", compiled=compiled)
+
+
+@pytest.mark.parametrize("compiled", [False, True])
+def test_bad_gravity_and_moment_point_are_named(compiled: bool) -> None:
+    model = jl.load_robot("halt7")
+    q = np.zeros((2, 7))
+    for kw, name in (({"gravity": "down"}, "gravity"), ({"moment_point": [1.0, "a", 2.0]}, "moment_point"),
+                     ({"gravity": [0.0, 0.0]}, "gravity"), ({"moment_point": [0.0, np.inf, 0.0]}, "moment_point")):
+        with pytest.raises(jl.ModelError, match=f"^{name} must be 3 finite numbers"):
+            rnea(model, q, q, q, compiled=compiled, **kw)
+    with pytest.raises(jl.ConfigurationError, match="dq must be .* ragged"):
+        rnea(model, q, [[0.0] * 7, [0.0] * 6], q, compiled=compiled)

@@ -330,7 +330,8 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     wrench = np.empty((n_samples, 6))
     acc = np.zeros((n_samples, 6))
     twist = np.zeros((n_samples, 6))
-    bq, bdq, bddq = (np.broadcast_to(x, shape).reshape(-1, n) for x in (q, dq, ddq))
+    # a view of an input that has the full shape (writable: no copy below), else its broadcast
+    bq, bdq, bddq = ((x if x.shape == shape else np.broadcast_to(x, shape)).reshape(-1, n) for x in (q, dq, ddq))
     root = model.root_body
     point = np.array(point, dtype=float)  # writable, contiguous: one numba specialisation
     if base == "fixed":
@@ -352,6 +353,17 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     if bad:
         raise ModelError(_SINGULAR_SYSTEM)
     return tau, wrench, acc, twist
+
+
+def _three_numbers(value: ArrayLike, name: str, unit: str) -> FloatArray:
+    """``value`` as (3,) finite floats, or :class:`ModelError` naming ``name``."""
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        arr = np.full(1, np.nan)
+    if arr.shape != (3,) or not np.all(np.isfinite(arr)):
+        raise ModelError(f"{name} must be 3 finite numbers [{unit}]; got {str(value)[:80]}")
+    return arr
 
 
 def rnea(
@@ -400,7 +412,7 @@ def rnea(
         True: the compiled kernels (:mod:`jointlock._kernels`, numba; the same numbers to
         round-off); False: the numpy implementation (the reference the kernels are tested
         against); None (default): the kernels from :data:`jointlock.forward.COMPILED_MIN_BATCH`
-        samples on, where they win back numba's start-up (0.4-2 s per process).  Pass True
+        (200,000) samples on, where they win back numba's start-up (0.4-2 s per process).  Pass True
         when calling many times in one process (an optimiser scoring candidates).
 
     Returns
@@ -426,14 +438,8 @@ def rnea(
             f"base='floating' needs a free-floating model (a spacecraft body); model {model.name!r} "
             "has a fixed base: load it with base='floating'"
         )
-    point = model.root_body.com if moment_point is None else np.asarray(moment_point, dtype=float)
-    if point.shape != (3,) or not np.all(np.isfinite(point)):
-        raise ModelError(
-            f"moment_point must be 3 finite numbers [m]; got {np.asarray(moment_point).tolist()}"
-        )
-    g = np.zeros(3) if gravity is None else np.asarray(gravity, dtype=float)
-    if g.shape != (3,) or not np.all(np.isfinite(g)):
-        raise ModelError(f"gravity must be 3 finite numbers [m/s^2]; got {np.asarray(gravity).tolist()}")
+    point = model.root_body.com if moment_point is None else _three_numbers(moment_point, "moment_point", "m")
+    g = np.zeros(3) if gravity is None else _three_numbers(gravity, "gravity", "m/s^2")
     if base == "floating" and np.any(g != 0):
         raise ModelError("gravity must be zero with base='floating' (a free-falling system feels none)")
 

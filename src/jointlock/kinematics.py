@@ -73,28 +73,32 @@ def com_positions(model: ArmModel, q: ArrayLike | None, state: ChainState | None
 
 def _use_kernel(q: ArrayLike | None, frame: str, state: ChainState | None, compiled: bool | None) -> bool:
     """Whether a Jacobian is computed by the compiled kernels: asked for (``compiled=True``),
-    or by default from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations, in the
-    root frame and without a precomputed state (which already holds the frames)."""
+    or by default from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations without a
+    precomputed state (which already holds the frames)."""
     if compiled is not None and not isinstance(compiled, (bool, np.bool_)):
         raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
-    if compiled and q is None:
-        raise ConfigurationError("compiled=True computes the Jacobian from q: give the joint angles q")
-    if compiled and (frame != "base" or state is not None):
+    if compiled and (q is None or state is not None):
         raise ConfigurationError(
-            "compiled=True computes the Jacobian in the root frame from q: use frame='base' and no state"
+            "compiled=True computes the Jacobian from the joint angles q: give q, and no state"
         )
+    if frame not in ("base", "ee") or compiled is False:
+        return False  # the numpy path says what is wrong with frame
     if compiled is None:
-        if frame != "base" or state is not None or q is None:
+        if state is not None or q is None:
             return False
-        shape = np.shape(q)  # validated afterwards, by whichever path runs
+        try:
+            shape = np.shape(q)  # validated afterwards, by whichever path runs
+        except ValueError:  # ragged: as_joint_array says so
+            return False
         return len(shape) > 1 and math.prod(shape[:-1]) >= _fk.COMPILED_MIN_BATCH
-    return bool(compiled)
+    return True
 
 
-def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool) -> FloatArray:
+def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool, frame: str) -> FloatArray:
     """(..., 6, n) Jacobian by :func:`jointlock._kernels.jacobian` or
     :func:`jointlock._kernels.generalized_jacobian`, :data:`DEFAULT_CHUNK` configurations at a
-    time (no frames of the whole batch are held)."""
+    time (no frames of the whole batch are held); with ``frame="ee"`` each chunk is turned into
+    the end-effector frame by the rotation of :func:`ee_pose`."""
     from . import _kernels  # numba is imported on first use, not with the package
 
     arr = as_joint_array(model, q)
@@ -109,6 +113,8 @@ def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool) -> FloatA
             _kernels.jacobian(flat[part], rot, pos, tool, out[part])
         else:
             _kernels.generalized_jacobian(flat[part], rot, pos, tool, *masses, out[part])
+        if frame == "ee":
+            out[part] = _rotate_twist(np.swapaxes(ee_pose(model, flat[part])[..., :3, :3], -1, -2), out[part])
     return out.reshape(arr.shape[:-1] + (6, n))
 
 
@@ -136,11 +142,11 @@ def jacobian(
         It must have been computed at ``q`` (:class:`~jointlock.errors.ConfigurationError`
         otherwise); with a state, ``q=None`` means ``state.q``.
     compiled
-        True: the compiled kernel (:func:`jointlock._kernels.jacobian`; root frame, no
+        True: the compiled kernel (:func:`jointlock._kernels.jacobian`; from ``q``, no
         state), in chunks, so that memory holds the result and little else; False: numpy
         from :func:`chain_state` (the reference the kernel is tested against); None
-        (default): the kernel from :data:`jointlock.forward.COMPILED_MIN_BATCH`
-        configurations on, in the root frame without a state.  Both agree to round-off.
+        (default): the kernel from :data:`jointlock.forward.COMPILED_MIN_BATCH` (200,000)
+        configurations on, when no state is given.  Both agree to round-off.
 
     Returns
     -------
@@ -150,7 +156,7 @@ def jacobian(
     """
     if _use_kernel(q, frame, state, compiled):
         assert q is not None  # state is None here
-        return _kernel_jacobian(model, q, generalized=False)
+        return _kernel_jacobian(model, q, generalized=False, frame=frame)
     s = state_at(model, q, state)
     z, p, pe = s.soa_axes, s.soa_positions, s.soa_ee_position
     d = pe[None] - p  # (n, 3, N)
@@ -276,7 +282,7 @@ def generalized_jacobian(
     """
     if _use_kernel(q, frame, state, compiled):
         assert q is not None  # state is None here
-        return _kernel_jacobian(model, q, generalized=model.floating)
+        return _kernel_jacobian(model, q, generalized=model.floating, frame=frame)
     s = state_at(model, q, state)
     jm = jacobian(model, s.q, state=s)
     if model.floating:

@@ -438,7 +438,13 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
     """
     from .errors import ConfigurationError
 
-    raw = np.asarray(q)
+    try:
+        raw = np.asarray(q)
+    except ValueError:  # a ragged nesting of lists
+        raise ConfigurationError(
+            f"{name} must be an array of real numbers with shape (..., {model.dof}); got a ragged "
+            f"nesting of sequences ({shown(q)})"
+        ) from None
     if raw.dtype.kind not in "iuf":  # bool, complex, text, objects: no silent conversion
         if raw.dtype.kind == "O":
             try:
