@@ -153,8 +153,13 @@ def test_kernel_refuses_a_singular_system_inertia() -> None:
 def test_bad_gravity_and_moment_point_are_named(compiled: bool) -> None:
     model = jl.load_robot("halt7")
     q = np.zeros((2, 7))
-    for kw, name in (({"gravity": "down"}, "gravity"), ({"moment_point": [1.0, "a", 2.0]}, "moment_point"),
-                     ({"gravity": [0.0, 0.0]}, "gravity"), ({"moment_point": [0.0, np.inf, 0.0]}, "moment_point")):
+    cases = (
+        ({"gravity": "down"}, "gravity"),
+        ({"moment_point": [1.0, "a", 2.0]}, "moment_point"),
+        ({"gravity": [0.0, 0.0]}, "gravity"),
+        ({"moment_point": [0.0, np.inf, 0.0]}, "moment_point"),
+    )
+    for kw, name in cases:
         with pytest.raises(jl.ModelError, match=f"^{name} must be 3 finite numbers"):
             rnea(model, q, q, q, compiled=compiled, **kw)
     with pytest.raises(jl.ConfigurationError, match="dq must be .* ragged"):

@@ -331,7 +331,9 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     acc = np.zeros((n_samples, 6))
     twist = np.zeros((n_samples, 6))
     # a view of an input that has the full shape (writable: no copy below), else its broadcast
-    bq, bdq, bddq = ((x if x.shape == shape else np.broadcast_to(x, shape)).reshape(-1, n) for x in (q, dq, ddq))
+    bq, bdq, bddq = (
+        (x if x.shape == shape else np.broadcast_to(x, shape)).reshape(-1, n) for x in (q, dq, ddq)
+    )
     root = model.root_body
     point = np.array(point, dtype=float)  # writable, contiguous: one numba specialisation
     if base == "fixed":

@@ -32,7 +32,7 @@ DEFAULT_CHUNK = 65536
 #: compilation on a machine 5-25 s (README, "Speed").
 COMPILED_MIN_BATCH = 200_000
 #: ... and from this many for :func:`ee_positions`, whose numpy path is already ~0.4 us per
-#: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (0.7-2 s) only
+#: point: the kernel saves ~0.3 us per point, so it wins back numba's start-up (0.4-2 s) only
 #: on millions of points (a 200,000-sample workspace stays on numpy).
 COMPILED_MIN_POSITIONS = 4_000_000
 
