@@ -340,12 +340,26 @@ def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatA
     """The masses for :func:`jointlock._kernels.generalized_jacobian`: per link mass (n,),
     centre of mass (n, 3) [m] and inertia about it (n, 3, 3) [kg m^2] in its ``z``-joint
     frame, and the spacecraft's mass, centre of mass and inertia (root frame) packed (13,)."""
-    links = link_constants(model, np.zeros(3))
-    root = model.root_body
-    packed = np.concatenate([[root.mass], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])
+    _rot, _pos, mass, com, inertia = kernel_link_arrays(model, np.zeros(3))
+    return mass, com, inertia, kernel_root(model)
+
+
+def kernel_link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:
+    """The links of :func:`link_constants` (parent of link 1 moved to ``origin`` (3,) [m]) as
+    the Newton-Euler kernels (:mod:`jointlock._kernels._dynamics`) take them: ``E`` (n, 3, 3),
+    ``p`` (n, 3) [m], mass (n,) [kg], centre of mass (n, 3) [m], inertia (n, 3, 3) [kg m^2]."""
+    links = link_constants(model, origin)
     return (
+        np.ascontiguousarray([link.rot for link in links], dtype=float),
+        np.ascontiguousarray([link.pos for link in links], dtype=float),
         np.array([link.mass for link in links], dtype=float),
         np.ascontiguousarray([link.com for link in links], dtype=float),
         np.ascontiguousarray([link.inertia for link in links], dtype=float),
-        packed.astype(float),
     )
+
+
+def kernel_root(model: ArmModel) -> FloatArray:
+    """(13,) the root body's (spacecraft's) mass [kg], centre of mass (3) [m] and inertia
+    about it (9, row-major) [kg m^2], root frame, as the kernels take them."""
+    root = model.root_body
+    return np.concatenate([[float(root.mass)], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])

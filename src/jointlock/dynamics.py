@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import forward as _fk
-from ._chain import SYM, composite, link_constants
+from ._chain import SYM, composite, kernel_link_arrays, kernel_root, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
 from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
@@ -305,20 +305,6 @@ def _kernel_input(x: FloatArray) -> FloatArray:
     return np.require(x, dtype=float, requirements=["C", "W"])
 
 
-def _link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:
-    """The links of :func:`jointlock._chain.link_constants` as the kernels of
-    :mod:`jointlock._kernels._dynamics` take them: ``E`` (n, 3, 3), ``p`` (n, 3), mass (n,),
-    centre of mass (n, 3), inertia (n, 3, 3)."""
-    links = link_constants(model, origin)
-    return (
-        np.ascontiguousarray([link.rot for link in links], dtype=float),
-        np.ascontiguousarray([link.pos for link in links], dtype=float),
-        np.array([link.mass for link in links], dtype=float),
-        np.ascontiguousarray([link.com for link in links], dtype=float),
-        np.ascontiguousarray([link.inertia for link in links], dtype=float),
-    )
-
-
 def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     """:func:`rnea` by the compiled kernels, in chunks of :data:`_COMPILED_CHUNK` samples:
     (torques, base wrench, base acceleration, base twist) as (N, .) arrays."""
@@ -337,11 +323,11 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     root = model.root_body
     point = np.array(point, dtype=float)  # writable, contiguous: one numba specialisation
     if base == "fixed":
-        links = _link_arrays(model, np.zeros(3))
+        links = kernel_link_arrays(model, np.zeros(3))
         base_acc = -g  # gravity as an upward base acceleration
     else:
-        links = _link_arrays(model, root.com)
-        packed = np.concatenate([[root.mass], root.com, np.asarray(root.inertia, dtype=float).reshape(9)])
+        links = kernel_link_arrays(model, root.com)
+        packed = kernel_root(model)
     bad = 0
     for s0 in range(0, n_samples, _COMPILED_CHUNK):
         part = slice(s0, s0 + _COMPILED_CHUNK)

@@ -439,12 +439,9 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
     from .errors import ConfigurationError
 
     try:
-        raw = np.asarray(q)
+        raw, kind = np.asarray(q), ""
     except ValueError:  # a ragged nesting of lists
-        raise ConfigurationError(
-            f"{name} must be an array of real numbers with shape (..., {model.dof}); got a ragged "
-            f"nesting of sequences ({shown(q)})"
-        ) from None
+        raw, kind = np.empty(0, dtype=object), "a ragged nesting of sequences"
     if raw.dtype.kind not in "iuf":  # bool, complex, text, objects: no silent conversion
         if raw.dtype.kind == "O":
             try:
@@ -453,8 +450,8 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
                 pass
         if raw.dtype.kind not in "iuf":
             raise ConfigurationError(
-                f"{name} must be an array of real numbers with shape (..., {model.dof}); got dtype "
-                f"{raw.dtype} ({shown(q)})"
+                f"{name} must be an array of real numbers with shape (..., {model.dof}); got "
+                f"{kind or f'dtype {raw.dtype}'} ({shown(q)})"
             )
     arr = np.asarray(raw, dtype=float)
     if arr.ndim == 0 or arr.shape[-1] != model.dof:
@@ -462,11 +459,7 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
             f"{name} must have shape (..., {model.dof}) for model {shown(model.name)} "
             f"(movable joints {list(model.joint_numbers)}); got shape {arr.shape}"
         )
-    # one pass without a temporary first: the sum is finite when every entry is (an overflowing
-    # sum of finite entries falls through to the exact test)
-    with np.errstate(over="ignore", invalid="ignore"):
-        finite_sum = math.isfinite(float(np.sum(arr)))
-    if not finite_sum and not np.all(np.isfinite(arr)):
+    if not np.all(np.isfinite(arr)):
         bad = tuple(int(i) for i in np.argwhere(~np.isfinite(arr))[0])
         raise ConfigurationError(f"{name} must be finite; got {arr[bad]} at index {bad}")
     return arr

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._common import BLOCK, _jit, _trig_block
+from ._common import BLOCK, _adjugate3, _jit, _trig_block
 from ._svd import _jacobi6_block, _jacobi_block, _work
 
 
@@ -263,13 +263,8 @@ def _generalized_block(q, s0, nb, rot, pos, tool, length, mass, com, inertia, ro
         ixz = cxz + root[6] - m0 * r0x * r0z + total * gx * gz
         iyz = cyz + root[9] - m0 * r0y * r0z + total * gy * gz
         # I_g^-1 by the adjugate (symmetric positive definite 3 x 3)
-        a00 = iyy * izz - iyz * iyz
-        a01 = ixz * iyz - ixy * izz
-        a02 = ixy * iyz - ixz * iyy
-        a11 = ixx * izz - ixz * ixz
-        a12 = ixy * ixz - ixx * iyz
-        a22 = ixx * iyy - ixy * ixy
-        inv_det = 1.0 / (ixx * a00 + ixy * a01 + ixz * a02)
+        a00, a11, a22, a01, a02, a12, det = _adjugate3(ixx, iyy, izz, ixy, ixz, iyz)
+        inv_det = 1.0 / det
         eg0, eg1, eg2 = pe0 - gx, pe1 - gy, pe2 - gz
         for j in range(n):
             z0, z1, z2 = w[j, 0, b], w[j, 1, b], w[j, 2, b]

@@ -73,6 +73,19 @@ def _sincos(x):
     return sin_x, cos_x
 
 
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _adjugate3(xx, yy, zz, xy, xz, yz):
+    """Adjugate of the symmetric 3 x 3 matrix with entries ``xx yy zz xy xz yz``, as
+    ``(a_xx, a_yy, a_zz, a_xy, a_xz, a_yz)``, and its determinant (inverse = adjugate / det)."""
+    axx = yy * zz - yz * yz
+    axy = xz * yz - xy * zz
+    axz = xy * yz - xz * yy
+    ayy = xx * zz - xz * xz
+    ayz = xy * xz - xx * yz
+    azz = xx * yy - xy * xy
+    return axx, ayy, azz, axy, axz, ayz, xx * axx + xy * axy + xz * axz
+
+
 @_jit
 def _trig_block(q, s0, nb, joint, sin_out, cos_out):
     """``sin``/``cos`` of ``q[s0:s0 + nb, joint]`` into ``sin_out[:nb]``, ``cos_out[:nb]``."""

@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
-from ._common import BLOCK, _jit, _trig_block
+from ._common import BLOCK, _adjugate3, _jit, _trig_block
 
 
 @njit(inline="always", cache=True, error_model="numpy", nogil=True)
@@ -49,6 +49,29 @@ def _entries(m):
     of the loops over the block (the work arrays those loops write could alias ``m``, so
     the compiler would not hoist the loads itself)."""
     return m[0, 0], m[0, 1], m[0, 2], m[1, 0], m[1, 1], m[1, 2], m[2, 0], m[2, 1], m[2, 2]
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _into_link(e, c, s, x0, x1, x2):
+    """``Rot(z, q)^T E^T x``: a parent-frame vector in the link frame (``e``: the nine entries
+    of ``E`` row by row, ``c, s = cos q, sin q``)."""
+    e00, e01, e02, e10, e11, e12, e20, e21, e22 = e
+    u0 = e00 * x0 + e10 * x1 + e20 * x2
+    u1 = e01 * x0 + e11 * x1 + e21 * x2
+    u2 = e02 * x0 + e12 * x1 + e22 * x2
+    return c * u0 + s * u1, c * u1 - s * u0, u2
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _out_of_link(e, c, s, x0, x1, x2):
+    """``E Rot(z, q) x``: a link-frame vector in the parent frame (see :func:`_into_link`)."""
+    e00, e01, e02, e10, e11, e12, e20, e21, e22 = e
+    r0, r1 = c * x0 - s * x1, s * x0 + c * x1
+    return (
+        e00 * r0 + e01 * r1 + e02 * x2,
+        e10 * r0 + e11 * r1 + e12 * x2,
+        e20 * r0 + e21 * r1 + e22 * x2,
+    )
 
 
 @_jit
@@ -70,7 +93,7 @@ def _forward(nb, sn, cs, qd, qdd, rot, pos, mass, com, inertia, state, force, mo
     ``force``, ``moment`` (n, 3, BLOCK).  ``state`` ends as the last link's."""
     n = rot.shape[0]
     for i in range(n):
-        e00, e01, e02, e10, e11, e12, e20, e21, e22 = _entries(rot[i])
+        e = _entries(rot[i])
         i00, i01, i02, i10, i11, i12, i20, i21, i22 = _entries(inertia[i])
         p0, p1, p2 = pos[i, 0], pos[i, 1], pos[i, 2]
         m = mass[i]
@@ -85,23 +108,10 @@ def _forward(nb, sn, cs, qd, qdd, rot, pos, mass, com, inertia, state, force, mo
             a0 = state[6, b] + d1 * p2 - d2 * p1 + w1 * x2 - w2 * x1
             a1 = state[7, b] + d2 * p0 - d0 * p2 + w2 * x0 - w0 * x2
             a2 = state[8, b] + d0 * p1 - d1 * p0 + w0 * x1 - w1 * x0
-            # into the link frame: Rot(z, q)^T E^T
             c, s = cs[i, b], sn[i, b]
-            u0 = e00 * w0 + e10 * w1 + e20 * w2
-            u1 = e01 * w0 + e11 * w1 + e21 * w2
-            u2 = e02 * w0 + e12 * w1 + e22 * w2
-            v0 = e00 * d0 + e10 * d1 + e20 * d2
-            v1 = e01 * d0 + e11 * d1 + e21 * d2
-            v2 = e02 * d0 + e12 * d1 + e22 * d2
-            g0 = e00 * a0 + e10 * a1 + e20 * a2
-            g1 = e01 * a0 + e11 * a1 + e21 * a2
-            g2 = e02 * a0 + e12 * a1 + e22 * a2
-            wu0 = c * u0 + s * u1
-            wu1 = c * u1 - s * u0
-            wdu0 = c * v0 + s * v1
-            wdu1 = c * v1 - s * v0
-            la0 = c * g0 + s * g1
-            la1 = c * g1 - s * g0
+            wu0, wu1, u2 = _into_link(e, c, s, w0, w1, w2)
+            wdu0, wdu1, v2 = _into_link(e, c, s, d0, d1, d2)
+            la0, la1, g2 = _into_link(e, c, s, a0, a1, a2)
             rate, accel = qd[i, b], qdd[i, b]
             nw0, nw1, nw2 = wu0, wu1, u2 + rate
             nd0, nd1, nd2 = wdu0 + wu1 * rate, wdu1 - wu0 * rate, v2 + accel
@@ -136,7 +146,7 @@ def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn):
         c0, c1, c2 = com[i, 0], com[i, 1], com[i, 2]
         last = i == n - 1
         j = i if last else i + 1
-        e00, e01, e02, e10, e11, e12, e20, e21, e22 = _entries(rot[j])
+        e = _entries(rot[j])
         p0, p1, p2 = pos[j, 0], pos[j, 1], pos[j, 2]
         for b in range(nb):
             f0, f1, f2 = force[i, 0, b], force[i, 1, b], force[i, 2, b]
@@ -145,16 +155,11 @@ def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn):
             n2 = moment[i, 2, b] + c0 * f1 - c1 * f0
             if not last:
                 c, s = cs[i + 1, b], sn[i + 1, b]
-                x0, x1, x2 = fn[0, b], fn[1, b], fn[2, b]
-                r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-                g0 = e00 * r0 + e01 * r1 + e02 * x2
-                g1 = e10 * r0 + e11 * r1 + e12 * x2
-                g2 = e20 * r0 + e21 * r1 + e22 * x2
-                x0, x1, x2 = fn[3, b], fn[4, b], fn[5, b]
-                r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-                n0 += e00 * r0 + e01 * r1 + e02 * x2 + p1 * g2 - p2 * g1
-                n1 += e10 * r0 + e11 * r1 + e12 * x2 + p2 * g0 - p0 * g2
-                n2 += e20 * r0 + e21 * r1 + e22 * x2 + p0 * g1 - p1 * g0
+                g0, g1, g2 = _out_of_link(e, c, s, fn[0, b], fn[1, b], fn[2, b])
+                h0, h1, h2 = _out_of_link(e, c, s, fn[3, b], fn[4, b], fn[5, b])
+                n0 += h0 + p1 * g2 - p2 * g1
+                n1 += h1 + p2 * g0 - p0 * g2
+                n2 += h2 + p0 * g1 - p1 * g0
                 f0 += g0
                 f1 += g1
                 f2 += g2
@@ -166,15 +171,11 @@ def _backward(nb, sn, cs, rot, pos, com, force, moment, tau, s0, fn):
 @_jit
 def _to_parent(nb, sn, cs, rot, fn):
     """``fn[0:6, :nb]`` (force, moment in the frame of link 1) turned into its parent's frame."""
-    e00, e01, e02, e10, e11, e12, e20, e21, e22 = _entries(rot[0])
+    e = _entries(rot[0])
     for b in range(nb):
         c, s = cs[0, b], sn[0, b]
         for k in (0, 3):
-            x0, x1, x2 = fn[k, b], fn[k + 1, b], fn[k + 2, b]
-            r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-            fn[k, b] = e00 * r0 + e01 * r1 + e02 * x2
-            fn[k + 1, b] = e10 * r0 + e11 * r1 + e12 * x2
-            fn[k + 2, b] = e20 * r0 + e21 * r1 + e22 * x2
+            fn[k, b], fn[k + 1, b], fn[k + 2, b] = _out_of_link(e, c, s, fn[k, b], fn[k + 1, b], fn[k + 2, b])
 
 
 @_jit
@@ -285,7 +286,8 @@ def _move_composite(nb, sn, cs, rot, pos, j, mc, sums):
     ``mc``) moved into the parent frame of link ``j``, about its origin: turned by
     ``R = E_j Rot(z, q_j)``, then shifted by ``p_j`` (parallel axes:
     ``K' = R K R^T + mc (|p|^2 1 - p p^T) + 2 (p.g) 1 - p g^T - g p^T`` with ``g = R S``)."""
-    e00, e01, e02, e10, e11, e12, e20, e21, e22 = _entries(rot[j])
+    e = _entries(rot[j])
+    e00, e01, e02, e10, e11, e12, e20, e21, e22 = e
     p0, p1, p2 = pos[j, 0], pos[j, 1], pos[j, 2]
     pp = p0 * p0 + p1 * p1 + p2 * p2
     mxx, myy, mzz = mc * (pp - p0 * p0), mc * (pp - p1 * p1), mc * (pp - p2 * p2)
@@ -312,21 +314,12 @@ def _move_composite(nb, sn, cs, rot, pos, j, mc, sums):
         t21 = e20 * rxy + e21 * ryy + e22 * ryz
         t22 = e20 * rxz + e21 * ryz + e22 * zz
         # vectors: first moment, linear and angular momentum, turned by R
-        x0, x1, x2 = sums[0, b], sums[1, b], sums[2, b]
-        r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-        g0 = e00 * r0 + e01 * r1 + e02 * x2
-        g1 = e10 * r0 + e11 * r1 + e12 * x2
-        g2 = e20 * r0 + e21 * r1 + e22 * x2
-        x0, x1, x2 = sums[9, b], sums[10, b], sums[11, b]
-        r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-        l0 = e00 * r0 + e01 * r1 + e02 * x2
-        l1 = e10 * r0 + e11 * r1 + e12 * x2
-        l2 = e20 * r0 + e21 * r1 + e22 * x2
-        x0, x1, x2 = sums[12, b], sums[13, b], sums[14, b]
-        r0, r1 = c * x0 - s * x1, s * x0 + c * x1
-        sums[12, b] = e00 * r0 + e01 * r1 + e02 * x2 + p1 * l2 - p2 * l1
-        sums[13, b] = e10 * r0 + e11 * r1 + e12 * x2 + p2 * l0 - p0 * l2
-        sums[14, b] = e20 * r0 + e21 * r1 + e22 * x2 + p0 * l1 - p1 * l0
+        g0, g1, g2 = _out_of_link(e, c, s, sums[0, b], sums[1, b], sums[2, b])
+        l0, l1, l2 = _out_of_link(e, c, s, sums[9, b], sums[10, b], sums[11, b])
+        h0, h1, h2 = _out_of_link(e, c, s, sums[12, b], sums[13, b], sums[14, b])
+        sums[12, b] = h0 + p1 * l2 - p2 * l1
+        sums[13, b] = h1 + p2 * l0 - p0 * l2
+        sums[14, b] = h2 + p0 * l1 - p1 * l0
         sums[9, b], sums[10, b], sums[11, b] = l0, l1, l2
         pg = p0 * g0 + p1 * g1 + p2 * g2
         sums[3, b] = t00 * e00 + t01 * e01 + t02 * e02 + mxx + 2.0 * (pg - p0 * g0)
@@ -347,7 +340,7 @@ def _accel_torques(nb, sn, cs, rot, pos, columns, state, tau, s0):
     :func:`_composite_block`)."""
     n = rot.shape[0]
     for i in range(n):
-        e00, e01, e02, e10, e11, e12, e20, e21, e22 = _entries(rot[i])
+        e = _entries(rot[i])
         p0, p1, p2 = pos[i, 0], pos[i, 1], pos[i, 2]
         for b in range(nb):
             d0, d1, d2 = state[3, b], state[4, b], state[5, b]
@@ -355,14 +348,8 @@ def _accel_torques(nb, sn, cs, rot, pos, columns, state, tau, s0):
             a1 = state[7, b] + d2 * p0 - d0 * p2
             a2 = state[8, b] + d0 * p1 - d1 * p0
             c, s = cs[i, b], sn[i, b]
-            v0 = e00 * d0 + e10 * d1 + e20 * d2
-            v1 = e01 * d0 + e11 * d1 + e21 * d2
-            v2 = e02 * d0 + e12 * d1 + e22 * d2
-            g0 = e00 * a0 + e10 * a1 + e20 * a2
-            g1 = e01 * a0 + e11 * a1 + e21 * a2
-            g2 = e02 * a0 + e12 * a1 + e22 * a2
-            nd0, nd1 = c * v0 + s * v1, c * v1 - s * v0
-            la0, la1 = c * g0 + s * g1, c * g1 - s * g0
+            nd0, nd1, v2 = _into_link(e, c, s, d0, d1, d2)
+            la0, la1, g2 = _into_link(e, c, s, a0, a1, a2)
             state[3, b], state[4, b], state[5, b] = nd0, nd1, v2
             state[6, b], state[7, b], state[8, b] = la0, la1, g2
             tau[s0 + b, i] += (
@@ -429,13 +416,7 @@ def rnea_floating(q, dq, ddq, rot, pos, mass, com, inertia, root, point, tau, wr
             kxy = sums[6, b] + z01 + hx * hy * inv_total
             kxz = sums[7, b] + z02 + hx * hz * inv_total
             kyz = sums[8, b] + z12 + hy * hz * inv_total
-            cxx = kyy * kzz - kyz * kyz
-            cxy = kxz * kyz - kxy * kzz
-            cxz = kxy * kyz - kxz * kyy
-            cyy = kxx * kzz - kxz * kxz
-            cyz = kxy * kxz - kxx * kyz
-            czz = kxx * kyy - kxy * kxy
-            det = kxx * cxx + kxy * cxy + kxz * cxz
+            cxx, cyy, czz, cxy, cxz, cyz, det = _adjugate3(kxx, kyy, kzz, kxy, kxz, kyz)
             if not det > 0.0:
                 bad += 1
             inv_det = 1.0 / det
