@@ -121,18 +121,30 @@ def _distance_to_axis(x: FloatArray, point: FloatArray, direction: FloatArray) -
 # -- rotations and subproblems, batched over the leading axes ------------------------------
 
 
+def _cross_matrix(axis: FloatArray) -> FloatArray:
+    """(3, 3) ``K`` with ``K x = axis x x``; for a batch of row vectors ``x @ K.T``."""
+    return np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+
+
 def _rotate(axis: FloatArray, angle: FloatArray, v: FloatArray) -> FloatArray:
     """``v`` (..., 3) turned by ``angle`` (...) [rad] about the unit ``axis`` (3,) (Rodrigues)."""
     c, s = np.cos(angle)[..., None], np.sin(angle)[..., None]
     along = (v @ axis)[..., None] * axis
-    return along + c * (v - along) + s * np.cross(axis, v)
+    return along + c * (v - along) + s * (v @ _cross_matrix(axis).T)
 
 
 def _rotation(axis: FloatArray, angle: FloatArray) -> FloatArray:
-    """(..., 3, 3) rotation by ``angle`` (...) [rad] about the unit ``axis`` (3,)."""
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    c, s = np.cos(angle)[..., None, None], np.sin(angle)[..., None, None]
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+    """(..., 3, 3) rotation by ``angle`` (...) [rad] about the unit ``axis`` (3,):
+    ``1 + s K + (1 - c) K^2``, entry by entry (no (..., 3, 3) temporaries per term)."""
+    k = _cross_matrix(axis)
+    kk = k @ k
+    c, s = np.cos(angle), np.sin(angle)
+    out = np.empty(np.shape(angle) + (3, 3))
+    vers = 1.0 - c
+    for i in range(3):
+        for j in range(3):
+            out[..., i, j] = (1.0 if i == j else 0.0) + s * k[i, j] + vers * kk[i, j]
+    return out
 
 
 def _turn_onto(axis: FloatArray, u: FloatArray, v: FloatArray, free: FloatArray) -> FloatArray:
@@ -140,10 +152,11 @@ def _turn_onto(axis: FloatArray, u: FloatArray, v: FloatArray, free: FloatArray)
     (through the origin); ``free`` where ``u`` or ``v`` lies on the axis (any angle does)."""
     up = u - (u @ axis)[..., None] * axis
     vp = v - (v @ axis)[..., None] * axis
-    sin = np.cross(up, vp) @ axis
+    sin = np.sum(up * (vp @ _cross_matrix(axis)), axis=-1)  # axis . (up x vp) = up . (vp x axis)
     cos = np.sum(up * vp, axis=-1)
-    off_u = np.linalg.norm(up, axis=-1) > _FREE_SINE * np.linalg.norm(u, axis=-1)
-    off_v = np.linalg.norm(vp, axis=-1) > _FREE_SINE * np.linalg.norm(v, axis=-1)
+    tol2 = _FREE_SINE * _FREE_SINE
+    off_u = np.sum(up * up, axis=-1) > tol2 * np.sum(u * u, axis=-1)
+    off_v = np.sum(vp * vp, axis=-1) > tol2 * np.sum(v * v, axis=-1)
     return np.where(off_u & off_v, np.arctan2(sin, cos), free)
 
 
@@ -207,7 +220,7 @@ def spherical_wrist_branches(
     x = c_t - pts[0]
     along = (x @ h[0])[..., None] * h[0]
     a = (x - along) @ h[1]
-    b = np.cross(h[0], x) @ h[1]
+    b = (x @ _cross_matrix(h[0]).T) @ h[1]
     rhs = (c0 - pts[0]) @ h[1] - along @ h[1]
     theta, real1 = _two_roots(a / size, b / size, rhs / size, -free_angle(1), slack)
     q1 = -theta  # (..., 2)
