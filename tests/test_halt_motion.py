@@ -703,3 +703,30 @@ def test_a_narrow_feasible_interval_is_flagged_fragile():
     assert narrow.feasible and (hi - lo) < 0.01 * abs(float(narrow.motion.k))
     assert narrow.fragile and narrow.to_dict()["fragile"]
     assert any(line.startswith("FRAGILE: the feasible stretch of k is 0.38 % of k* wide") for line in narrow.summary())
+
+
+@pytest.mark.parametrize("base", ["fixed", "floating"])
+def test_compiled_objective_finds_the_same_halt(base, monkeypatch):
+    """HaltProblem(compiled=True): the torque objectives through the compiled Newton-Euler
+    kernels (tested call by call), the same optimum and torques as numpy to round-off."""
+    from jointlock import _kernels
+
+    calls = []
+    name = "rnea_fixed" if base == "fixed" else "rnea_floating"
+    kernel = getattr(_kernels, name)
+    monkeypatch.setattr(_kernels, name, lambda *a: (calls.append(1), kernel(*a))[1])
+    ref = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101), n_scan=41)
+    assert calls == []
+    ours = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101, compiled=True), n_scan=41)
+    assert calls
+    assert ours.k == pytest.approx(ref.k, rel=1e-9)
+    assert ours.global_torque == pytest.approx(ref.global_torque, rel=1e-12)
+    assert ours.global_torque_k0 == pytest.approx(ref.global_torque_k0, rel=1e-12)
+    peak = _problem(T=12.0, base=base, n_samples=101, compiled=True, objective="peak_torque")
+    ref_peak = _problem(T=12.0, base=base, n_samples=101, objective="peak_torque")
+    k = np.linspace(0.0, 1e-4, 5)
+    from jointlock.planning.halt_motion import halt_objective
+
+    np.testing.assert_allclose(halt_objective(peak, k), halt_objective(ref_peak, k), rtol=1e-12)
+    with pytest.raises(jl.ScenarioError, match="compiled must be True, False or None"):
+        _problem(compiled="yes")

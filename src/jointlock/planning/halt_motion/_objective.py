@@ -28,7 +28,13 @@ def base_torque_history(
 ) -> FloatArray:
     """Base disturbance torque ``tau_b(t; k)`` (000 eq. 31), (..., n_t, 3) [N m], root frame."""
     q, dq, ddq = problem.trajectory(k, t, per_joint=per_joint)
-    return rnea(problem.model, q, dq, ddq, base=problem.base, moment_point=problem.moment_point).base_moment
+    return _base_moment(problem, q, dq, ddq)
+
+
+def _base_moment(problem: HaltProblem, q: FloatArray, dq: FloatArray, ddq: FloatArray) -> FloatArray:
+    """(..., 3) base disturbance torque [N m] of the motion ``q, dq, ddq`` (..., n)."""
+    model, base, point = problem.model, problem.base, problem.moment_point
+    return rnea(model, q, dq, ddq, base=base, moment_point=point, compiled=problem.compiled).base_moment
 
 
 def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
@@ -99,7 +105,7 @@ def halt_objective(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = Fals
     if problem.objective == "peak_torque":
 
         def peak(q, dq, ddq, t):
-            tau = rnea(problem.model, q, dq, ddq, base=problem.base, moment_point=problem.moment_point).base_moment
+            tau = _base_moment(problem, q, dq, ddq)
             return np.linalg.norm(tau, axis=-1).max(axis=-1)
 
         return _per_candidate(problem, k, per_joint, peak)

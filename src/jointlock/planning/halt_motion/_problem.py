@@ -87,6 +87,13 @@ class HaltProblem:
         ``"mean_torque"`` (000 eq. 32, default), ``"peak_torque"`` (the largest base torque) or
         ``"attitude_change"`` (the free spacecraft's attitude change at the end; needs a model
         with a spacecraft).
+    compiled
+        Passed to :func:`~jointlock.dynamics.rnea` for every evaluation of the torque
+        objectives: True runs the compiled Newton-Euler kernels (an optimiser scores many
+        candidate motions in one process: the 50 x 100 GA spends ~80 % of its time there, and
+        the kernels are 3-5x faster once numba is loaded, 0.4-2 s per process); None (default)
+        leaves the choice to :func:`~jointlock.dynamics.rnea` (numpy below 200,000 samples per
+        call, so the defaults stay on numpy); False: numpy.  The same numbers to round-off.
     """
 
     model: ArmModel
@@ -106,6 +113,7 @@ class HaltProblem:
     tau_max: FloatArray | None = None
     brake_max: FloatArray | None = None
     objective: str = "mean_torque"
+    compiled: bool | None = None
 
     def __post_init__(self) -> None:
         n = self.model.dof
@@ -156,6 +164,8 @@ class HaltProblem:
             raise ScenarioError(
                 "objective 'attitude_change' needs a model with a spacecraft (load it with base='floating')"
             )
+        if self.compiled is not None and not isinstance(self.compiled, (bool, np.bool_)):
+            raise ScenarioError(f"compiled must be True, False or None; got {self.compiled!r}")
         if self.moment_about not in MOMENT_POINTS:
             raise ScenarioError(
                 f"moment_about must be one of {', '.join(MOMENT_POINTS)}; got {self.moment_about!r}"
