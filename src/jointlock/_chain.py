@@ -336,6 +336,13 @@ def kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray,
     return rot, pos, tool, skip
 
 
+def kernel_input(x: FloatArray) -> FloatArray:
+    """``x`` as every compiled kernel takes its arrays: C-contiguous, writable float64 (a copy
+    only where it is not), so that numba compiles one specialisation per kernel, not one per
+    memory layout (read-only, broadcast, Fortran-ordered or integer input)."""
+    return np.require(x, dtype=float, requirements=["C", "W"])
+
+
 def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The masses for :func:`jointlock._kernels.generalized_jacobian`: per link mass (n,),
     centre of mass (n, 3) [m] and inertia about it (n, 3, 3) [kg m^2] in its ``z``-joint

@@ -20,7 +20,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import forward as _fk
-from ._chain import SYM, composite, kernel_link_arrays, kernel_root, link_constants
+from ._chain import SYM, composite, kernel_input, kernel_link_arrays, kernel_root, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
 from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
@@ -299,12 +299,6 @@ _SINGULAR_SYSTEM = (
 )
 
 
-def _kernel_input(x: FloatArray) -> FloatArray:
-    """``x`` as the kernels take it: C-contiguous, writable float64 (a copy only where it is
-    not), so that numba compiles one specialisation, not one per memory layout."""
-    return np.require(x, dtype=float, requirements=["C", "W"])
-
-
 def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     """:func:`rnea` by the compiled kernels, in chunks of :data:`_COMPILED_CHUNK` samples:
     (torques, base wrench, base acceleration, base twist) as (N, .) arrays."""
@@ -331,7 +325,7 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     bad = 0
     for s0 in range(0, n_samples, _COMPILED_CHUNK):
         part = slice(s0, s0 + _COMPILED_CHUNK)
-        cq, cdq, cddq = (_kernel_input(x[part]) for x in (bq, bdq, bddq))
+        cq, cdq, cddq = (kernel_input(x[part]) for x in (bq, bdq, bddq))
         if base == "fixed":
             _kernels.rnea_fixed(cq, cdq, cddq, *links, base_acc, point, tau[part], wrench[part])
         else:

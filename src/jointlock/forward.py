@@ -18,7 +18,7 @@ from functools import cached_property
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ._chain import ee_position_rows, kernel_program, position_program
+from ._chain import ee_position_rows, kernel_input, kernel_program, position_program
 from .errors import ConfigurationError
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import pose, skew
@@ -275,7 +275,7 @@ def ee_positions(
     q = as_joint_array(model, q)
     if isinstance(chunk, bool) or not isinstance(chunk, (int, np.integer)) or chunk < 1:
         raise ConfigurationError(f"chunk must be an integer >= 1; got {chunk!r}")
-    flat = np.require(q.reshape(-1, model.dof), requirements=["C", "W"])  # one numba specialisation
+    flat = kernel_input(q.reshape(-1, model.dof))
     out = np.empty((flat.shape[0], 3))
     if compiled is None:
         compiled = flat.shape[0] >= COMPILED_MIN_POSITIONS

@@ -33,7 +33,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from . import forward as _fk
-from ._chain import kernel_mass_program, kernel_program, momentum_matrix_soa
+from ._chain import kernel_input, kernel_mass_program, kernel_program, momentum_matrix_soa
 from .bounds import check_overflow
 from .errors import ConfigurationError, ModelError
 from .forward import DEFAULT_CHUNK, ChainState, chain_state, ee_pose, ee_positions, link_poses, state_at
@@ -103,7 +103,7 @@ def _kernel_jacobian(model: ArmModel, q: ArrayLike, generalized: bool, frame: st
 
     arr = as_joint_array(model, q)
     n = model.dof
-    flat = np.require(arr.reshape(-1, n), requirements=["C", "W"])  # one numba specialisation
+    flat = kernel_input(arr.reshape(-1, n))
     out = np.empty((flat.shape[0], 6, n))
     rot, pos, tool, _skip = kernel_program(model)
     masses = kernel_mass_program(model) if generalized else None

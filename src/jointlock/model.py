@@ -436,8 +436,6 @@ def as_joint_array(model: ArmModel, q: ArrayLike, name: str = "q") -> FloatArray
         Naming ``name``, the shape received and the shape allowed, or where the first
         non-finite value is.
     """
-    from .errors import ConfigurationError
-
     try:
         raw, kind = np.asarray(q), ""
     except ValueError:  # a ragged nesting of lists

@@ -75,6 +75,23 @@ def _out_of_link(e, c, s, x0, x1, x2):
 
 
 @_jit
+def _work(n):
+    """The work arrays of one block for ``n`` joints: sines, cosines, rates, accelerations
+    (n, BLOCK); the recursion's state ``(w, wd, a)`` (9, BLOCK); a force and moment (6, BLOCK);
+    every link's inertia force and moment (n, 3, BLOCK) each."""
+    return (
+        np.empty((n, BLOCK)),
+        np.empty((n, BLOCK)),
+        np.empty((n, BLOCK)),
+        np.empty((n, BLOCK)),
+        np.empty((9, BLOCK)),
+        np.empty((6, BLOCK)),
+        np.empty((n, 3, BLOCK)),
+        np.empty((n, 3, BLOCK)),
+    )
+
+
+@_jit
 def _load_block(q, dq, ddq, s0, nb, sn, cs, qd, qdd):
     """Sines, cosines, rates and accelerations of samples ``s0 : s0 + nb`` into the (n, BLOCK)
     work arrays (contiguous along the block)."""
@@ -195,14 +212,7 @@ def rnea_fixed(q, dq, ddq, rot, pos, mass, com, inertia, base_acc, point, tau, w
         root frame (``-f_1``, ``-(n_1 + (p_1 - point) x f_1)``).
     """
     nsamp, n = q.shape
-    sn = np.empty((n, BLOCK))
-    cs = np.empty((n, BLOCK))
-    qd = np.empty((n, BLOCK))
-    qdd = np.empty((n, BLOCK))
-    state = np.empty((9, BLOCK))
-    fn = np.empty((6, BLOCK))
-    force = np.empty((n, 3, BLOCK))
-    moment = np.empty((n, 3, BLOCK))
+    sn, cs, qd, qdd, state, fn, force, moment = _work(n)
     l0, l1, l2 = pos[0, 0] - point[0], pos[0, 1] - point[1], pos[0, 2] - point[2]
     g0, g1, g2 = base_acc[0], base_acc[1], base_acc[2]
     for s0 in range(0, nsamp, BLOCK):
@@ -382,14 +392,7 @@ def rnea_floating(q, dq, ddq, rot, pos, mass, com, inertia, root, point, tau, wr
     definite (their outputs are meaningless).
     """
     nsamp, n = q.shape
-    sn = np.empty((n, BLOCK))
-    cs = np.empty((n, BLOCK))
-    qd = np.empty((n, BLOCK))
-    qdd = np.empty((n, BLOCK))
-    state = np.empty((9, BLOCK))
-    fn = np.empty((6, BLOCK))
-    force = np.empty((n, 3, BLOCK))
-    moment = np.empty((n, 3, BLOCK))
+    sn, cs, qd, qdd, state, fn, force, moment = _work(n)
     columns = np.empty((n, 5, BLOCK))
     sums = np.empty((15, BLOCK))
     solver = np.empty((6, BLOCK))  # the inverse Schur complement, entries xx yy zz xy xz yz

@@ -11,6 +11,7 @@ from typing import Literal, cast
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._chain import kernel_input, kernel_mass_program, kernel_program
 from ...errors import ConfigurationError
 from ...model import ArmModel, FloatArray
 from ...progress import Progress
@@ -139,8 +140,7 @@ def _jacobi_values(arr: FloatArray) -> FloatArray:
     """Singular values by the compiled one-sided Jacobi kernel; LAPACK outside its range."""
     if arr.ndim < 2 or 0 in arr.shape[-2:]:
         return cast(FloatArray, np.linalg.svd(arr, compute_uv=False))
-    # C-contiguous and writable: one numba specialisation for any input layout
-    flat = np.require(arr.reshape((-1,) + arr.shape[-2:]), requirements=["C", "W"])
+    flat = kernel_input(arr.reshape((-1,) + arr.shape[-2:]))
     big = np.max(np.abs(flat), initial=0.0)
     if not np.isfinite(big) or big > _COMPILED_RANGE[1] or 0.0 < big < _COMPILED_RANGE[0]:
         return cast(FloatArray, np.linalg.svd(arr, compute_uv=False))
@@ -348,15 +348,14 @@ def configuration_indices(
         raise ConfigurationError(f"batch_size must be >= 1; got {batch_size!r}")
     arr = as_joint_array(model, q)
     batch = arr.shape[:-1]
-    flat = np.require(arr.reshape(-1, model.dof), requirements=["C", "W"])  # one numba specialisation
+    flat = kernel_input(arr.reshape(-1, model.dof))
     if method is None:
         from ...forward import COMPILED_MIN_BATCH
 
         method = "jacobi" if flat.shape[0] >= COMPILED_MIN_BATCH else "svd"
     fused = method == "jacobi"
     if fused:  # the compiled kernel builds each block's Jacobian and its singular values at once
-        from ... import _kernels
-        from ..._chain import kernel_mass_program, kernel_program
+        from ... import _kernels  # numba is imported on first use, not with the package
 
         program = kernel_program(model)[:3]
         floating = jacobian == "generalized" and model.floating
