@@ -13,7 +13,14 @@ import jointlock as jl
 from jointlock.derivatives import jacobian_derivatives
 from jointlock.kinematics import chain_state, jacobian
 from jointlock.planning.jump import JumpScenario, compensated_rates, simulate
-from jointlock.planning.jump._control import law
+from jointlock.planning.jump._control import (
+    CYCLIC,
+    RUNNING_SUM_LOOP_FROM,
+    _running_sum,
+    cross_cyclic,
+    cross_first,
+    law,
+)
 from jointlock.planning.jump._engine import _branched_runs, _healthy_runs, _integrate, _post_runs, _problem
 
 #: Agreement of a run stepped in a batch and alone, relative to the largest entry [-].
@@ -104,3 +111,37 @@ def test_the_closed_form_gradient_equals_the_derivatives_one():
     assert np.all(np.abs(qdot.T - ref) <= 1e-12 * np.abs(ref).max(axis=1, keepdims=True))
     assert _close(w, w_ref)
     assert np.all(qdot.T[~healthy] == 0.0)
+
+
+@pytest.mark.parametrize("batch", [5, RUNNING_SUM_LOOP_FROM + 3])
+def test_running_sums_add_as_cumsum_does(batch):
+    # below the threshold one cumsum, from it one add per joint: the same additions in the same order
+    terms = np.random.default_rng(7).normal(size=(3, 7, batch))
+    assert np.array_equal(_running_sum(terms.copy()), np.cumsum(terms, axis=1))
+    assert np.array_equal(_running_sum(terms.copy(), reverse=True), np.cumsum(terms[:, ::-1], axis=1)[:, ::-1])
+
+
+def test_the_cyclic_cross_product_is_the_cross_product():
+    a, b = np.random.default_rng(8).normal(size=(2, 3, 7, 11))
+    ref = np.moveaxis(np.cross(np.moveaxis(a, 0, -1), np.moveaxis(b, 0, -1)), -1, 0)
+    assert _close(cross_first(a, b), ref)
+    assert _close(cross_cyclic(a[CYCLIC], b[CYCLIC]), ref)
+
+
+def test_the_law_of_a_large_batch_equals_it_in_small_batches():
+    # a batch from RUNNING_SUM_LOOP_FROM runs takes the other running-sum branch of the gradient
+    arm = jl.load_robot("canadarm7").fixed()
+    rng = np.random.default_rng(9)
+    runs = 2 * RUNNING_SUM_LOOP_FROM
+    q = np.asarray(JumpScenario().q0) + rng.uniform(-0.4, 0.4, (runs, arm.dof))
+    frame = _problem(arm, JumpScenario()).frame(q, None)
+    healthy = np.ones((arm.dof, runs), dtype=bool)
+    healthy[rng.integers(0, arm.dof, runs), np.arange(runs)] = False
+    xdot, kappa = rng.normal(size=(3, runs)), rng.normal(size=runs)
+    whole = law(frame.jac, healthy, xdot, kappa, axes=frame.axes)
+    half = RUNNING_SUM_LOOP_FROM // 2
+    for start in range(0, runs, half):
+        part = slice(start, start + half)
+        small = law(frame.jac[..., part], healthy[:, part], xdot[:, part], kappa[part], axes=frame.axes[..., part])
+        for got, ref in zip(whole, small):
+            assert _close(got[..., part], ref)

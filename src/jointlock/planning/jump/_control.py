@@ -9,8 +9,6 @@ so a step of one run and a step of a thousand runs cost nearly the same number o
 
 from __future__ import annotations
 
-from typing import cast
-
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -24,17 +22,30 @@ SINGULAR_GRAM_RTOL = 1e-13
 
 #: Cyclic component indices: ``(a x b)_i = a_{i+1} b_{i+2} - a_{i+2} b_{i+1}``.
 _NEXT, _AFTER = np.array([1, 2, 0]), np.array([2, 0, 1])
-#: Flat indices (into a 3 x 3 matrix's 9 entries) of the two products of each cofactor:
-#: ``adj[r, c] = g[NEXT c, NEXT r] g[AFTER c, AFTER r] - g[NEXT c, AFTER r] g[AFTER c, NEXT r]``.
-_COF = tuple(
-    np.array([3 * i[c] + j[r] for r in range(3) for c in range(3)])
-    for i, j in ((_NEXT, _NEXT), (_AFTER, _AFTER), (_NEXT, _AFTER), (_AFTER, _NEXT))
+#: A vector's components twice over, ``(a_0, a_1, a_2, a_0, a_1)``: with it ``a_{i+1}`` and
+#: ``a_{i+2}`` are the slices ``[1:4]`` and ``[2:5]``, one gather per operand instead of two.
+CYCLIC = np.array([0, 1, 2, 0, 1])
+#: Flat indices (into a 3 x 3 matrix's 9 entries) of the two products of each cofactor,
+#: ``adj[r, c] = g[NEXT c, NEXT r] g[AFTER c, AFTER r] - g[NEXT c, AFTER r] g[AFTER c, NEXT r]``:
+#: the first factors of both products, then the second factors (one gather each).
+_COF_FIRST, _COF_SECOND = (
+    np.concatenate(
+        [np.array([3 * i[c] + j[r] for r in range(3) for c in range(3)]) for i, j in pairs]
+    )
+    for pairs in (((_NEXT, _NEXT), (_NEXT, _AFTER)), ((_AFTER, _AFTER), (_AFTER, _NEXT)))
 )
 
 
 def cross_first(a: FloatArray, b: FloatArray) -> FloatArray:
     """Cross product over the *first* axis: (3, ...) x (3, ...) -> (3, ...) (broadcast)."""
-    return cast(FloatArray, a[_NEXT] * b[_AFTER] - a[_AFTER] * b[_NEXT])
+    return cross_cyclic(a[CYCLIC], b[CYCLIC])
+
+
+def cross_cyclic(a5: FloatArray, b5: FloatArray) -> FloatArray:
+    """:func:`cross_first` of ``a5 = a[CYCLIC]`` and ``b5 = b[CYCLIC]`` (5, ...) -> (3, ...):
+    for an operand used in several products, gathered once (the integrator's step is a few
+    hundred numpy calls on small batches; each saved call counts)."""
+    return a5[1:4] * b5[2:5] - a5[2:5] * b5[1:4]
 
 
 def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatArray]:
@@ -42,7 +53,8 @@ def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatAr
     ``gram`` (3, 3, B), with an SVD fallback for the (near-)singular ones; returns it with
     ``det(J J^T)`` (B,)."""
     g = gram.reshape(9, -1)
-    adj = g[_COF[0]] * g[_COF[1]] - g[_COF[2]] * g[_COF[3]]  # (9, B), row-major adj[r, c]
+    products = g[_COF_FIRST] * g[_COF_SECOND]
+    adj = products[:9] - products[9:]  # (9, B), row-major adj[r, c]
     det = np.einsum("cb,cb->b", g[:3], adj[::3])  # along the first row of g
     trace3 = g[::4].sum(axis=0) / 3.0
     singular = ~(det > SINGULAR_GRAM_RTOL * trace3**3)
@@ -53,6 +65,26 @@ def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatAr
         jt = np.moveaxis(jac_h[..., singular], -1, 0).swapaxes(-1, -2)  # (S, n, 3)
         m[..., singular] = np.moveaxis(np.linalg.pinv(jt), 0, -1)
     return m, det
+
+
+#: From this many runs on, :func:`_running_sum` adds joint by joint: numpy's ``cumsum`` along
+#: a middle axis is not vectorised (~5 ns per entry), an ``add`` per joint is (~2 us per call).
+RUNNING_SUM_LOOP_FROM = 128
+
+
+def _running_sum(terms: FloatArray, *, reverse: bool = False) -> FloatArray:
+    """Running sums of ``terms`` (3, n, B) over the joints (axis 1), from the first joint or
+    (``reverse``) from the last: the additions of ``np.cumsum``, in its order, so the same
+    values to the bit.  ``terms`` may be overwritten."""
+    n, B = terms.shape[1], terms.shape[2]
+    if B < RUNNING_SUM_LOOP_FROM:
+        if reverse:
+            return np.cumsum(terms[:, ::-1], axis=1)[:, ::-1]
+        return np.cumsum(terms, axis=1)
+    for i in range(n - 2, -1, -1) if reverse else range(1, n):
+        j = i + 1 if reverse else i - 1
+        np.add(terms[:, j], terms[:, i], out=terms[:, i])
+    return terms
 
 
 def law(
@@ -106,9 +138,10 @@ def law(
     m, det = _pinv_rows(jac_h, gram)  # m[:, k] = 0 where column k is locked
     w = np.sqrt(np.maximum(det, 0.0))
     if axes is not None:
-        suffix = np.cumsum(cross_first(jac_h, m)[:, ::-1], axis=1)[:, ::-1]  # sum_{k >= i} J_k x M_k
+        m5 = m[CYCLIC]
+        suffix = _running_sum(cross_cyclic(jac_h[CYCLIC], m5), reverse=True)  # sum_{k >= i} J_k x M_k
         prefix = np.zeros_like(m)
-        np.cumsum(cross_first(m, axes)[:, :-1], axis=1, out=prefix[:, 1:])  # sum_{k < i} M_k x z_k
+        prefix[:, 1:] = _running_sum(cross_cyclic(m5, axes[CYCLIC])[:, :-1])  # sum_{k < i} M_k x z_k
         grad = w * (np.einsum("rib,rib->ib", axes, suffix) + np.einsum("rib,rib->ib", jac_h, prefix))
     elif djac is not None:
         grad = w * np.einsum("rcb,ircb->ib", m, djac)  # M's locked columns are 0: no need to mask djac

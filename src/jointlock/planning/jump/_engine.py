@@ -237,9 +237,10 @@ def _integrate(
     diverged_rate = max(DIVERGED_RATE_MIN, DIVERGED_FACTOR * sc.vmax)
     out = _RunOut(np.zeros(B), np.zeros(B), np.zeros(B), np.full(B, np.inf), np.zeros(B))
     fail_steps = np.asarray(fail_steps, dtype=int).reshape(B, -1)
-    onehot = np.zeros((len(fail_cols), n), dtype=bool)
+    one_lock = fail_steps.shape[1] == 1
+    locks_at = np.full((B, n), np.iinfo(int).max)  # the step from which each joint is locked
     for l, c in enumerate(fail_cols):
-        onehot[l, c] = True
+        np.minimum(locks_at[:, c], fail_steps[:, l], out=locks_at[:, c])
     R = min(int(record), B)
     if R:
         out.q = np.repeat(q_init[:R, None, :], N + 1, axis=1)
@@ -266,9 +267,8 @@ def _integrate(
             q[take] = q[parent[take]]
             if rb is not None:
                 rb[take] = rb[parent[take]]
-        failed = fail_steps[sl] <= k  # (m, L)
-        healthy = ~np.any(failed[:, :, None] & onehot[None], axis=1).T  # (n, m)
-        changed = np.any(fail_steps[sl] == k, axis=1)
+        healthy = (locks_at[sl] > k).T  # (n, m)
+        changed = fail_steps[sl, 0] == k if one_lock else np.any(fail_steps[sl] == k, axis=1)
         frame = prob.frame(q[sl], None if rb is None else rb[sl])
         err = prob.x_nom[k][:, None] - frame.x  # (3, m)
         xdc = prob.xd_nom[k][:, None] + sc.kp * err
@@ -280,7 +280,8 @@ def _integrate(
         qd = qd_t.T  # (m, n)
         dev = np.sqrt(np.einsum("rb,rb->b", err, err))
         np.maximum(out.max_dev[sl], dev, out=out.max_dev[sl])
-        np.maximum(out.max_vel[sl], np.abs(qd).max(-1), out=out.max_vel[sl])
+        peak = np.abs(qd).max(-1)
+        np.maximum(out.max_vel[sl], peak, out=out.max_vel[sl])
         np.minimum(out.min_w[sl], w, out=out.min_w[sl])
         if null_norm:
             np.maximum(out.max_null[sl], np.abs(null).max(0), out=out.max_null[sl])
@@ -290,7 +291,7 @@ def _integrate(
         out.max_acc[sl] = np.where(check, np.maximum(out.max_acc[sl], acc), out.max_acc[sl])
         if R:
             _record_step(out, frame, k, R, qd, dev, qd_plus, jump_col)
-        if m and np.abs(qd).max() > diverged_rate:
+        if m and peak.max() > diverged_rate:
             _stop_diverged(qd, kappa[sl, k], k * dt, diverged_rate)
         qd_prev[sl] = qd
         q[sl] += dt * qd

@@ -16,7 +16,10 @@ import numpy as np
 
 from ..._chain import axis_frame
 from ...model import ArmModel, FloatArray
-from ._control import cross_first, law
+from ._control import CYCLIC, cross_cyclic, law
+
+#: ``(s, -s)``: the signs of the sines in ``Rz``'s first two columns.
+_SIGNS = np.array([1.0, -1.0])[:, None]
 
 
 @dataclass
@@ -92,19 +95,19 @@ class _FixedChain:
         n, B = len(self.link_t), q.shape[0]
         qt = q.T
         cos = np.cos(qt)  # (n, B)
-        sin_pm = np.sin(qt)[:, None, :] * np.array([1.0, -1.0])[:, None]  # (n, 2, B): s, -s
+        sin_pm = np.sin(qt)[:, None, :] * _SIGNS  # (n, 2, B): s, -s
         links = np.empty((n, 3, 4, B))  # [R'_i | p_i]
         for i in range(n):
+            r = links[i]  # [R'_{i-1} | p_{i-1}] H_i first (row by row), then turned by Rz(q_i)
             if i == 0:
-                a = np.broadcast_to(self.link_t[0].T[:3, :, None], (3, 4, B))
+                r[...] = self.link_t[0].T[:3, :, None]
             else:
-                a = np.matmul(self.link_t[i], links[i - 1])  # [R'_{i-1} | p_{i-1}] H_i, row by row
-            r = links[i]
-            # Rz(q) mixes the first two columns: (a0, a1) -> (a0 c + a1 s, a1 c - a0 s)
-            np.multiply(a[:, :2], cos[i], out=r[:, :2])
-            r[:, :2] += a[:, 1::-1] * sin_pm[i]
-            r[:, 2:] = a[:, 2:]  # the axis and the origin
+                np.matmul(self.link_t[i], links[i - 1], out=r)
+            # Rz(q) mixes the first two columns, (a0, a1) -> (a0 c + a1 s, a1 c - a0 s); the
+            # axis and the origin stay
+            np.add(r[:, :2] * cos[i], r[:, 1::-1] * sin_pm[i], out=r[:, :2])
         x = self.tool @ links[-1]  # (3, B)
         axes = links[:, :, 2].transpose(1, 0, 2)  # (3, n, B)
-        jac = cross_first(axes, x[:, None, :] - links[:, :, 3].transpose(1, 0, 2))
+        lever = x[CYCLIC, None, :] - links[:, CYCLIC, 3].transpose(1, 0, 2)  # (5, n, B), cyclic
+        jac = cross_cyclic(axes[CYCLIC], lever)
         return _Frame(x, jac, axes=axes)
