@@ -11,9 +11,13 @@ where they are not), so that numba compiles one specialisation per kernel.
 
 Layout.  Configurations are processed in blocks of :data:`BLOCK` with the block as the
 innermost (contiguous) axis of every work array ("structure of arrays"), so that each step
-is a plain loop over the block, which LLVM turns into SIMD code where the body is simple
-enough (the sines and cosines, the Jacobi rotations; the Newton-Euler recursions run scalar).
-Nothing here calls LAPACK or allocates per configuration.
+is a plain loop over the block, which LLVM turns into SIMD code (8 lanes with AVX-512) when
+it can prove the loop's arrays do not overlap.  It checks that at run time, and gives up when
+a loop touches more than a few separately addressed rows ("too many memory checks"): rows of
+a 2-D work array count separately, since its row stride is a run-time value.  So a loop
+should touch few arrays, each at constant offsets: the Newton-Euler kernels keep a block's
+work in one flat vector plus one per link (:mod:`jointlock._kernels._dynamics`).  Nothing here
+calls LAPACK or allocates per configuration.
 
 Chain convention (the one of :func:`jointlock._chain.link_constants` and
 :func:`jointlock._chain.position_program`): every link in its ``z``-joint frame; link ``i``
