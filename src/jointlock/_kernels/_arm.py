@@ -82,35 +82,89 @@ def ee_positions(q, rot, pos, tool, skip, out):
             out[s0 + b, 2] = vz[b]
 
 
+#: Rows (each ``BLOCK`` long) of the fixed-base Jacobian's work vectors (:func:`jacobian_work`):
+#: ``fw``, the running frame (rotation rows 9, origin 3), the sine and cosine of the current
+#: joint and the end effector (3); ``fj``, per joint its axis (3), origin (3) and Jacobian
+#: column (6).  Flat vectors with the rows at constant offsets: each loop over the block
+#: touches two arrays, which LLVM vectorises (rows of 2-D work arrays, whose strides are
+#: run-time values, defeated its alias checks and the loops ran scalar).
+_FSN, _FCS, _FPE, _FRAME = 12 * BLOCK, 13 * BLOCK, 14 * BLOCK, 17 * BLOCK
+_FJ = 12 * BLOCK  # entries per joint in fj
+
+
 @_jit
-def _jacobian_block(q, s0, nb, rot, pos, tool, length, frames, sn, cs, axes, origins, jac):
+def jacobian_work(n):
+    """The work vectors of :func:`_jacobian_block` for ``n`` joints, and a (6, n, BLOCK) array
+    for the Jacobian."""
+    return np.zeros(_FRAME), np.zeros(n * _FJ), np.zeros((6, n, BLOCK))
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _advance_row(fw, b, r, e0, e1, e2, p0, p1, p2, c, s):
+    """Row ``r`` of frame ``i`` of configuration ``b`` from frame ``i - 1`` (in place):
+    ``F_i = F_{i-1} [E_i, p_i] Rot(z, q_i)`` with ``e0, e1, e2`` the columns of ``E_i``
+    (three entries each) and ``c, s = cos q_i, sin q_i``."""
+    r0, r1, r2 = fw[(3 * r) * BLOCK + b], fw[(3 * r + 1) * BLOCK + b], fw[(3 * r + 2) * BLOCK + b]
+    fw[(9 + r) * BLOCK + b] += r0 * p0 + r1 * p1 + r2 * p2
+    a0 = r0 * e0[0] + r1 * e0[1] + r2 * e0[2]
+    a1 = r0 * e1[0] + r1 * e1[1] + r2 * e1[2]
+    a2 = r0 * e2[0] + r1 * e2[1] + r2 * e2[2]
+    fw[(3 * r) * BLOCK + b] = a0 * c + a1 * s
+    fw[(3 * r + 1) * BLOCK + b] = a1 * c - a0 * s
+    fw[(3 * r + 2) * BLOCK + b] = a2
+
+
+@_jit
+def _jacobian_block(q, s0, nb, rot, pos, tool, length, fw, fj, jac):
     """Geometric Jacobian (6, n, :nb) of ``q[s0:s0 + nb]`` into ``jac``, the linear rows
-    divided by ``length`` [m]; ``frames`` (12, BLOCK), ``axes``/``origins`` (n, 3, BLOCK) work."""
+    divided by ``length`` [m]; ``fw``, ``fj``: the work vectors of :func:`jacobian_work`."""
     n = q.shape[1]
-    _identity_frames(frames, nb)
+    for b in range(nb):  # the root frame: identity rotation, zero origin
+        for k in range(12):
+            fw[k * BLOCK + b] = 0.0
+        fw[b] = 1.0
+        fw[4 * BLOCK + b] = 1.0
+        fw[8 * BLOCK + b] = 1.0
     for i in range(n):
-        _trig_block(q, s0, nb, i, sn, cs)
+        _trig_block(q, s0, nb, i, fw[_FSN : _FSN + BLOCK], fw[_FCS : _FCS + BLOCK])
         e = rot[i]
+        e0 = (e[0, 0], e[1, 0], e[2, 0])
+        e1 = (e[0, 1], e[1, 1], e[2, 1])
+        e2 = (e[0, 2], e[1, 2], e[2, 2])
         p0, p1, p2 = pos[i, 0], pos[i, 1], pos[i, 2]
+        o = i * _FJ
         for b in range(nb):
-            _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
+            c, s = fw[_FCS + b], fw[_FSN + b]
+            _advance_row(fw, b, 0, e0, e1, e2, p0, p1, p2, c, s)
+            _advance_row(fw, b, 1, e0, e1, e2, p0, p1, p2, c, s)
+            _advance_row(fw, b, 2, e0, e1, e2, p0, p1, p2, c, s)
             for r in range(3):
-                axes[i, r, b] = frames[3 * r + 2, b]
-                origins[i, r, b] = frames[9 + r, b]
+                fj[o + r * BLOCK + b] = fw[(3 * r + 2) * BLOCK + b]
+                fj[o + (3 + r) * BLOCK + b] = fw[(9 + r) * BLOCK + b]
     t0, t1, t2 = tool[0], tool[1], tool[2]
     for b in range(nb):
-        pe0 = frames[9, b] + frames[0, b] * t0 + frames[1, b] * t1 + frames[2, b] * t2
-        pe1 = frames[10, b] + frames[3, b] * t0 + frames[4, b] * t1 + frames[5, b] * t2
-        pe2 = frames[11, b] + frames[6, b] * t0 + frames[7, b] * t1 + frames[8, b] * t2
-        for i in range(n):
-            z0, z1, z2 = axes[i, 0, b], axes[i, 1, b], axes[i, 2, b]
-            d0, d1, d2 = pe0 - origins[i, 0, b], pe1 - origins[i, 1, b], pe2 - origins[i, 2, b]
-            jac[0, i, b] = (z1 * d2 - z2 * d1) / length
-            jac[1, i, b] = (z2 * d0 - z0 * d2) / length
-            jac[2, i, b] = (z0 * d1 - z1 * d0) / length
-            jac[3, i, b] = z0
-            jac[4, i, b] = z1
-            jac[5, i, b] = z2
+        for r in range(3):
+            fw[_FPE + r * BLOCK + b] = (
+                fw[(9 + r) * BLOCK + b]
+                + fw[(3 * r) * BLOCK + b] * t0 + fw[(3 * r + 1) * BLOCK + b] * t1 + fw[(3 * r + 2) * BLOCK + b] * t2
+            )
+    for i in range(n):
+        o = i * _FJ
+        for b in range(nb):
+            z0, z1, z2 = fj[o + b], fj[o + BLOCK + b], fj[o + 2 * BLOCK + b]
+            d0 = fw[_FPE + b] - fj[o + 3 * BLOCK + b]
+            d1 = fw[_FPE + BLOCK + b] - fj[o + 4 * BLOCK + b]
+            d2 = fw[_FPE + 2 * BLOCK + b] - fj[o + 5 * BLOCK + b]
+            fj[o + 6 * BLOCK + b] = (z1 * d2 - z2 * d1) / length
+            fj[o + 7 * BLOCK + b] = (z2 * d0 - z0 * d2) / length
+            fj[o + 8 * BLOCK + b] = (z0 * d1 - z1 * d0) / length
+            fj[o + 9 * BLOCK + b] = z0
+            fj[o + 10 * BLOCK + b] = z1
+            fj[o + 11 * BLOCK + b] = z2
+        for r in range(6):
+            col = jac[r, i]
+            for b in range(nb):
+                col[b] = fj[o + (6 + r) * BLOCK + b]
 
 
 @_jit
@@ -118,15 +172,10 @@ def jacobian(q, rot, pos, tool, out):
     """Fixed-base geometric Jacobian, root frame: ``out`` (N, 6, n) written, column ``i``
     ``(z_i x (p_e - p_i), z_i)`` (as :func:`jointlock.kinematics.jacobian`)."""
     n = q.shape[1]
-    frames = np.empty((12, BLOCK))
-    sn = np.empty(BLOCK)
-    cs = np.empty(BLOCK)
-    axes = np.empty((n, 3, BLOCK))
-    origins = np.empty((n, 3, BLOCK))
-    jac = np.empty((6, n, BLOCK))
+    fw, fj, jac = jacobian_work(n)
     for s0 in range(0, q.shape[0], BLOCK):
         nb = min(BLOCK, q.shape[0] - s0)
-        _jacobian_block(q, s0, nb, rot, pos, tool, 1.0, frames, sn, cs, axes, origins, jac)
+        _jacobian_block(q, s0, nb, rot, pos, tool, 1.0, fw, fj, jac)
         for b in range(nb):
             for r in range(6):
                 for i in range(n):
@@ -140,19 +189,14 @@ def fixed_singular_values(q, rot, pos, tool, length, out):
     at ``q`` (N, n) into ``out`` (N, min(6, n)), descending: :func:`jacobian` and
     :func:`singular_values` fused per block (the Jacobian never leaves the cache)."""
     n = q.shape[1]
-    frames = np.empty((12, BLOCK))
-    sn = np.empty(BLOCK)
-    cs = np.empty(BLOCK)
-    axes = np.empty((n, 3, BLOCK))
-    origins = np.empty((n, 3, BLOCK))
-    jac = np.empty((6, n, BLOCK))
+    fw, fj, jac = jacobian_work(n)
     tall = n <= 6
     m, k = (6, n) if tall else (n, 6)
     a = jac if tall else np.empty((n, 6, BLOCK))
     norms, gam, cosv, sinv, tanv = _work(m, k)
     for s0 in range(0, q.shape[0], BLOCK):
         nb = min(BLOCK, q.shape[0] - s0)
-        _jacobian_block(q, s0, nb, rot, pos, tool, length, frames, sn, cs, axes, origins, jac)
+        _jacobian_block(q, s0, nb, rot, pos, tool, length, fw, fj, jac)
         if not tall:
             for i in range(n):
                 for r in range(6):
