@@ -18,7 +18,6 @@ from jointlock.planning.jump._control import (
     RUNNING_SUM_LOOP_FROM,
     _running_sum,
     cross_cyclic,
-    cross_first,
     law,
 )
 from jointlock.planning.jump._engine import _branched_runs, _healthy_runs, _integrate, _post_runs, _problem
@@ -114,18 +113,37 @@ def test_the_closed_form_gradient_equals_the_derivatives_one():
 
 
 @pytest.mark.parametrize("batch", [5, RUNNING_SUM_LOOP_FROM + 3])
-def test_running_sums_add_as_cumsum_does(batch):
-    # below the threshold one cumsum, from it one add per joint: the same additions in the same order
-    terms = np.random.default_rng(7).normal(size=(3, 7, batch))
-    assert np.array_equal(_running_sum(terms.copy()), np.cumsum(terms, axis=1))
-    assert np.array_equal(_running_sum(terms.copy(), reverse=True), np.cumsum(terms[:, ::-1], axis=1)[:, ::-1])
+@pytest.mark.parametrize("joints", [0, 1, 2, 7])
+def test_running_sums_add_as_cumsum_does(batch, joints):
+    # below the threshold one cumsum, from it one add per joint in place: the same additions
+    # in the same order, so the same values to the bit
+    terms = np.random.default_rng(7).normal(size=(3, joints, batch))
+    loop = batch >= RUNNING_SUM_LOOP_FROM
+    for reverse, ref in ((False, np.cumsum(terms, axis=1)), (True, np.cumsum(terms[:, ::-1], axis=1)[:, ::-1])):
+        work = terms.copy()
+        got = _running_sum(work, reverse=reverse)
+        assert (got is work) == loop  # the branch the batch size asks for ran
+        assert np.array_equal(got, ref)
 
 
 def test_the_cyclic_cross_product_is_the_cross_product():
     a, b = np.random.default_rng(8).normal(size=(2, 3, 7, 11))
     ref = np.moveaxis(np.cross(np.moveaxis(a, 0, -1), np.moveaxis(b, 0, -1)), -1, 0)
-    assert _close(cross_first(a, b), ref)
     assert _close(cross_cyclic(a[CYCLIC], b[CYCLIC]), ref)
+
+
+def test_one_lock_step_for_several_joints_locks_them_together(prob):
+    # fail_steps with one column and several fail_cols: every listed joint locks at that step
+    krows = np.zeros((2, prob.N))
+    q0 = np.repeat(prob.q0[None], 2, axis=0)
+    k0 = np.zeros(2, dtype=int)
+    cols = [0, prob.lock_col]
+    one = _integrate(prob, krows, q0, None, k0, np.array([[10], [25]]), cols, record=2)
+    each = _integrate(prob, krows, q0, None, k0, np.array([[10, 10], [25, 25]]), cols, record=2)
+    assert one.qd is not None and each.qd is not None
+    assert np.array_equal(one.qd, each.qd)
+    assert np.all(one.qd[0][10:][:, cols] == 0.0)
+    assert np.all(one.qd[1][:25][:, cols] != 0.0) and np.all(one.qd[1][25:][:, cols] == 0.0)
 
 
 def test_the_law_of_a_large_batch_equals_it_in_small_batches():

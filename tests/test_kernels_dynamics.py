@@ -87,6 +87,17 @@ def test_kernels_keep_batch_shapes_and_broadcast() -> None:
     )
 
 
+def test_kernels_on_one_joint_and_on_no_samples() -> None:
+    arm = jl.load_robot("halt7", base="floating")
+    one = jl.lock_joints(arm, {j: 0.3 for j in arm.joint_numbers[1:]})  # joint 1 alone moves
+    assert one.dof == 1
+    q, dq, ddq = _states(one, 130, seed=6)
+    for base in ("fixed", "floating"):
+        _assert_same(rnea(one, q, dq, ddq, base=base, compiled=True), rnea(one, q, dq, ddq, base=base, compiled=False))
+        empty = rnea(arm, np.zeros((0, arm.dof)), np.zeros((0, arm.dof)), np.zeros((0, arm.dof)), base=base, compiled=True)
+        assert empty.torques.shape == (0, arm.dof) and empty.base_twist.shape == (0, 6)
+
+
 def test_kernels_over_several_chunks(monkeypatch: pytest.MonkeyPatch) -> None:
     from jointlock import dynamics
 

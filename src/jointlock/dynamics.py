@@ -306,15 +306,20 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
 
     n = shape[-1]
     n_samples = int(np.prod(shape[:-1], dtype=np.int64))
-    # the four results in one allocation: freed together, as one block, the allocator keeps
-    # it for the next call (four blocks of this size are given back to the OS and the next
-    # call's writes fault fresh pages in: 5 of 14 ms for 50 x 1001 free-floating samples)
-    buf = np.empty(n_samples * (n + 18))
-    tau = buf[: n_samples * n].reshape(n_samples, n)
-    wrench, acc, twist = (buf[n_samples * (n + 6 * k) : n_samples * (n + 6 * k + 6)].reshape(-1, 6) for k in range(3))
-    if base == "fixed":
-        acc[:] = 0.0
-        twist[:] = 0.0
+    if n_samples <= _COMPILED_CHUNK:
+        # the four results in one allocation: freed together, as one block, the allocator
+        # keeps it for the next call (four blocks of this size are given back to the OS and
+        # the next call's writes fault fresh pages in: 5 of 14 ms for 50 x 1001 free-floating
+        # samples).  Only up to one chunk: keeping one result keeps the block (13 MB at most)
+        buf = np.empty(n_samples * (n + 18))
+        tau = buf[: n_samples * n].reshape(n_samples, n)
+        wrench, acc, twist = (buf[n_samples * (n + 6 * k) : n_samples * (n + 6 * k + 6)].reshape(-1, 6) for k in range(3))
+        if base == "fixed":
+            acc[:] = 0.0
+            twist[:] = 0.0
+    else:
+        tau, wrench = np.empty((n_samples, n)), np.empty((n_samples, 6))
+        acc, twist = np.zeros((n_samples, 6)), np.zeros((n_samples, 6))
     # a view of an input that has the full shape (writable: no copy below), else its broadcast
     bq, bdq, bddq = (
         (x if x.shape == shape else np.broadcast_to(x, shape)).reshape(-1, n) for x in (q, dq, ddq)

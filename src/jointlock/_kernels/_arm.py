@@ -88,7 +88,7 @@ def ee_positions(q, rot, pos, tool, skip, out):
 #: column (6).  Flat vectors with the rows at constant offsets: each loop over the block
 #: touches two arrays, which LLVM vectorises (rows of 2-D work arrays, whose strides are
 #: run-time values, defeated its alias checks and the loops ran scalar).
-_FSN, _FCS, _FPE, _FRAME = 12 * BLOCK, 13 * BLOCK, 14 * BLOCK, 17 * BLOCK
+_FSN, _FCS, _FPE, _FW_LEN = 12 * BLOCK, 13 * BLOCK, 14 * BLOCK, 17 * BLOCK
 _FJ = 12 * BLOCK  # entries per joint in fj
 
 
@@ -96,7 +96,7 @@ _FJ = 12 * BLOCK  # entries per joint in fj
 def jacobian_work(n):
     """The work vectors of :func:`_jacobian_block` for ``n`` joints, and a (6, n, BLOCK) array
     for the Jacobian."""
-    return np.zeros(_FRAME), np.zeros(n * _FJ), np.zeros((6, n, BLOCK))
+    return np.zeros(_FW_LEN), np.zeros(n * _FJ), np.zeros((6, n, BLOCK))
 
 
 @njit(inline="always", cache=True, error_model="numpy", nogil=True)

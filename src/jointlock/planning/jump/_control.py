@@ -36,15 +36,10 @@ _COF_FIRST, _COF_SECOND = (
 )
 
 
-def cross_first(a: FloatArray, b: FloatArray) -> FloatArray:
-    """Cross product over the *first* axis: (3, ...) x (3, ...) -> (3, ...) (broadcast)."""
-    return cross_cyclic(a[CYCLIC], b[CYCLIC])
-
-
 def cross_cyclic(a5: FloatArray, b5: FloatArray) -> FloatArray:
-    """:func:`cross_first` of ``a5 = a[CYCLIC]`` and ``b5 = b[CYCLIC]`` (5, ...) -> (3, ...):
-    for an operand used in several products, gathered once (the integrator's step is a few
-    hundred numpy calls on small batches; each saved call counts)."""
+    """Cross product ``a x b`` over the *first* axis, (3, ...) from ``a5 = a[CYCLIC]`` and
+    ``b5 = b[CYCLIC]`` (5, ...) (broadcast): an operand used in several products is gathered
+    once (the integrator's step is about 120 numpy calls on small batches; each counts)."""
     return a5[1:4] * b5[2:5] - a5[2:5] * b5[1:4]
 
 

@@ -239,8 +239,9 @@ def _integrate(
     fail_steps = np.asarray(fail_steps, dtype=int).reshape(B, -1)
     one_lock = fail_steps.shape[1] == 1
     locks_at = np.full((B, n), np.iinfo(int).max)  # the step from which each joint is locked
+    steps = np.broadcast_to(fail_steps, (B, len(fail_cols)))  # one column: every joint at once
     for l, c in enumerate(fail_cols):
-        np.minimum(locks_at[:, c], fail_steps[:, l], out=locks_at[:, c])
+        np.minimum(locks_at[:, c], steps[:, l], out=locks_at[:, c])
     R = min(int(record), B)
     if R:
         out.q = np.repeat(q_init[:R, None, :], N + 1, axis=1)
