@@ -287,8 +287,7 @@ def _rnea_rows(model, qf, dqf, ddqf, base, g, point):
 
 
 #: Samples per pass of the compiled Newton-Euler kernels: inputs that are not C-contiguous
-#: float64 (or not writable, e.g. broadcast views) are copied a chunk at a time.  (Inputs
-#: broadcast over several batch axes are expanded once, whole, by the flattening reshape.)
+#: float64 (or not writable) are copied a chunk at a time (broadcast ones once, whole).
 _COMPILED_CHUNK = 65536
 
 #: What a free-floating system whose inertia about its centre of mass is singular gets.
@@ -307,16 +306,14 @@ def _rnea_compiled(model, q, dq, ddq, shape, base, g, point):
     n = shape[-1]
     n_samples = int(np.prod(shape[:-1], dtype=np.int64))
     if n_samples <= _COMPILED_CHUNK:
-        # the four results in one allocation: freed together, as one block, the allocator
-        # keeps it for the next call (four blocks of this size are given back to the OS and
-        # the next call's writes fault fresh pages in: 5 of 14 ms for 50 x 1001 free-floating
-        # samples).  Only up to one chunk: keeping one result keeps the block (13 MB at most)
+        # one block for the four results: the allocator keeps it for the next call (four such
+        # blocks went back to the OS, and the next call faulted fresh pages in: 5 of 14 ms at
+        # 50 x 1001 samples); up to a chunk only, as one result kept keeps the whole block
         buf = np.empty(n_samples * (n + 18))
         tau = buf[: n_samples * n].reshape(n_samples, n)
         wrench, acc, twist = (buf[n_samples * (n + 6 * k) : n_samples * (n + 6 * k + 6)].reshape(-1, 6) for k in range(3))
-        if base == "fixed":
-            acc[:] = 0.0
-            twist[:] = 0.0
+        if base == "fixed":  # the kernel writes them free-floating only
+            acc[:] = twist[:] = 0.0
     else:
         tau, wrench = np.empty((n_samples, n)), np.empty((n_samples, 6))
         acc, twist = np.zeros((n_samples, 6)), np.zeros((n_samples, 6))
