@@ -419,9 +419,7 @@ class ArmModel:
             "locked": {str(lj.number): math.degrees(lj.angle) for lj in self.locked},
             "masses_kg": [b.mass for b in self.bodies],
             "total_link_mass_kg": float(sum(b.mass for b in self.bodies)),
-            "base": (
-                {"type": "floating", "mass_kg": self.root_body.mass} if self.floating else {"type": "fixed"}
-            ),
+            "base": {"type": "floating", "mass_kg": self.root_body.mass} if self.floating else {"type": "fixed"},
         }
 
 

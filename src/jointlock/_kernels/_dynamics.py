@@ -30,10 +30,9 @@ Free-floating (zero momentum), as the numpy reference:
 (the inertia about the system's centre of mass) and its adjugate, as
 :func:`jointlock.dynamics._base_solver`.
 
-Layout, for SIMD (:mod:`jointlock._kernels`).  A block's work is one flat vector ``g`` of the
-rows the links share and one ``lk[i]`` per link, each row ``BLOCK`` long at a constant
-offset: every loop over the block touches two or three arrays, and LLVM vectorises it (with
-2-D work arrays it gave up on the run-time alias checks and ran scalar, 1.8-2.3x slower).
+Layout, for SIMD (:mod:`jointlock._kernels`): one flat vector ``g`` of the rows the links share
+and one ``lk[i]`` per link, rows ``BLOCK`` long at constant offsets, so that LLVM vectorises
+each loop (with 2-D work arrays it gave up on its run-time alias checks: 1.8-2.3x slower).
 """
 
 from __future__ import annotations
@@ -93,8 +92,7 @@ _LINK = 16 * _R
 
 @_jit
 def _load_block(q, dq, ddq, s0, nb, lk):
-    """Sines, cosines, rates and accelerations of samples ``s0 : s0 + nb`` into the links'
-    vectors (contiguous along the block)."""
+    """Sines, cosines, rates and accelerations of samples ``s0 : s0 + nb`` into ``lk``."""
     n = q.shape[1]
     for i in range(n):
         li = lk[i]
@@ -191,14 +189,22 @@ def _backward(nb, lk, rot, pos, com, g):
 
 @_jit
 def _to_parent(nb, lk, rot, g):
-    """The fn rows of ``g`` (force, moment in the frame of link 1) turned into its parent's
-    frame."""
+    """The fn rows of ``g`` (force, moment; frame of link 1) turned into its parent's frame."""
     e = _entries(rot[0])
     l0 = lk[0]
     for b in range(nb):
         c, s = l0[_CS + b], l0[_SN + b]
         g[_F0 + b], g[_F1 + b], g[_F2 + b] = _out_of_link(e, c, s, g[_F0 + b], g[_F1 + b], g[_F2 + b])
         g[_N0 + b], g[_N1 + b], g[_N2 + b] = _out_of_link(e, c, s, g[_N0 + b], g[_N1 + b], g[_N2 + b])
+
+
+@_jit
+def _newton_euler(nb, lk, rot, pos, mass, com, inertia, g):
+    """Both recursions from the state rows of ``g``: each link's torque into its vector, the
+    force and moment link 1 receives into the fn rows of ``g`` (its parent's frame)."""
+    _forward(nb, lk, rot, pos, mass, com, inertia, g)
+    _backward(nb, lk, rot, pos, com, g)
+    _to_parent(nb, lk, rot, g)
 
 
 @_jit
@@ -237,9 +243,7 @@ def rnea_fixed(q, dq, ddq, rot, pos, mass, com, inertia, base_acc, point, tau, w
             g[_W0 + b], g[_W1 + b], g[_W2 + b] = 0.0, 0.0, 0.0
             g[_D0 + b], g[_D1 + b], g[_D2 + b] = 0.0, 0.0, 0.0
             g[_A0 + b], g[_A1 + b], g[_A2 + b] = a0, a1, a2
-        _forward(nb, lk, rot, pos, mass, com, inertia, g)
-        _backward(nb, lk, rot, pos, com, g)
-        _to_parent(nb, lk, rot, g)
+        _newton_euler(nb, lk, rot, pos, mass, com, inertia, g)
         _store_torques(nb, lk, tau, s0)
         for b in range(nb):
             f0, f1, f2 = g[_F0 + b], g[_F1 + b], g[_F2 + b]
@@ -363,11 +367,10 @@ def _move_composite(nb, lk, rot, pos, j, mc, g):
 
 @_jit
 def _accel_torques(nb, lk, rot, pos, g):
-    """Joint torques of the spacecraft's acceleration ``(alpha_0, a_0)`` = the ``wd`` and
-    ``a`` state rows of ``g`` (root frame, at the parent origin of link 1) added to the links'
-    torques: the rigid acceleration carried out to every link against each outboard
-    composite's unit-rate momentum (``H_bm^T nu0_dot``; the columns of
-    :func:`_composite_block`)."""
+    """Joint torques of the spacecraft's acceleration ``(alpha_0, a_0)`` (the ``wd`` and ``a``
+    state rows of ``g``; root frame, parent origin of link 1) added to the links' torques:
+    it is carried out to every link against each outboard composite's unit-rate momentum
+    (``H_bm^T nu0_dot``; the columns of :func:`_composite_block`)."""
     n = rot.shape[0]
     for i in range(n):
         li = lk[i]
@@ -460,9 +463,7 @@ def rnea_floating(q, dq, ddq, rot, pos, mass, com, inertia, root, point, tau, wr
             g[_D0 + b], g[_D1 + b], g[_D2 + b] = 0.0, 0.0, 0.0
             g[_A0 + b], g[_A1 + b], g[_A2 + b] = 0.0, 0.0, 0.0
             g[_W0 + b], g[_W1 + b], g[_W2 + b] = om0, om1, om2
-        _forward(nb, lk, rot, pos, mass, com, inertia, g)
-        _backward(nb, lk, rot, pos, com, g)
-        _to_parent(nb, lk, rot, g)
+        _newton_euler(nb, lk, rot, pos, mass, com, inertia, g)
         for b in range(nb):
             hx, hy, hz = g[_S + b], g[_S + _R + b], g[_S + 2 * _R + b]
             om0, om1, om2 = base_twist[s0 + b, 3], base_twist[s0 + b, 4], base_twist[s0 + b, 5]
