@@ -29,6 +29,7 @@ from numpy.typing import ArrayLike, NDArray
 
 from .bounds import MAX_INERTIA_KGM2, MAX_MASS_KG, MAX_MODEL_LENGTH_M, shown
 from .errors import ConfigurationError, ModelError
+from .shapes import Shape, check_shapes, with_link
 
 FloatArray = NDArray[np.float64]
 
@@ -99,12 +100,14 @@ def inertia_matrix(value: ArrayLike, name: str = "inertia") -> FloatArray:
 @dataclass(frozen=True)
 class Body:
     """A rigid body: mass [kg], centre of mass ``com`` (3,) [m] and inertia (3, 3) [kg m^2]
-    about the centre of mass, both expressed in the body's own frame."""
+    about the centre of mass, both expressed in the body's own frame, and its collision
+    ``shapes`` (:mod:`jointlock.shapes`, in the same frame; none by default)."""
 
     mass: float
     com: FloatArray = field(default_factory=lambda: _readonly(np.zeros(3)))
     inertia: FloatArray = field(default_factory=lambda: _readonly(np.zeros((3, 3))))
     name: str = ""
+    shapes: tuple[Shape, ...] = field(default=(), compare=False)
 
     def __post_init__(self) -> None:
         label = f"body {shown(self.name)}" if self.name else "body"
@@ -129,6 +132,7 @@ class Body:
                     f"got eigenvalues {np.round(eig, 12).tolist()} [kg m^2]"
                 )
         object.__setattr__(self, "mass", mass)
+        object.__setattr__(self, "shapes", check_shapes(self.shapes, label))
         object.__setattr__(self, "com", _readonly(com))
         object.__setattr__(self, "inertia", _readonly(0.5 * (inertia + inertia.T)))
 
@@ -136,14 +140,16 @@ class Body:
         """The same body expressed in another frame; ``pose`` (4, 4) is T_new_old."""
         pose = np.asarray(pose, dtype=float)
         rot = pose[:3, :3]
-        return Body(self.mass, rot @ self.com + pose[:3, 3], rot @ self.inertia @ rot.T, self.name)
+        shapes = tuple(s.transformed(pose) for s in self.shapes)
+        return Body(self.mass, rot @ self.com + pose[:3, 3], rot @ self.inertia @ rot.T, self.name, shapes)
 
     def merged(self, other: Body, pose_other: ArrayLike | None = None, name: str = "") -> Body:
         """Merge ``other`` (expressed in a frame whose pose in this body's frame is
         ``pose_other``, (4, 4)) into this body: total mass, mass-weighted centre of mass,
         inertias moved to the common centre of mass by the parallel-axis theorem after
         rotating ``other`` into this frame (000 §3.1.1, items 1-3, with the rotation made
-        explicit)."""
+        explicit).  The merged body carries both bodies' shapes, ``other``'s moved into this
+        frame."""
         if pose_other is not None:
             other = other.transformed(pose_other)
         total = self.mass + other.mass
@@ -156,7 +162,7 @@ class Body:
             + other.inertia
             + _parallel_axis(other.mass, other.com - com)
         )
-        return Body(total, com, inertia, name or self.name)
+        return Body(total, com, inertia, name or self.name, self.shapes + other.shapes)
 
 
 def _parallel_axis(mass: float, offset: FloatArray) -> FloatArray:
@@ -292,6 +298,14 @@ class ArmModel:
                 f"model {shown(self.name)}: a free-floating base needs a spacecraft body with mass > 0 "
                 f"[kg]; got {self.root_body.mass}"
             )
+        # each shape remembers the link it was made for (0: the root body), whatever is
+        # merged later: it decides the pairs checked and names them (jointlock.clearance)
+        bodies = tuple(
+            b if all(s.link is not None for s in b.shapes) else replace(b, shapes=with_link(b.shapes, j.number))
+            for j, b in zip(joints, bodies)
+        )
+        if any(s.link is None for s in self.root_body.shapes):
+            object.__setattr__(self, "root_body", replace(self.root_body, shapes=with_link(self.root_body.shapes, 0)))
         object.__setattr__(self, "joints", joints)
         object.__setattr__(self, "bodies", bodies)
         object.__setattr__(self, "tool", _readonly(_transform(self.tool, f"model {shown(self.name)}: tool")))

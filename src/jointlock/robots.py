@@ -20,6 +20,7 @@ import numpy as np
 from .bounds import shown
 from .dh import from_dh
 from .errors import ModelError
+from .geometry import bus_box, with_link_capsules, with_root_shapes
 from .io.files import check_path_text
 from .model import ArmModel, Body, FloatArray, Joint
 from .spatial import rot_x, translation
@@ -40,6 +41,10 @@ def _check_base(base: str) -> None:
 HALT7_SPACECRAFT = Body(
     2000.0, np.array([0.0, 0.0, -1.0]), np.diag([2000.0 * 4 / 6] * 3), name="spacecraft"
 )
+
+
+#: Radius of ``halt7``'s link capsules [m] (ours, see :func:`halt7`).
+HALT7_LINK_RADIUS = 0.1
 
 
 def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
@@ -65,6 +70,14 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
     * Masses, centres of mass and principal inertias from Table 7, as printed, in each link's
       DH frame.  The end effector is DH frame 7 (row 7's ``d_7 = 0.6`` m places it).
     * Base: 000 gives none; ``base="floating"`` attaches :data:`HALT7_SPACECRAFT` (ours).
+    * Collision geometry (ours; 000 gives none): a capsule of radius :data:`HALT7_LINK_RADIUS`
+      = 0.1 m along each link of the stick figure (root post, joint origins, end effector; the
+      last link, of zero length, a sphere at the end effector), and the spacecraft bus as the
+      2 m cube of :data:`HALT7_SPACECRAFT`'s mass and inertia, with either base (a held
+      spacecraft is still there).  Table 7's axial moments imply solid cylinders of radius
+      ``sqrt(2 I_axial / m)`` = 0.050 m (booms) and 0.049 m (short links); 0.1 m, twice that,
+      is an envelope for the joint housings and the radius ``canadarm7`` uses, so a clearance
+      found here is a lower bound for the thinner solid.
     """
     _check_base(base)
     deg = math.radians
@@ -85,7 +98,7 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
         Body(m, np.array(com), np.array(inertia), name=f"link{i + 1}")
         for i, (m, inertia, com) in enumerate(table7)
     ]
-    return from_dh(
+    model = from_dh(
         "halt7",
         a=a,
         alpha=alpha,
@@ -103,6 +116,7 @@ def halt7(*, base: BaseMode = "fixed", theta_offsets: bool = False) -> ArmModel:
             + f" (theta_offsets={theta_offsets}); spacecraft base: jointlock's default (000 gives none)."
         ),
     )
+    return with_root_shapes(with_link_capsules(model, HALT7_LINK_RADIUS), [bus_box(HALT7_SPACECRAFT)])
 
 
 # -- canadarm7 (seed 004, §5) -------------------------------------------------------------
@@ -139,6 +153,11 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
     * Virtual manipulator: ``virtual_link_vectors(model, weighting="segment")`` is 004's
       formula (each segment of link i scaled by (m_0 + ... + m_i) / M) and reproduces its
       printed virtual lengths; the default ``"vafa-dubowsky"`` weighting is the exact one.
+    * Collision geometry: each link's 0.1 m cylinder as a capsule along its segment (the
+      root post, joint 1 at l = 0.5 m, likewise) and the bus as the 2 m cube of the
+      spacecraft's mass and inertia, with either base.  The arm's root lies inside that cube
+      (its centre of mass is the root origin, joint 1 0.5 m above it): the pairs that touch at
+      the zero pose (the bus with links 2 and 3) are not checked (``jointlock.clearance``).
     """
     _check_base(base)
     L = CANADARM7_LENGTHS
@@ -176,7 +195,7 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
     spacecraft = Body(
         CANADARM7_MASSES[0], np.zeros(3), np.diag([CANADARM7_MASSES[0] * 4.0 / 6.0] * 3), name="spacecraft"
     )
-    return ArmModel(
+    model = ArmModel(
         name="canadarm7",
         joints=joints,
         bodies=tuple(bodies),
@@ -188,6 +207,7 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
             "(modified DH, zero offsets, frames at 004's joint points); link inertias and spacecraft shape ours."
         ),
     )
+    return with_root_shapes(with_link_capsules(model, radius), [bus_box(spacecraft)])
 
 
 # -- puma6 (seed 002, Table 1) --------------------------------------------------------------
@@ -196,6 +216,8 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
 PUMA6_A2 = 0.985
 PUMA6_D4 = -0.765
 PUMA6_D6 = 0.382
+#: Radius of ``puma6``'s link capsules [m] (illustrative, as its masses).
+PUMA6_LINK_RADIUS = 0.06
 
 #: Default spacecraft for ``puma6`` (002 has a fixed base; this one is ours): 500 kg, a
 #: 1.2 m cube (I = m s^2 / 6), centre of mass 0.8 m below the root frame origin.
@@ -223,6 +245,9 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
       ``[yaw, pitch, roll]`` in radians; positions in mm.
     * 002 gives no joint limits (+-180 deg here) and no masses: the link masses below are
       illustrative (ours), each link a slender rod between consecutive DH origins.
+    * Collision geometry (illustrative too): a capsule of radius :data:`PUMA6_LINK_RADIUS`
+      along each of those rods and the bus as the 1.2 m cube of :data:`PUMA6_SPACECRAFT`'s
+      mass and inertia, with either base.
     """
     _check_base(base)
     deg = math.radians
@@ -238,7 +263,7 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
         length = float(np.linalg.norm(previous_origin))
         rod = masses[i] * max(length, 0.1) ** 2 / 12.0
         bodies.append(Body(masses[i], 0.5 * previous_origin, np.diag([rod, rod, rod]), name=f"link{i + 1}"))
-    return from_dh(
+    model = from_dh(
         "puma6",
         a=a,
         alpha=alpha,
@@ -251,6 +276,7 @@ def puma6(*, base: BaseMode = "fixed") -> ArmModel:
             "from the worked examples; masses illustrative (002 gives none)."
         ),
     )
+    return with_root_shapes(with_link_capsules(model, PUMA6_LINK_RADIUS), [bus_box(PUMA6_SPACECRAFT)])
 
 
 # -- registry -------------------------------------------------------------------------------

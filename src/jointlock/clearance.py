@@ -1,0 +1,362 @@
+"""Clearance: batched signed distances between an arm's links, its spacecraft bus and keep-out
+volumes (SPEC piece 16, issue 27).
+
+:func:`clearance` takes any batch of configurations (..., n) and returns, for each, the smallest
+signed distance over the checked pairs (negative: the two shapes overlap by that much), which
+pair it is, its witness points, and every pair's distance.
+
+Which pairs are checked.  The shapes are those of the model's bodies (:mod:`jointlock.shapes`;
+the built-in arms have capsules along their links and the bus box) and the keep-out volumes
+given in the root frame.  Each shape remembers the link it was made for (its joint number in
+the full arm, 0 for the root body), so the pairs are the same before and after a lock:
+
+* two shapes of one rigid body (a locked joint's two links included) are never checked;
+* adjacent links (``|i - j| = 1``, the root body being link 0) are never checked: a joint
+  keeps them in contact by design;
+* pairs that overlap at the full arm's zero pose (every joint at 0) are listed in
+  :attr:`Clearance.ignored` and not checked: mounted parts (canadarm7's root lies inside the
+  box of its spacecraft's mass and inertia), not collisions;
+* a keep-out volume is checked against every link but not the root body (both are fixed).
+
+Distances are exact for capsule-capsule (spheres included) and capsule-box pairs and are
+computed by compiled kernels (:mod:`jointlock._kernels._distance`), tested against coal
+(hpp-fcl) to 1e-12 m, penetration included.  A box on a moving link facing another box is not
+supported yet (refused in one line).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from ._cache import cached_on
+from .bounds import shown
+from .errors import ConfigurationError, ModelError
+from .forward import DEFAULT_CHUNK, chain_state
+from .model import ArmModel, FloatArray, as_joint_array
+from .shapes import Box, Capsule, Shape, Sphere, check_shapes
+
+#: The link number keep-out volumes are given (checked against every link, not the root body).
+KEEP_OUT_LINK = -1
+
+
+@dataclass(frozen=True, eq=False)
+class CollisionPairs:
+    """The shapes of a model (and keep-outs) and the pairs checked between them.
+
+    Attributes
+    ----------
+    capsule_body, box_body
+        (C,), (B,) body of each capsule (spheres included) and box: -1 for the root body and
+        keep-outs, ``i`` for the model's ``bodies[i]``.
+    capsule_points, capsule_radii
+        (C, 6) end points a, b in the body frame [m]; (C,) radii [m].
+    box_poses, box_halves
+        (B, 4, 4) box frames in the body frame; (B, 3) half extents [m].
+    pairs
+        (P, 3) int64: kind (0 capsule-capsule, 1 capsule-box), index 1, index 2.
+    names
+        (P,) ``"link3 - bus"``: the two shapes' names.
+    links
+        (P, 2) the two shapes' links (full-arm joint numbers, 0 the root body, -1 a keep-out).
+    ignored
+        The pairs in contact at the zero pose, not checked.
+    keys
+        (P,) each pair's shapes as ``(link, name, link, name)``.
+    """
+
+    capsule_body: np.ndarray
+    capsule_points: FloatArray
+    capsule_radii: FloatArray
+    box_body: np.ndarray
+    box_poses: FloatArray
+    box_halves: FloatArray
+    pairs: np.ndarray
+    names: tuple[str, ...]
+    links: np.ndarray
+    ignored: tuple[str, ...] = ()
+    keys: tuple[tuple[int, str, int, str], ...] = ()
+
+
+def _shape_name(shape: Shape) -> str:
+    if shape.name:
+        return shape.name
+    return "root" if shape.link == 0 else f"link{shape.link}"
+
+
+def _collect(model: ArmModel, keep_out: Sequence[Shape]) -> list[tuple[int, Shape]]:
+    shapes: list[tuple[int, Shape]] = [(-1, s) for s in model.root_body.shapes]
+    for i, body in enumerate(model.bodies):
+        shapes += [(i, s) for s in body.shapes]
+    for k, s in enumerate(keep_out):
+        named = s if s.name else replace(s, name=f"keep_out{k + 1}")
+        shapes.append((-1, replace(named, link=KEEP_OUT_LINK)))
+    return shapes
+
+
+def _checked(link_a: int, link_b: int, body_a: int, body_b: int) -> bool:
+    if link_a == KEEP_OUT_LINK or link_b == KEEP_OUT_LINK:
+        other = link_b if link_a == KEEP_OUT_LINK else link_a
+        return other > 0
+    if body_a == body_b:
+        return False
+    return abs(link_a - link_b) > 1
+
+
+def _build(model: ArmModel, keep_out: Sequence[Shape], ignored: frozenset[tuple[int, str, int, str]]) -> CollisionPairs:
+    shapes = _collect(model, keep_out)
+    capsules = [(b, s) for b, s in shapes if isinstance(s, (Capsule, Sphere))]
+    boxes = [(b, s) for b, s in shapes if isinstance(s, Box)]
+    pairs: list[tuple[int, int, int]] = []
+    names: list[str] = []
+    links: list[tuple[int, int]] = []
+    keys: list[tuple[int, str, int, str]] = []
+    skipped: list[str] = []
+
+    def add(kind: int, i: int, j: int, a: tuple[int, Shape], b: tuple[int, Shape]) -> None:
+        la, lb = int(a[1].link), int(b[1].link)  # type: ignore[arg-type]
+        if not _checked(la, lb, a[0], b[0]):
+            return
+        key = (la, _shape_name(a[1]), lb, _shape_name(b[1]))
+        name = f"{key[1]} - {key[3]}"
+        if key in ignored:
+            skipped.append(name)
+            return
+        pairs.append((kind, i, j))
+        names.append(name)
+        links.append((la, lb))
+        keys.append(key)
+
+    for i in range(len(capsules)):
+        for j in range(i + 1, len(capsules)):
+            add(0, i, j, capsules[i], capsules[j])
+        for j in range(len(boxes)):
+            add(1, i, j, capsules[i], boxes[j])
+    for i in range(len(boxes)):
+        for j in range(i + 1, len(boxes)):
+            a, b = boxes[i], boxes[j]
+            if _checked(int(a[1].link), int(b[1].link), a[0], b[0]) and not (a[0] < 0 and b[0] < 0):  # type: ignore[arg-type]
+                raise ModelError(
+                    f"box {shown(_shape_name(a[1]))} and box {shown(_shape_name(b[1]))}: distances between two "
+                    "boxes of which one moves are not supported yet; give the link a capsule or a sphere"
+                )
+
+    def points(s: Shape) -> list[float]:
+        if isinstance(s, Sphere):
+            return list(s.center) * 2
+        return list(s.a) + list(s.b)  # type: ignore[union-attr]
+
+    return CollisionPairs(
+        capsule_body=np.array([b for b, _ in capsules], dtype=np.int64),
+        capsule_points=np.array([points(s) for _, s in capsules], dtype=float).reshape(-1, 6),
+        capsule_radii=np.array([s.radius for _, s in capsules], dtype=float),
+        box_body=np.array([b for b, _ in boxes], dtype=np.int64),
+        box_poses=np.array([s.pose for _, s in boxes], dtype=float).reshape(-1, 4, 4),
+        box_halves=np.array([s.half_extents for _, s in boxes], dtype=float).reshape(-1, 3),
+        pairs=np.array(pairs, dtype=np.int64).reshape(-1, 3),
+        names=tuple(names),
+        links=np.array(links, dtype=np.int64).reshape(-1, 2),
+        ignored=tuple(skipped),
+        keys=tuple(keys),
+    )
+
+
+def _zero_pose_contacts(model: ArmModel) -> frozenset[tuple[int, str, int, str]]:
+    """The model's own pairs (no keep-outs) that overlap at the full arm's zero pose."""
+    full = model.unlocked if model.locked and model.unlocked is not None else model
+    pairs = _build(full, (), frozenset())
+    if not len(pairs.names):
+        return frozenset()
+    distance, _, _ = _distances(full, pairs, np.zeros((1, full.dof)))
+    return frozenset(key for key, d in zip(pairs.keys, distance[0]) if d <= 0.0)
+
+
+def collision_pairs(model: ArmModel, keep_out: Sequence[Shape] = ()) -> CollisionPairs:
+    """The shapes and the pairs :func:`clearance` checks on ``model`` with ``keep_out`` volumes
+    (shapes in the root frame); see the module for the rules."""
+    keep = check_shapes(keep_out, "keep_out")
+    ignored = cached_on(model, "zero_pose_contacts", lambda: _zero_pose_contacts(model))
+    if not keep:
+        return cached_on(model, "collision_pairs", lambda: _build(model, (), ignored))
+    return _build(model, keep, ignored)
+
+
+def _distances(model: ArmModel, pairs: CollisionPairs, q: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
+    """(N, P) signed distances, (N,) closest pair and (N, 2, 3) its witness points of
+    configurations q (N, n)."""
+    from ._kernels._distance import pair_distances
+
+    count = q.shape[0]
+    n_caps, n_boxes, n_pairs = pairs.capsule_radii.size, pairs.box_halves.shape[0], pairs.pairs.shape[0]
+    distance = np.empty((count, n_pairs))
+    closest = np.zeros(count, dtype=np.int64)
+    witness = np.zeros((count, 2, 3))
+    if n_pairs == 0 or count == 0:
+        return distance, closest, witness
+    for start in range(0, count, DEFAULT_CHUNK):
+        stop = min(start + DEFAULT_CHUNK, count)
+        m = stop - start
+        state = chain_state(model, q[start:stop]) if model.dof else None
+        caps = np.empty((m, n_caps, 6))
+        boxes = np.empty((m, max(n_boxes, 1), 12))
+        for c in range(n_caps):
+            body, pts = int(pairs.capsule_body[c]), pairs.capsule_points[c]
+            for half in (0, 3):
+                if body < 0:
+                    caps[:, c, half : half + 3] = pts[half : half + 3]
+                else:
+                    assert state is not None
+                    rot, pos = state.soa_rotations[body], state.soa_positions[body]
+                    caps[:, c, half : half + 3] = (np.einsum("ijn,j->in", rot, pts[half : half + 3]) + pos).T
+        for b in range(n_boxes):
+            body, frame = int(pairs.box_body[b]), pairs.box_poses[b]
+            if body < 0:
+                boxes[:, b, :9] = frame[:3, :3].ravel()
+                boxes[:, b, 9:] = frame[:3, 3]
+            else:
+                assert state is not None
+                rot, pos = state.soa_rotations[body], state.soa_positions[body]
+                boxes[:, b, :9] = np.einsum("ijn,jk->nik", rot, frame[:3, :3]).reshape(m, 9)
+                boxes[:, b, 9:] = (np.einsum("ijn,j->in", rot, frame[:3, 3]) + pos).T
+        pair_distances(
+            caps,
+            np.ascontiguousarray(pairs.capsule_radii),
+            boxes,
+            np.ascontiguousarray(pairs.box_halves if n_boxes else np.ones((1, 3))),
+            np.ascontiguousarray(pairs.pairs),
+            distance[start:stop],
+            closest[start:stop],
+            witness[start:stop],
+        )
+    return distance, closest, witness
+
+
+@dataclass(frozen=True, eq=False)
+class Clearance:
+    """Signed distances of a batch of configurations (:func:`clearance`).
+
+    Attributes
+    ----------
+    distance
+        (...,) smallest signed distance over the checked pairs [m]; negative: overlap.  +inf
+        when no pair is checked.
+    closest
+        (...,) index into ``names`` of the pair that gives it.
+    witness
+        (..., 2, 3) points on its two shapes, root frame [m] (``|w[1] - w[0]| = |distance|``).
+    pair_distance
+        (..., P) every checked pair's signed distance [m].
+    names
+        (P,) the checked pairs, ``"link3 - bus"``.
+    ignored
+        The pairs not checked because they overlap at the full arm's zero pose.
+    """
+
+    distance: FloatArray
+    closest: np.ndarray
+    witness: FloatArray
+    pair_distance: FloatArray
+    names: tuple[str, ...]
+    ignored: tuple[str, ...] = ()
+    margin: float = field(default=0.0)
+
+    @property
+    def closest_pair(self) -> np.ndarray:
+        """(...,) the name of the closest pair of each configuration (``""`` without pairs)."""
+        table = np.array(self.names + ("",), dtype=object)
+        index = np.where(np.isfinite(self.distance), self.closest, len(self.names))
+        return np.asarray(table[index], dtype=object)
+
+    def pair_at(self, index: tuple[int, ...] = ()) -> str:
+        """The name of the closest pair of the configuration at ``index``."""
+        return self.names[int(self.closest[index])] if self.names else ""
+
+    def colliding(self, margin: float | None = None) -> np.ndarray:
+        """(...,) True where the clearance is below ``margin`` [m] (default: the result's)."""
+        return np.asarray(self.distance < (self.margin if margin is None else margin))
+
+    def worst(self) -> tuple[int, ...]:
+        """Index of the configuration with the smallest clearance."""
+        return tuple(int(i) for i in np.unravel_index(int(np.argmin(self.distance)), self.distance.shape)) if self.distance.size else ()
+
+    def summary(self) -> str:
+        """One line: the smallest clearance, the pair and, for a batch, how many are below the
+        margin."""
+        if not self.names:
+            return "clearance: no pair checked (the model has no collision shapes)"
+        at = self.worst()
+        d = float(self.distance[at])
+        pair = self.pair_at(at)
+        verdict = "COLLIDES" if d < 0 else ("below the margin" if d < self.margin else "clear")
+        text = f"clearance {d:+.4f} m ({pair}): {verdict}"
+        if self.margin:
+            text += f" (margin {self.margin:g} m)"
+        if self.distance.size > 1:
+            below = int(np.count_nonzero(self.colliding()))
+            text = f"smallest {text}; {below} of {self.distance.size} configurations below {self.margin:g} m"
+        return text
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data: the smallest clearance [m], its pair and witness points, each pair's
+        smallest distance, the margin and how many configurations are below it."""
+        if not self.names or not self.distance.size:
+            return {"checked_pairs": [], "ignored_pairs": list(self.ignored), "min_clearance_m": None}
+        at = self.worst()
+        flat = self.pair_distance.reshape(-1, len(self.names))
+        return {
+            "min_clearance_m": float(self.distance[at]),
+            "closest_pair": self.pair_at(at),
+            "witness_points_m": self.witness[at].tolist(),
+            "margin_m": self.margin,
+            "configurations": int(self.distance.size),
+            "below_margin": int(np.count_nonzero(self.colliding())),
+            "pair_min_clearance_m": {name: float(v) for name, v in zip(self.names, flat.min(axis=0))},
+            "checked_pairs": list(self.names),
+            "ignored_pairs": list(self.ignored),
+        }
+
+
+def clearance(
+    model: ArmModel, q: ArrayLike, *, keep_out: Sequence[Shape] = (), margin: float = 0.0
+) -> Clearance:
+    """Signed distances of configurations ``q`` (..., n) [rad] between the arm's links, its
+    spacecraft bus and the ``keep_out`` volumes (shapes in the root frame).
+
+    Parameters
+    ----------
+    model
+        The arm (locked or not) with collision shapes on its bodies.
+    q
+        (..., n) joint angles of its movable joints [rad].
+    keep_out
+        Shapes in the root frame (a docked vehicle, a solar array, a payload).
+    margin
+        The clearance required [m] (``clearance_min_m``), kept on the result for
+        :meth:`Clearance.colliding` and the summary.
+
+    Returns
+    -------
+    Clearance
+        Negative distances are penetration depths; see the module for the pairs checked.
+    """
+    q = as_joint_array(model, q)
+    if not (isinstance(margin, (int, float)) and not isinstance(margin, bool) and math.isfinite(margin) and margin >= 0):
+        raise ConfigurationError(f"margin must be a finite clearance >= 0 [m]; got {shown(margin)}")
+    pairs = collision_pairs(model, keep_out)
+    batch = q.shape[:-1]
+    distance, closest, witness = _distances(model, pairs, q.reshape(-1, model.dof))
+    smallest = distance.min(axis=1) if distance.shape[1] else np.full(distance.shape[0], np.inf)
+    return Clearance(
+        distance=smallest.reshape(batch),
+        closest=closest.reshape(batch),
+        witness=witness.reshape(batch + (2, 3)),
+        pair_distance=distance.reshape(batch + (distance.shape[1],)),
+        names=pairs.names,
+        ignored=pairs.ignored,
+        margin=float(margin),
+    )

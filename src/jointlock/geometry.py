@@ -1,0 +1,50 @@
+"""Giving a model collision geometry (SPEC piece 16, issue 27): capsules along its links, a box
+for its spacecraft bus.
+
+The shapes themselves are :mod:`jointlock.shapes`; a model carries them on its bodies
+(``Body.shapes``), so that locking merges them like the inertia.  Distances are
+:mod:`jointlock.clearance`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import replace
+
+from .errors import ModelError
+from .model import ArmModel, Body
+from .shapes import Box, Shape, box_from_inertia, chain_capsules
+
+
+def with_link_capsules(model: ArmModel, radius: float | Sequence[float]) -> ArmModel:
+    """``model`` with a capsule along each link of its stick figure (the polyline through the
+    root, every joint origin and the end effector that the 3-D view draws), replacing the
+    links' shapes; the root post (root origin to joint 1) goes to the root body, next to its
+    other shapes.
+
+    Parameters
+    ----------
+    radius
+        One radius [m] for every capsule, or (n + 1,) radii: the root post's, then link
+        1..n's; 0 leaves that body without a shape.  A zero-length link (an end effector at
+        the last joint's origin) gets a sphere.
+    """
+    if model.locked:
+        raise ModelError("give the full arm its capsules, then lock it (locking merges them)")
+    root, links = chain_capsules([j.placement for j in model.joints], model.tool, radius)  # type: ignore[arg-type]
+    bodies = tuple(replace(b, shapes=s) for b, s in zip(model.bodies, links))
+    root_shapes = tuple(s for s in model.root_body.shapes if s.name != "post") + root
+    return replace(model, bodies=bodies, root_body=replace(model.root_body, shapes=root_shapes))
+
+
+def with_root_shapes(model: ArmModel, shapes: Sequence[Shape]) -> ArmModel:
+    """``model`` with ``shapes`` added to its root body (the spacecraft bus, a mounting), in
+    the root frame.  The root body keeps them with a fixed base too: a held spacecraft is
+    still there."""
+    return replace(model, root_body=replace(model.root_body, shapes=model.root_body.shapes + tuple(shapes)))
+
+
+def bus_box(spacecraft: Body, name: str = "bus") -> Box:
+    """The spacecraft bus as the uniform box of ``spacecraft``'s mass and inertia, in the root
+    frame (:func:`jointlock.shapes.box_from_inertia`): the box the 3-D view draws."""
+    return box_from_inertia(spacecraft.mass, spacecraft.com, spacecraft.inertia, name=name)
