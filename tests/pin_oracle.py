@@ -83,3 +83,45 @@ def reduced_model(full, keep: list[str], values: dict[str, float]):
     reduced = pin.buildReducedModel(full, lock, q_ref)
     assert list(reduced.names[1:]) == keep
     return reduced
+
+
+def to_pinocchio_geometry(model: jl.ArmModel, pm):
+    """(pin.GeometryModel, pair names) of ``model``'s collision shapes on ``pm`` (from
+    :func:`to_pinocchio`, fixed base): coal capsules, spheres and boxes on the joints that
+    carry them, and jointlock's checked pairs (:func:`jointlock.clearance.collision_pairs`) as
+    the collision pairs, in the same order."""
+    import coal
+
+    from jointlock.clearance import collision_pairs
+
+    pairs = collision_pairs(model)
+    geom = pin.GeometryModel()
+
+    def add(name: str, body: int, shape, placement: np.ndarray) -> int:
+        parent = 0 if body < 0 else body + 1
+        obj = pin.GeometryObject(name, parent, pin.SE3(placement[:3, :3].copy(), placement[:3, 3].copy()), shape)
+        return geom.addGeometryObject(obj)
+
+    capsules = []
+    for c, (body, points, radius) in enumerate(zip(pairs.capsule_body, pairs.capsule_points, pairs.capsule_radii)):
+        a, b = points[:3], points[3:]
+        length = float(np.linalg.norm(b - a))
+        frame = np.eye(4)
+        frame[:3, 3] = (a + b) / 2
+        if length > 0:
+            z = (b - a) / length
+            helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+            x = np.cross(helper, z)
+            x /= np.linalg.norm(x)
+            frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+            shape = coal.Capsule(float(radius), length)
+        else:
+            shape = coal.Sphere(float(radius))
+        capsules.append(add(f"capsule{c}", int(body), shape, frame))
+    boxes = [
+        add(f"box{b}", int(body), coal.Box(*(2 * half)), pose)
+        for b, (body, pose, half) in enumerate(zip(pairs.box_body, pairs.box_poses, pairs.box_halves))
+    ]
+    for kind, i, j in pairs.pairs:
+        geom.addCollisionPair(pin.CollisionPair(capsules[i], capsules[j] if kind == 0 else boxes[j]))
+    return geom, pairs.names

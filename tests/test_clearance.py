@@ -145,7 +145,7 @@ def test_halt7_population_against_coal_and_the_share_colliding():
     for n in range(100):
         frames = [np.eye(4)] + [np.block([[state.rotations[n, i], state.positions[n, i][:, None]], [np.zeros((1, 3)), 1.0]]) for i in range(arm.dof)]
 
-        def world(index: int, kind: str):
+        def world(index: int, kind: str, frames: list = frames):
             if kind == "capsule":
                 frame = frames[pairs.capsule_body[index] + 1]
                 a, b = pairs.capsule_points[index, :3], pairs.capsule_points[index, 3:]
@@ -230,3 +230,24 @@ def test_bad_input_is_refused_in_one_line():
         with_link_capsules(jl.lock(arm, 2, 0.0), 0.1)
     with pytest.raises(ConfigurationError, match="must have shape"):
         clearance(arm, np.zeros(6))
+
+
+@pytest.mark.oracle
+def test_pinocchio_geometry_model_compute_distances_equals_clearance():
+    """Pinocchio's GeometryModel (coal shapes on the joints, jointlock's pairs) and
+    computeDistances: the same signed distance for every pair at random configurations."""
+    from pin_oracle import pin, pin_q, to_pinocchio, to_pinocchio_geometry
+
+    for name, lock_at in (("halt7", (4, 0.0)), ("canadarm7", (3, 0.4)), ("puma6", None)):
+        arm = jl.load_robot(name)
+        arm = jl.lock(arm, *lock_at) if lock_at else arm
+        pm, _ = to_pinocchio(arm)
+        geom, names = to_pinocchio_geometry(arm, pm)
+        data, gdata = pm.createData(), pin.GeometryData(geom)
+        q = np.random.default_rng(5).uniform(-np.pi, np.pi, (40, arm.dof))
+        ours = clearance(arm, q)
+        assert ours.names == names
+        for n in range(q.shape[0]):
+            pin.computeDistances(pm, data, geom, gdata, pin_q(pm, q[n], False))
+            theirs = [r.min_distance for r in gdata.distanceResults]
+            assert np.allclose(ours.pair_distance[n], theirs, atol=1e-6), name

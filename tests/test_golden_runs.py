@@ -27,9 +27,11 @@ from jointlock.io.files import to_plain
 ROOT = Path(__file__).resolve().parents[1]
 GOLDEN = ROOT / "tests" / "data" / "golden"
 
-#: The reduced settings the golden files were recorded with (those of tests/test_run.py).
+#: The reduced settings the golden files were recorded with (those of tests/test_run.py), and
+#: the clearance not required: the files predate collision geometry (issue 27), which moves
+#: halt_000's halt configuration; with it off every number must be the recorded one.
 FAST = {
-    "halt_000": {"halt_config.samples": 3000, "halt.n_samples": 201},
+    "halt_000": {"halt_config.samples": 3000, "halt.n_samples": 201, "limits.check_clearance": False},
     "jump_001": {"jump.sweep": 6},
     "replan_002": {"workspace.samples": 4000, "replan.steps": 10},
     "singular_004": {"singular.samples": 50},

@@ -353,13 +353,13 @@ def test_cli_exact_reachability(capsys):
 
 def test_halt_pipeline_uses_exact_reachability(capsys):
     """`jointlock halt halt7`: the optimal halt configuration is now reachable in 000's 10 s;
-    with --no-reachability (000's way) it is not."""
+    with --no-reachability --no-clearance (000's way) it is not."""
     cmd = ["halt", "halt7", "--samples", "2000", "--n-samples", "101", "--json", "--quiet"]
     assert main(cmd) == 0
     data = json.loads(capsys.readouterr().out)
     assert data["feasible"] and not data["violations"] and data["reduction"] > 0
     assert 0 < data["reachable_samples"] <= 2000 and "exact" in data["reachability"]
-    assert main(cmd + ["--no-reachability"]) == 0
+    assert main(cmd + ["--no-reachability", "--no-clearance"]) == 0
     data = json.loads(capsys.readouterr().out)
     assert not data["feasible"] and "reachability" not in data
 

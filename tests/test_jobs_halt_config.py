@@ -205,8 +205,9 @@ def test_section_plots_draw_on_a_given_axis_or_their_own(results):
     figs = section_figures(r)
     assert len(figs) == 6 and tuple(figs[0].get_size_inches()) == (5.0, 3.4)
     texts = [t.get_text() for t in figs[0].axes[0].get_legend().get_texts()]
-    n_ok = r.configuration.reachable_samples
-    assert f"reachable samples ({n_ok})" in texts and "best" in texts
+    n_ok = int(np.count_nonzero(r.configuration.reachable))  # reachable and clear of the bus
+    assert f"admissible samples ({n_ok})" in texts and "best" in texts
+    assert f"unreachable or too close samples ({SAMPLES - n_ok})" in texts
     assert matplotlib.get_backend() == backend
 
 

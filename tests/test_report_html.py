@@ -36,11 +36,16 @@ def report(tmp_path_factory) -> Path:
     from jointlock.run import run_scenario
 
     out = tmp_path_factory.mktemp("run")
-    # 000's own, unconstrained halt-configuration search: its halt breaks limits, so the
-    # report's "broken" rendering is exercised too
+    # 000's own, unconstrained halt-configuration search (no reachability, no clearance): its
+    # halt breaks limits, so the report's "broken" rendering is exercised too
     sc = load_scenario(
         EXAMPLES / "halt_000.toml",
-        {"halt_config.samples": 2000, "halt.n_samples": 101, "halt_config.reachable": False},
+        {
+            "halt_config.samples": 2000,
+            "halt.n_samples": 101,
+            "halt_config.reachable": False,
+            "limits.check_clearance": False,
+        },
     )
     run_scenario(sc).write(out)
     return out / "report.html"

@@ -262,7 +262,7 @@ def test_new_limit_names_resolve_to_the_same_keys(tmp_path, fresh_warnings):
     with warnings.catch_warnings():
         warnings.simplefilter("error")  # the new names do not warn
         sc = load_scenario(write(tmp_path, LIMITS_HEAD + NEW_LIMITS))
-    torques = {"torque_max_Nm": None, "brake_max_Nm": None}
+    torques = {"torque_max_Nm": None, "brake_max_Nm": None, "clearance_min_m": None, "check_clearance": True}
     assert sc.data["limits"] == {"vmax_deg": 30.0, "amax_deg": 15.0, "eps_m": 0.002, **torques}
 
 
@@ -274,7 +274,9 @@ def test_former_limit_names_work_and_warn_once(tmp_path, fresh_warnings):
         first = load_scenario(path)
         second = load_scenario(path, {"limits.vmax_deg": 30.0})  # an override by the former name
     assert first.data == second.data == new.data and first.jobs == new.jobs
-    assert list(first.data["limits"]) == list(new.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m", "torque_max_Nm", "brake_max_Nm"]
+    assert list(first.data["limits"]) == list(new.data["limits"]) == [
+        "vmax_deg", "amax_deg", "eps_m", "torque_max_Nm", "brake_max_Nm", "clearance_min_m", "check_clearance"
+    ]
     assert former_name_warnings(record) == [
         f"{path}: limits.vmax_deg is deprecated: write limits.vmax_deg_s instead (the same quantity, "
         "in deg/s); the old name still works for now",
@@ -302,7 +304,7 @@ def test_an_override_replaces_the_files_value_under_either_name(tmp_path, fresh_
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", FutureWarning)
         sc = load_scenario(path, {key: 12.5})
-    torques = {"torque_max_Nm": None, "brake_max_Nm": None}
+    torques = {"torque_max_Nm": None, "brake_max_Nm": None, "clearance_min_m": None, "check_clearance": True}
     assert sc.data["limits"] == {"vmax_deg": 12.5, "amax_deg": 15.0, "eps_m": 0.002, **torques}
     assert list(sc.data["limits"]) == ["vmax_deg", "amax_deg", "eps_m", *torques]  # the file's order, then defaults
     assert sc.overrides == {key: {"file": 30.0, "value": 12.5}}

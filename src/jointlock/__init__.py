@@ -73,6 +73,7 @@ _CORE = {
     "Sphere": "jointlock.shapes",
     "Clearance": "jointlock.clearance",
     "clearance": "jointlock.clearance",
+    "ClearanceSettings": "jointlock.clearance",
 }
 
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).
@@ -142,6 +143,7 @@ __all__ = [
     "Capsule",
     "ChainState",
     "Clearance",
+    "ClearanceSettings",
     "ConfigurationError",
     "InfeasibleError",
     "Joint",

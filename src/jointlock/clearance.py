@@ -360,3 +360,55 @@ def clearance(
         ignored=pairs.ignored,
         margin=float(margin),
     )
+
+
+#: Default clearance a job requires [m]: 5 cm between the collision shapes (which are envelopes
+#: already: the built-in arms' capsules are twice the radius their inertias imply), so that a
+#: recommended halt configuration does not graze the bus; a scenario sets it with
+#: ``limits.clearance_min_m`` (``limits.check_clearance = false``: reported only).
+DEFAULT_CLEARANCE_MIN_M = 0.05
+
+
+@dataclass(frozen=True, eq=False)
+class ClearanceSettings:
+    """What a job requires of clearance (one typed setting, like the limits).
+
+    Attributes
+    ----------
+    min_m
+        The clearance required [m] between the arm's links, its spacecraft bus and the keep-out
+        volumes; None: not checked as a constraint (a paper's own way; results still report
+        the clearance).
+    keep_out
+        Keep-out volumes, shapes in the root frame (:mod:`jointlock.shapes`).
+    """
+
+    min_m: float | None = DEFAULT_CLEARANCE_MIN_M
+    keep_out: tuple[Shape, ...] = ()
+
+    def __post_init__(self) -> None:
+        if self.min_m is not None:
+            value = self.min_m
+            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
+                raise ConfigurationError(f"clearance min_m must be a finite clearance >= 0 [m] or None; got {shown(value)}")
+            object.__setattr__(self, "min_m", float(value))
+        object.__setattr__(self, "keep_out", check_shapes(self.keep_out, "keep_out"))
+
+    @classmethod
+    def off(cls, keep_out: Sequence[Shape] = ()) -> ClearanceSettings:
+        """Clearance reported, not required (the papers' way)."""
+        return cls(min_m=None, keep_out=tuple(keep_out))
+
+    @property
+    def required(self) -> bool:
+        """Whether the clearance is a constraint."""
+        return self.min_m is not None
+
+    @property
+    def margin(self) -> float:
+        """The clearance a result is judged against [m] (0 when not required)."""
+        return 0.0 if self.min_m is None else self.min_m
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain data: the clearance required [m] (None: reported only) and the keep-outs."""
+        return {"min_m": self.min_m, "keep_out": [s.to_dict() for s in self.keep_out]}

@@ -298,3 +298,29 @@ def print_json(obj: Any) -> None:
     from ..io.files import json_text
 
     sys.stdout.write(json_text(obj))
+
+
+def add_clearance_options(p: argparse.ArgumentParser) -> None:
+    """``--clearance-min-m`` and ``--no-clearance`` (scenario ``[limits] clearance_min_m`` and
+    ``check_clearance``)."""
+    p.add_argument(
+        "--clearance-min-m",
+        type=field_arg("limits", "clearance_min_m"),
+        metavar="M",
+        help="clearance kept between the links, the spacecraft bus and keep-outs [m] (default 0.05): closer "
+        "halt configurations are excluded, a closer --qf-deg is refused, a closer halt motion is reported",
+    )
+    p.add_argument(
+        "--no-clearance",
+        action="store_true",
+        help="do not require the clearance (the papers' way); it is still reported",
+    )
+
+
+def clearance_from_args(args: argparse.Namespace) -> Any:
+    """The :class:`~jointlock.clearance.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``."""
+    from ..jobs._common import scenario_clearance
+
+    return scenario_clearance(
+        {"limits": {"clearance_min_m": args.clearance_min_m, "check_clearance": not args.no_clearance}}
+    )

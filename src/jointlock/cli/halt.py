@@ -19,9 +19,11 @@ from .._lazy import lazy_attributes
 from ..errors import ScenarioError
 from ..papers import p000
 from ._common import (
+    add_clearance_options,
     add_robot_arguments,
     chain_from_args,
     check_out_dir,
+    clearance_from_args,
     deg_arg,
     field_arg,
     lock_map,
@@ -222,6 +224,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write plots (PNG), time series (CSV, NPZ) and result.json")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    add_clearance_options(p)
     p.set_defaults(func=run)
 
 
@@ -327,6 +330,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         margin=args.margin,
         objective=args.objective,
         prefer_margin=args.prefer_margin,
+        clearance=clearance_from_args(args),
         _names=CLI_NAMES,
     )
 

@@ -10,7 +10,9 @@ from typing import TYPE_CHECKING, Any
 from ..errors import ScenarioError
 from ..papers import p000
 from ._common import (
+    add_clearance_options,
     add_robot_arguments,
+    clearance_from_args,
     deg_arg,
     field_arg,
     model_from_args,
@@ -123,6 +125,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write result.json, section plots and samples here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    add_clearance_options(p)
     p.set_defaults(func=run)
 
 
@@ -173,6 +176,7 @@ def run(args: argparse.Namespace) -> int:
         amax_deg=args.amax_deg,
         limit_names=CLI_LIMIT_NAMES,
         progress=not args.quiet and args.samples >= PROGRESS_MIN_SAMPLES,
+        clearance=clearance_from_args(args),
     )
     data = result.to_dict()
     files = []

@@ -25,6 +25,7 @@ from typing import Any, ClassVar, overload
 
 import numpy as np
 
+from ..clearance import DEFAULT_CLEARANCE_MIN_M, ClearanceSettings
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, figure_png, json_text, to_plain
 from ..model import ArmModel
@@ -156,6 +157,16 @@ def scenario_locks(data: Mapping[str, Any]) -> dict[int, float]:
         return {}
     earlier = (data.get("failure") or {}).get("also_locked_deg") or {}
     return {**{int(j): math.radians(float(a)) for j, a in earlier.items()}, lk[0]: lk[1]}
+
+
+def scenario_clearance(data: Mapping[str, Any]) -> ClearanceSettings:
+    """The clearance a resolved scenario requires (``[limits] clearance_min_m``, turned off by
+    ``[limits] check_clearance = false``: reported only)."""
+    lim = data.get("limits") or {}
+    minimum = lim.get("clearance_min_m")
+    if lim.get("check_clearance") is False:
+        return ClearanceSettings.off()
+    return ClearanceSettings(DEFAULT_CLEARANCE_MIN_M if minimum is None else float(minimum))
 
 
 def locked_deg(model: ArmModel) -> dict[str, float]:

@@ -22,6 +22,7 @@ import numpy as np
 
 from .._deprecate import renamed_keyword
 from ..analysis.ability import INDEX_NAMES, Assignment, JacobianKind
+from ..clearance import ClearanceSettings
 from ..errors import ConfigurationError
 from ..io.files import atomic_write_bytes, atomic_write_json, with_svg, write_figure
 from ..locking import lock_joints
@@ -36,7 +37,7 @@ from ..planning.halt_config import (
 from ..plots.halt_config import section_figures
 from ..progress import Progress
 from ..robots import UrdfChain, load_robot
-from ._common import JobResult, scenario_locks
+from ._common import JobResult, scenario_clearance, scenario_locks
 from .halt import SCENARIO_LIMIT_NAMES, FailureState, JointLimits, halt_limits, limits_text
 
 #: Below this many samples no progress bar is shown (the run takes well under a second).
@@ -155,6 +156,13 @@ class HaltConfigurationStudy(JobResult):
                 "  (fixed base: the generalized Jacobian is the fixed-base one; --base floating for 000's J_F)"
             )
         out.append(f"samples: {r.samples}, seed: {r.seed}")
+        if r.colliding_samples is not None:
+            out.append(
+                f"clearance required: {r.clearance_min_m:g} m (links, spacecraft bus, keep-outs): "
+                f"{r.colliding_samples} of {r.samples} samples excluded"
+            )
+        if r.best_clearance is not None:
+            out.append(f"best: {r.best_clearance.summary()}")
         if isinstance(reach, HaltReachability):
             k_txt = ""
             if r.k_range is not None:
@@ -278,6 +286,7 @@ def study_halt_configuration(
     amax_deg: float | list[float] | None = None,
     limit_names: tuple[str, str] = ("vmax_deg", "amax_deg"),
     progress: bool = False,
+    clearance: ClearanceSettings | None = None,
 ) -> HaltConfigurationStudy:
     """The optimal halt configuration of a locked arm (000 HCOM: Monte Carlo over the healthy
     joints, CP from AHP + entropy weights, eqs. 8-24), refined locally, as
@@ -316,6 +325,12 @@ def study_halt_configuration(
         How the two limits are named in the limit sources (the CLI passes its options).
     progress
         Show a progress bar on stderr (when it is a terminal).
+    clearance
+        Beyond 000 (issue 27): the clearance a halt configuration must keep between the arm's
+        links, its spacecraft bus and keep-out volumes (:class:`~jointlock.clearance.
+        ClearanceSettings`; default: :data:`~jointlock.clearance.DEFAULT_CLEARANCE_MIN_M`);
+        closer samples are excluded and counted.  ``ClearanceSettings.off()``: 000's search,
+        the clearance only reported.
 
     Returns
     -------
@@ -339,6 +354,9 @@ def study_halt_configuration(
         raise ConfigurationError(f"characteristic_length must be a finite length > 0 [m]; got {length}")
     if reachability is not None and not isinstance(reachability, ReachabilitySettings):
         raise ConfigurationError(f"reachability must be ReachabilitySettings or None; got {reachability!r}")
+    clearance = clearance if clearance is not None else ClearanceSettings()
+    if not isinstance(clearance, ClearanceSettings):
+        raise ConfigurationError(f"clearance must be ClearanceSettings or None; got {type(clearance).__name__}")
     limits = constraint = None
     if reachability is not None:
         limits = halt_limits(model, vmax_deg, amax_deg, names=limit_names)
@@ -355,6 +373,8 @@ def study_halt_configuration(
             characteristic_length=length,
             reachability=constraint,
             progress=bar,
+            clearance_min_m=clearance.min_m,
+            keep_out=clearance.keep_out,
         )
     return HaltConfigurationStudy(robot=model.name, configuration=result, limits=limits)
 
@@ -398,4 +418,5 @@ def halt_config_from_scenario(
         limit_names=SCENARIO_LIMIT_NAMES,
         amax_deg=lim["amax_deg"],
         progress=progress and samples >= PROGRESS_MIN_SAMPLES,
+        clearance=scenario_clearance(data),
     )

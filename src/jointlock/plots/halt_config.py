@@ -28,7 +28,8 @@ def plot_section(result: Any, joint: int, *, ax: Any | None = None, bins: int = 
     """Joint angle [deg] vs CP over the sample set for healthy joint ``joint`` (its number,
     1-based, full arm), with the upper envelope (max CP per angle bin), the best and the
     runner-up (000 Fig. 7).  Under exact reachability unreachable samples are grey crosses
-    (their own legend entry) and the envelope is over the reachable ones.
+    (their own legend entry) and the envelope is over the reachable ones; with a clearance
+    required, samples too close to the bus or the arm itself are greyed out with them.
 
     Parameters
     ----------
@@ -57,6 +58,8 @@ def plot_section(result: Any, joint: int, *, ax: Any | None = None, bins: int = 
     q_deg = np.degrees(res.q_samples)
     edges = np.linspace(math.degrees(float(res.lower.min())), math.degrees(float(res.upper.max())), bins + 1)
     ok = np.ones(res.samples, bool) if res.reachable is None else res.reachable
+    # with a clearance required the mask is "reachable and clear" (HaltConfiguration.reachable)
+    kept, excluded = ("admissible", "unreachable or too close") if res.colliding_samples is not None else ("reachable", "unreachable")
     if not ok.all():
         ax.scatter(
             q_deg[~ok, j],
@@ -68,7 +71,7 @@ def plot_section(result: Any, joint: int, *, ax: Any | None = None, bins: int = 
             linewidths=0.7,
             zorder=2.5,  # above the reachable cloud: a thin set must stay visible
             rasterized=True,
-            label=f"unreachable samples ({int((~ok).sum())})",
+            label=f"{excluded} samples ({int((~ok).sum())})",
         )
     ax.scatter(
         q_deg[ok, j],
@@ -77,7 +80,7 @@ def plot_section(result: Any, joint: int, *, ax: Any | None = None, bins: int = 
         alpha=0.25,
         color="tab:blue",
         rasterized=True,
-        label="samples" if res.reachable is None else f"reachable samples ({int(ok.sum())})",
+        label="samples" if res.reachable is None else f"{kept} samples ({int(ok.sum())})",
     )
     which = np.clip(np.digitize(q_deg[ok, j], edges) - 1, 0, bins - 1)
     envelope = np.full(bins, np.nan)

@@ -54,6 +54,12 @@ def _chain_args(data: Mapping[str, Any]) -> list[str]:
     return argv
 
 
+def _clearance_args(lim: Mapping[str, Any]) -> list[str]:
+    """``--clearance-min-m`` / ``--no-clearance`` of ``[limits]`` (none when at the defaults)."""
+    argv = ["--clearance-min-m", _num(lim["clearance_min_m"])] if lim.get("clearance_min_m") is not None else []
+    return argv + (["--no-clearance"] if lim.get("check_clearance") is False else [])
+
+
 def job_argv(
     job: str, scenario: Scenario, out: Path, previous: Mapping[str, dict], *, quiet: bool
 ) -> list[str]:  # one branch per job: the options of seven subcommands
@@ -82,6 +88,7 @@ def job_argv(
         for key in ("vmax_deg", "amax_deg"):
             if lim[key] is not None:
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
+        argv += _clearance_args(lim)
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "halt":
         argv += job_lock_args(scenario) + ["--base", t["base"] or d["base"]]
@@ -100,6 +107,7 @@ def job_argv(
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
         for key, option in (("torque_max_Nm", "--torque-max-Nm"), ("brake_max_Nm", "--brake-max-Nm")):
             argv += [option, _num(lim[key])] if lim.get(key) is not None else []
+        argv += _clearance_args(lim)
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
         argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])

@@ -21,6 +21,13 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
             "cp_best_sample": r["best_sample"]["cp"],
             "refinement_gain": r["refinement"]["gain"],
         }
+        if (clear := r.get("clearance")) is not None:
+            s["halt_config"].update(
+                clearance_m=clear["best"]["min_clearance_m"],
+                clearance_pair=clear["best"]["closest_pair"],
+                clearance_required_m=clear["required_m"],
+                colliding_samples=clear["colliding_samples"],
+            )
     if "halt" in jobs:
         r = jobs["halt"]["result"]
         s["halt"] = {
@@ -32,6 +39,11 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
             "minimum_T_s": r["minimum_T_s"],
             "violations": len(r["violations"]),
         }
+        if (clear := r.get("clearance")) is not None:
+            s["halt"]["clearance"] = {
+                key: clear[key]
+                for key in ("collides", "start_m", "motion_min_m", "motion_min_pair", "motion_min_time_s", "verdict")
+            }
     if "jump" in jobs:
         r = jobs["jump"]["result"]
         s["jump"] = {
@@ -112,10 +124,19 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     """Human-readable summary of a run (a few lines per job)."""
     s = results["summary"]
     lines = [f"{results['title']}  ({results['scenario_file']}, seed {results['seed']})"]
+    verdict = ((s.get("halt") or {}).get("clearance") or {}).get("verdict")
+    if verdict:  # a halt that comes too close says so first
+        lines.insert(0, verdict)
     if "halt_config" in s:
         h = s["halt_config"]
         q = ", ".join(f"{v:.2f}" for v in h["q_best_deg"])
         lines.append(f"  halt configuration: [{q}] deg, CP {h['cp_best']:.4f}")
+        if h.get("clearance_m") is not None:
+            excluded = h["colliding_samples"]
+            lines.append(
+                f"  clearance {h['clearance_m']:+.3f} m ({h['clearance_pair']})"
+                + ("" if excluded is None else f"; {excluded} samples closer than {h['clearance_required_m']:g} m excluded")
+            )
     if "halt" in s:
         h = s["halt"]
         if h["feasible"]:

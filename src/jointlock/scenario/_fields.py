@@ -187,6 +187,18 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
             "N m", "motor torque limit of every healthy joint, capped by the model's own (halt)", hi=MAX_TORQUE_NM
         ),
         "brake_max_Nm": _pos("N m", "brake torque limit of every locked joint (halt)", hi=MAX_TORQUE_NM),
+        "clearance_min_m": Field(
+            "number",
+            None,
+            lo=0.0,
+            hi=MAX_LENGTH_M,
+            unit="m",
+            help="clearance kept between the links, the spacecraft bus and keep-outs (halt_config, halt; "
+            "default 0.05)",
+        ),
+        "check_clearance": Field(
+            "bool", True, help="require the clearance (false: report it only, the papers' way) (halt_config, halt)"
+        ),
     },
 }
 

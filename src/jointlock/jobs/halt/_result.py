@@ -11,8 +11,10 @@ from typing import Any, ClassVar, cast
 
 import numpy as np
 
+from ..._cache import cached_on
 from ...analysis.actuators import ActuatorLoads, actuator_loads
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
+from ...clearance import Clearance, ClearanceSettings, clearance, collision_pairs
 from ...io.files import (
     atomic_write_bytes,
     atomic_write_json,
@@ -104,6 +106,10 @@ class HaltPlan(JobResult):
         Share of each limit kept free (asked; kept when the halt is feasible).
     notes
         Plain-language notes on how the halt was planned (printed with the summary).
+    clearance_settings
+        The clearance required and the keep-out volumes (:class:`~jointlock.clearance.
+        ClearanceSettings`); with a clearance required, a halt that comes closer is not
+        :attr:`feasible`.
     """
 
     job: ClassVar[str] = "halt"
@@ -120,6 +126,7 @@ class HaltPlan(JobResult):
     state_source: str = "given"
     margin: float = 0.0
     notes: tuple[str, ...] = ()
+    clearance_settings: ClearanceSettings = field(default_factory=ClearanceSettings)
 
     @property
     def problem(self) -> HaltProblem:
@@ -127,7 +134,17 @@ class HaltPlan(JobResult):
 
     @property
     def feasible(self) -> bool:
+        """The halt motion keeps every limit (speed, acceleration, torques); whether it keeps
+        the clearance is :attr:`collision_free`."""
         return bool(self.motion.feasible)
+
+    @property
+    def collision_free(self) -> bool | None:
+        """Whether the halt motion keeps the clearance required (0 m when only reported) on
+        every sample of the constraint grid; a pair already closer at the state at failure must
+        not come closer still.  None for a model without collision shapes."""
+        data = self._clearance_dict()
+        return None if data is None else not data["collides"]
 
     @property
     def k_deg(self) -> Any:
@@ -171,6 +188,7 @@ class HaltPlan(JobResult):
             "global_torque_k0_Nm": res.global_torque_k0,
             "reduction": None if math.isnan(res.reduction) else res.reduction,
             "feasible": res.feasible,
+            "collision_free": self.collision_free,
             "violations": [_violation(v) for v in res.violations],
             "violations_k0": [_violation(v) for v in res.violations_k0],
             "k_interval_deg": res.k_interval / scale,
@@ -198,6 +216,9 @@ class HaltPlan(JobResult):
             "smallest_margin": (binding := self.binding_limit())[1],
             "binding_limit": binding[0],
             "actuators": None if (loads := self.actuator_loads()) is None else loads.to_dict(),
+            "clearance": None
+            if (clear := self._clearance_dict()) is None
+            else {**clear, "verdict": next(iter(self._collision_line()), None)},
             "torque_limit_Nm": _none_for_inf(self.limits.torque),
             "brake_limit_Nm": _none_for_inf(self.limits.brake),
             "torque_limit_source": list(self.limits.torque_source),
@@ -232,6 +253,72 @@ class HaltPlan(JobResult):
     def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]]:
         """The halt to animate (:func:`~jointlock.jobs._motions.halt_motions`)."""
         return halt_motions(self)
+
+    def clearance(self) -> Clearance | None:
+        """Clearance of the halt motion (:func:`jointlock.clearance.clearance`) on the
+        constraint grid (``n_check`` samples, the halt configuration last); None for a model
+        without collision shapes.  ``distance`` (n_check,) [m]; negative: the arm overlaps the
+        spacecraft bus or itself."""
+        p = self.problem
+        settings = self.clearance_settings
+        if not collision_pairs(p.model, settings.keep_out).names:
+            return None
+        q, _, _ = self.motion.trajectory(p.times(p.n_check))
+        return clearance(p.model, q, keep_out=settings.keep_out, margin=settings.margin)
+
+    def _clearance_dict(self) -> dict[str, Any] | None:
+        return cached_on(self, "clearance_dict", self._compute_clearance_dict)
+
+    def _compute_clearance_dict(self) -> dict[str, Any] | None:
+        motion = self.clearance()
+        if motion is None:
+            return None
+        t = self.problem.times(self.problem.n_check)
+        worst = motion.worst()
+        start = motion.pair_distance[0]
+        # a pair already closer than required at the failure may not come closer still
+        floor = np.minimum(self.clearance_settings.margin, start)
+        shortfall = floor - motion.pair_distance  # (n_check, P): > 0 where the halt makes it worse
+        first = int(np.argmin(start)) if start.size else 0
+        return {
+            "halt_configuration_m": float(motion.distance[-1]),
+            "halt_configuration_pair": motion.pair_at((motion.distance.size - 1,)),
+            "start_m": float(motion.distance[0]),
+            "start_pair": motion.names[first] if motion.names else "",
+            "motion_min_m": float(motion.distance[worst]),
+            "motion_min_pair": motion.pair_at(worst),
+            "motion_min_time_s": float(t[worst]),
+            "required_m": self.clearance_settings.min_m,
+            "collides": bool(np.any(shortfall > 0)),
+            "worst_shortfall_m": float(max(shortfall.max(), 0.0)) if shortfall.size else 0.0,
+            "samples": int(motion.distance.size),
+            "ignored_pairs": list(motion.ignored),
+        }
+
+    def _collision_line(self) -> list[str]:
+        """The first line of the summary when the halt comes closer than required."""
+        data = self._clearance_dict()
+        margin = self.clearance_settings.margin
+        if data is None or (not data["collides"] and data["start_m"] >= margin):
+            return []
+
+        def reach(d: float) -> str:
+            return f"{-d:.3f} m into" if d < 0 else f"within {d:.3f} m of"
+
+        head = "COLLIDES" if data["collides"] else "CLEARANCE"
+        text = f"{head}: "
+        if data["start_m"] < margin:
+            text += (
+                f"the state at failure already reaches {reach(data['start_m'])} {data['start_pair']} (required "
+                f"{margin:g} m: check the state, or the collision geometry: {self.problem.model.name}'s is "
+                "documented with its factory); "
+            )
+        if data["collides"]:
+            text += f"the halt reaches {reach(data['motion_min_m'])} {data['motion_min_pair']} at t = {data['motion_min_time_s']:.3g} s"
+        else:
+            text += "the halt comes no closer"
+        text += f"; the halt configuration keeps {data['halt_configuration_m']:+.3f} m ({data['halt_configuration_pair']})"
+        return [text]
 
     def actuator_loads(self) -> ActuatorLoads | None:
         """Motor torques of the healthy joints and brake torques of the locked joints over the
@@ -321,7 +408,7 @@ class HaltPlan(JobResult):
         """The lines ``jointlock halt`` prints."""
         res, p = self.motion, self.problem
         nums = list(p.model.joint_numbers)
-        lines = [
+        lines = self._collision_line() + [
             f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
             f"base torque with {p.base} base about {MOMENT_TEXT[p.moment_about]}",
             f"halt configuration ({self.qf_source}): "

@@ -15,16 +15,18 @@ from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
 from ...bounds import as_real
+from ...clearance import ClearanceSettings, collision_pairs
+from ...clearance import clearance as clearance_of
 from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
-from ...model import ArmModel
+from ...model import ArmModel, as_joint_array
 from ...papers import p000
 from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
 from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
 from ...progress import Progress
 from ...robots import UrdfChain, load_robot
-from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_locks
+from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_clearance, scenario_locks
 from ._checks import (
     LIBRARY_NAMES,
     SCENARIO_NAMES,
@@ -100,6 +102,7 @@ def _search_halt_configuration(
     reachable: bool,
     per_joint: bool,
     progress: bool,
+    clearance: ClearanceSettings,
 ) -> tuple[HaltConfiguration, str | None]:
     """000's HCOM on J_F among the configurations the halt reaches (unless ``reachable`` is
     False), falling back to the whole ranges when none is; returns it and the reachability
@@ -113,8 +116,9 @@ def _search_halt_configuration(
     bar = Progress(samples, "halt configuration", enabled=None if progress else False)
     try:
         hc = optimal_halt_configuration(
-            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar, reachability=reach
-        )
+            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar, reachability=reach,
+            clearance_min_m=clearance.min_m, keep_out=clearance.keep_out,
+        )  # fmt: skip
     except InfeasibleError as exc:
         if reach is None:
             raise
@@ -122,8 +126,9 @@ def _search_halt_configuration(
         bar.close()
         bar = Progress(samples, "halt configuration", enabled=None if progress else False)
         hc = optimal_halt_configuration(
-            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar
-        )
+            model, samples=samples, rng=seed, jacobian=HCOM_JACOBIAN, progress=bar,
+            clearance_min_m=clearance.min_m, keep_out=clearance.keep_out,
+        )  # fmt: skip
     bar.close()
     if reach is not None and hc.reachability is not None:
         note = (
@@ -202,6 +207,7 @@ def plan_halt(
     margin: float = 0.0,
     objective: str = "mean_torque",
     prefer_margin: float = 0.0,
+    clearance: ClearanceSettings | None = None,
     _names: Mapping[str, Any] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -275,6 +281,13 @@ def plan_halt(
     state_source
         Where ``state`` comes from, in words, recorded in the result and printed with it
         (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
+    clearance
+        Beyond 000 (issue 27): the clearance required between the arm's links, its spacecraft
+        bus and keep-out volumes (:class:`~jointlock.clearance.ClearanceSettings`; default: no
+        overlap, 0 m).  The search excludes configurations closer than that; a given ``qf``
+        closer than that is refused; a halt motion that comes closer is not feasible and says
+        which pair, when and by how much.  ``ClearanceSettings.off()``: reported only (000's
+        way; ``paper_qf`` is 000's configuration and is only reported).
 
     Raises
     ------
@@ -285,6 +298,9 @@ def plan_halt(
         ``reachable=False``) nothing sampled satisfies the search's constraints.
     """
     ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
+    clearance = clearance if clearance is not None else ClearanceSettings()
+    if not isinstance(clearance, ClearanceSettings):
+        raise ScenarioError(f"clearance must be a ClearanceSettings; got {type(clearance).__name__}")
     check_halt_settings(T, n_samples, samples, solver, ga, _names)
     state_given = state is not None
     model, state, T, base, paper = _arm_state_and_time(robot, state, locks, T, base, _state_names)
@@ -312,6 +328,7 @@ def plan_halt(
     configuration, reach_note = None, None
     if qf is not None:
         qf_arr, qf_source = np.asarray(qf, dtype=float), _names["qf"]
+        _check_qf_clearance(model, qf_arr, clearance, _names["qf"])
     elif paper_qf:
         if not paper:
             raise ScenarioError(
@@ -327,7 +344,7 @@ def plan_halt(
             _check_start_margin(model, state, T, kept, margin, _names)
         configuration, reach_note = _search_halt_configuration(
             model, state, T, kept, samples=samples, seed=rng, reachable=reachable,
-            per_joint=solver == "vector", progress=progress,
+            per_joint=solver == "vector", progress=progress, clearance=clearance,
         )  # fmt: skip
         qf_arr = np.asarray(configuration.q_best, dtype=float)
         seed_text = "a numpy Generator" if isinstance(rng, np.random.Generator) else rng
@@ -357,7 +374,21 @@ def plan_halt(
         state_source=state_source,
         margin=margin,
         notes=notes,
+        clearance_settings=clearance,
     )
+
+
+def _check_qf_clearance(model: ArmModel, qf: np.ndarray, settings: ClearanceSettings, name: str) -> None:
+    """Refuse a given halt configuration closer than the clearance required (naming the pair)."""
+    if not settings.required or not collision_pairs(model, settings.keep_out).names:
+        return
+    result = clearance_of(model, as_joint_array(model, qf, name), keep_out=settings.keep_out)
+    if float(result.distance) < settings.margin:
+        raise ScenarioError(
+            f"{name}: the halt configuration keeps {float(result.distance):+.3f} m between {result.pair_at()} "
+            f"(clearance required: {settings.margin:g} m); choose another, or turn the requirement off "
+            "(limits.check_clearance = false, --no-clearance)"
+        )
 
 
 def halt_from_scenario(
@@ -406,5 +437,6 @@ def halt_from_scenario(
         margin=float(t["margin"]),
         objective=t["objective"],
         prefer_margin=float(t["prefer_margin"]),
+        clearance=scenario_clearance(data),
         _names=names,
     )

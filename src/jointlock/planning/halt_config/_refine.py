@@ -22,12 +22,15 @@ def _refine(
     lo: FloatArray,
     hi: FloatArray,
     reach: HaltReachability | None,
+    keeps_clear: Callable[[FloatArray], np.ndarray] | None = None,
 ) -> tuple[list[FloatArray], list[float], int]:
     """Maximise CP from each start (m, n) [rad] inside the box ``[lo, hi]``.
 
     ``exact(qs)`` gives CP (k,) and the indices of configurations (k, n) on the frozen scale.
     A refined point that leaves the reachable set (``reach``) is pulled back along the segment
-    from its start (reachable; the set is convex).
+    from its start (reachable; the set is convex).  With ``keeps_clear`` (configurations
+    (k, n) -> (k,) bool, the clearance constraint, whose set is not convex) a refined point is
+    pulled back to the last point of its straight path from the start that keeps clear.
 
     Returns
     -------
@@ -59,9 +62,22 @@ def _refine(
         if reach is not None and not reach.contains(x):
             x = _pull_back(reach, start, x)
             evaluations += 1
+        if keeps_clear is not None:
+            x = _pull_back_clear(keeps_clear, start, x)
         refined_q.append(x)
         refined_cp.append(float(exact(x)[0]))
     return refined_q, refined_cp, evaluations
+
+
+def _pull_back_clear(keeps_clear: Callable[[FloatArray], np.ndarray], start: FloatArray, x: FloatArray) -> FloatArray:
+    """The last point before the first that does not keep clear on the segment from ``start``
+    (clear) to ``x``, checked at 257 points in one batched call (``x`` itself when all are)."""
+    lam = np.linspace(0.0, 1.0, 257)
+    ok = keeps_clear(start + lam[:, None] * (x - start))
+    if ok.all():
+        return x
+    first_bad = int(np.argmin(ok))
+    return start + lam[max(first_bad - 1, 0)] * (x - start)
 
 
 def _pull_back(reach: HaltReachability, start: FloatArray, x: FloatArray, rounds: int = 3) -> FloatArray:

@@ -10,6 +10,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ...analysis.ability import INDEX_NAMES, AbilityModel, JacobianKind, KinematicIndices
+from ...clearance import Clearance
 from ...model import FloatArray
 from ._bound import ReachabilityBound
 from ._reachability import HaltReachability
@@ -98,6 +99,17 @@ class HaltConfiguration:
         How many samples are reachable (None without :class:`HaltReachability`).
     k_range
         Feasible shared ``k`` [rad/s^6] over the reachable set (shared-``k`` constraint only).
+    clearance_min_m
+        The clearance required of the halt configuration [m] (None: not required, 000's way).
+    colliding_samples
+        Samples excluded for coming closer than that (None when not required).
+    best_clearance
+        Clearance of :attr:`q_best` (:class:`jointlock.clearance.Clearance`), whenever the
+        model has collision shapes (None otherwise).
+
+    With ``clearance_min_m``, :attr:`reachable` marks the samples that are reachable *and*
+    keep the clearance (the admissible ones); ``reachable_samples`` still counts reachability
+    alone.
     """
 
     best: HaltCandidate
@@ -122,6 +134,9 @@ class HaltConfiguration:
     reachable: np.ndarray | None = field(default=None, repr=False)
     reachable_samples: int | None = None
     k_range: tuple[float, float] | None = None
+    clearance_min_m: float | None = None
+    colliding_samples: int | None = None
+    best_clearance: Clearance | None = field(default=None, repr=False)
 
     @property
     def q_best(self) -> FloatArray:
@@ -179,6 +194,16 @@ class HaltConfiguration:
             "lower_deg": np.degrees(self.lower).tolist(),
             "upper_deg": np.degrees(self.upper).tolist(),
             "reachability": self._reachability_dict(),
+            "clearance": self._clearance_dict(),
+        }
+
+    def _clearance_dict(self) -> dict[str, Any] | None:
+        if self.best_clearance is None:
+            return None
+        return {
+            "required_m": self.clearance_min_m,
+            "colliding_samples": self.colliding_samples,
+            "best": self.best_clearance.to_dict(),
         }
 
     def _reachability_dict(self) -> dict[str, Any] | None:

@@ -6,7 +6,7 @@ from __future__ import annotations
 
 import logging
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -22,10 +22,12 @@ from ...analysis.ability import (
     configuration_indices,
     fit_ability_model,
 )
+from ...clearance import clearance, collision_pairs
 from ...errors import ConfigurationError, InfeasibleError
 from ...forward import COMPILED_MIN_BATCH
 from ...model import ArmModel, FloatArray, as_joint_array
 from ...progress import Progress
+from ...shapes import Shape
 from ._bound import ReachabilityBound, _readonly
 from ._reachability import HaltReachability
 from ._refine import _refine
@@ -76,6 +78,8 @@ def optimal_halt_configuration(
     runner_up_separation: float = RUNNER_UP_SEPARATION,
     batch_size: int = DEFAULT_BATCH,
     progress: Progress | None = None,
+    clearance_min_m: float | None = None,
+    keep_out: Sequence[Shape] = (),
 ) -> HaltConfiguration:
     """Optimal halt configuration of an arm with locked joints (000 HCOM, eqs. 19-24).
 
@@ -125,6 +129,17 @@ def optimal_halt_configuration(
         Samples per batched evaluation.
     progress
         Optional progress bar (advanced per batch).
+    clearance_min_m
+        Beyond 000 (issue 27): the clearance a halt configuration must keep [m] between the
+        arm's links, its spacecraft bus and the ``keep_out`` volumes
+        (:func:`jointlock.clearance.clearance`).  Samples closer than that are excluded like
+        unreachable ones (they keep their CP in the fitted scale, but can be neither the best
+        nor the runner-up; counted in ``colliding_samples``), and a refined point that comes
+        closer is pulled back along its path from its start.  None (default, 000's search):
+        nothing is excluded; the best configuration's clearance is reported either way when the
+        model has collision shapes.
+    keep_out
+        Keep-out volumes, shapes in the root frame (:mod:`jointlock.shapes`).
 
     Returns
     -------
@@ -144,6 +159,10 @@ def optimal_halt_configuration(
         raise ConfigurationError(f"jacobian must be 'generalized' or 'fixed'; got {jacobian!r}")
     if int(refine_starts) < 1:
         raise ConfigurationError(f"refine_starts must be >= 1; got {refine_starts!r}")
+    if clearance_min_m is not None and not (
+        isinstance(clearance_min_m, (int, float)) and not isinstance(clearance_min_m, bool) and math.isfinite(clearance_min_m)
+    ):
+        raise ConfigurationError(f"clearance_min_m must be a finite number [m] or None; got {clearance_min_m!r}")
     generator, seed = resolve_rng(rng)
     lo, hi, reachability, k_range = _search_box(model_locked, lower, upper, reachability)
     exact_reach = reachability if isinstance(reachability, HaltReachability) else None
@@ -159,6 +178,20 @@ def optimal_halt_configuration(
             f"reachable configurations exist in the box [{', '.join(f'{v:.4g}' for v in np.degrees(lo))}] .. "
             f"[{', '.join(f'{v:.4g}' for v in np.degrees(hi))}] deg (a thin set): increase samples or T"
         )
+    n_reachable = None if reachable is None else int(np.count_nonzero(reachable))
+    checked = bool(collision_pairs(model_locked, keep_out).names)
+    clear = None
+    if clearance_min_m is not None and checked:
+        margin = float(clearance_min_m)
+        clear = clearance(model_locked, q, keep_out=keep_out).distance >= margin
+        admissible = clear if reachable is None else clear & reachable
+        if not admissible.any():
+            raise InfeasibleError(
+                f"none of the {k} samples keeps a clearance of {margin:g} m"
+                + ("" if reachable is None else f" among the {int(reachable.sum())} reachable")
+                + " (links, spacecraft bus, keep-outs): lower clearance_min_m, widen the ranges or raise samples"
+            )
+        reachable = admissible
     ind = configuration_indices(
         model_locked,
         q,
@@ -188,7 +221,13 @@ def optimal_halt_configuration(
     evaluations = 0
     if refine:
         starts = q[order[: min(int(refine_starts), n_ok)]]
-        refined_q, refined_cp, evaluations = _refine(exact, starts, lo, hi, exact_reach)
+
+        def keeps_clear(qs: FloatArray) -> np.ndarray:
+            return clearance(model_locked, qs, keep_out=keep_out).distance >= float(clearance_min_m)  # type: ignore[arg-type]
+
+        refined_q, refined_cp, evaluations = _refine(
+            exact, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None
+        )
     best = best_sample
     if refined_cp and max(refined_cp) > best_sample.cp:
         j = int(np.argmax(refined_cp))
@@ -207,6 +246,8 @@ def optimal_halt_configuration(
     cp.setflags(write=False)
     if reachable is not None:
         reachable.setflags(write=False)
+    if clear is not None:
+        clear.setflags(write=False)
     return HaltConfiguration(
         best=best,
         best_sample=best_sample,
@@ -228,8 +269,13 @@ def optimal_halt_configuration(
         indices_samples=ind,
         refine_evaluations=evaluations,
         reachable=reachable,
-        reachable_samples=None if reachable is None else n_ok,
+        reachable_samples=n_reachable,
         k_range=k_range,
+        clearance_min_m=None if clear is None else float(clearance_min_m),  # type: ignore[arg-type]
+        colliding_samples=None if clear is None else int(k - np.count_nonzero(clear)),
+        best_clearance=clearance(model_locked, best.q, keep_out=keep_out, margin=max(float(clearance_min_m or 0.0), 0.0))
+        if checked
+        else None,
     )
 
 
