@@ -251,3 +251,140 @@ def test_pinocchio_geometry_model_compute_distances_equals_clearance():
             pin.computeDistances(pm, data, geom, gdata, pin_q(pm, q[n], False))
             theirs = [r.min_distance for r in gdata.distanceResults]
             assert np.allclose(ours.pair_distance[n], theirs, atol=1e-6), name
+
+
+#: Issue 27's known colliding halt7 configuration (joint 4 at 0): the boom crosses the bus.
+KNOWN_COLLIDING_DEG = [-174.3, 114.8, 161.0, -173.0, -22.2, -58.4]
+
+
+def test_the_search_excludes_configurations_closer_than_required_and_refines_within():
+    from jointlock.planning.halt_config import optimal_halt_configuration
+
+    arm = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
+    assert clearance(arm, np.radians(KNOWN_COLLIDING_DEG)).distance < 0
+    plain = optimal_halt_configuration(arm, samples=3000, rng=1)
+    kept = optimal_halt_configuration(arm, samples=3000, rng=1, clearance_min_m=0.05)
+    # the same samples; the admissible ones are exactly those keeping 0.05 m
+    assert np.array_equal(plain.q_samples, kept.q_samples)
+    assert np.array_equal(kept.reachable, clearance(arm, kept.q_samples).distance >= 0.05)
+    assert kept.colliding_samples == 3000 - int(kept.reachable.sum()) > 0.3 * 3000
+    assert plain.colliding_samples is None and plain.best_clearance is not None  # reported either way
+    for candidate in (kept.best, kept.best_sample, kept.runner_up):
+        assert clearance(arm, candidate.q).distance >= 0.05 - 1e-12
+    assert kept.best.cp >= kept.best_sample.cp
+    assert kept.to_dict()["clearance"]["colliding_samples"] == kept.colliding_samples
+    with pytest.raises(jl.InfeasibleError, match="keeps a clearance of 50 m"):
+        optimal_halt_configuration(arm, samples=200, rng=1, clearance_min_m=50.0)
+
+
+def test_a_given_halt_configuration_closer_than_required_is_refused_naming_the_pair():
+    arm = jl.load_robot("halt7", base="floating")
+    with pytest.raises(jl.ScenarioError, match=r"qf: the halt configuration keeps -\d\.\d{3} m between link3 - bus"):
+        jl.plan_halt("halt7", qf=np.radians(KNOWN_COLLIDING_DEG), n_samples=101)
+    # reported, not refused, when the clearance is not required
+    plan = jl.plan_halt("halt7", qf=np.radians(KNOWN_COLLIDING_DEG), n_samples=101, clearance=jl.ClearanceSettings.off())
+    data = plan.to_dict()["clearance"]
+    assert data["halt_configuration_m"] < 0 and data["halt_configuration_pair"] == "link3 - bus"
+    assert plan.collision_free is False and plan.summary()[0].startswith("COLLIDES")
+    del arm
+
+
+def test_the_cli_refuses_a_colliding_qf_in_one_line(capsys):
+    from jointlock.cli import main
+
+    cmd = ["halt", "halt7", "--qf-deg", *map(str, KNOWN_COLLIDING_DEG), "--n-samples", "101", "--quiet"]
+    assert main(cmd) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--qf-deg: the halt configuration keeps" in err[0] and "link3 - bus" in err[0]
+
+
+def test_000s_scenario_halts_clear_of_the_bus_and_says_where_it_starts():
+    """The demo's scenario (HCOM on J_F, halt torque with the spacecraft held): the halt
+    configuration keeps the 0.05 m required, and the halt comes no closer to the bus than 000's
+    state at failure, which is already 0.051 m into it under halt7's geometry (said first)."""
+    from jointlock.papers import p000
+
+    sc = p000.SCENARIO
+    plan = jl.plan_halt("halt7", samples=4000, n_samples=201)
+    motion = plan.clearance()
+    assert motion is not None and motion.distance[-1] >= 0.05 - 1e-9
+    assert motion.distance[0] == pytest.approx(-0.0510, abs=5e-4)
+    # collision free exactly when no pair comes closer than min(required, where it started)
+    floor = np.minimum(0.05, motion.pair_distance[0])
+    assert plan.collision_free == bool(np.all(motion.pair_distance >= floor))
+    data = plan.to_dict()["clearance"]
+    assert data["start_pair"] == "link3 - bus" and data["required_m"] == 0.05
+    assert plan.summary()[0].startswith(("CLEARANCE: the state at failure already reaches 0.051 m into link3 - bus",
+                                         "COLLIDES: the state at failure already reaches 0.051 m into link3 - bus"))
+    assert list(sc["q0_deg"]) == [-180.0, -180.0, -100.0, -10.0, 20.0, 20.0]
+
+
+def test_clearance_settings_are_checked_and_plain():
+    with pytest.raises(ConfigurationError, match="clearance min_m must be a finite clearance >= 0"):
+        jl.ClearanceSettings(min_m=-1.0)
+    with pytest.raises(ModelError, match=r"keep_out: shapes\[0\]"):
+        jl.ClearanceSettings(keep_out=[1.0])
+    assert jl.ClearanceSettings.off().to_dict() == {"min_m": None, "keep_out": []}
+    assert jl.ClearanceSettings().margin == 0.05 and not jl.ClearanceSettings.off().required
+
+
+def test_the_halt_motion_moves_k_to_keep_the_clearance():
+    """000's scenario with 2000 samples: the optimum over the limits alone (k* = 7.70e-4
+    deg/s^6) drives the boom 3 mm deeper into the bus than the state at failure; the halt keeps
+    to the stretch of k whose motions come no closer, and says so."""
+    from jointlock.planning.halt_motion import clear_k_segments, clearance_shortfall
+
+    off = jl.plan_halt("halt7", samples=2000, n_samples=101, clearance=jl.ClearanceSettings.off())
+    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    assert not np.allclose(off.problem.qf, kept.problem.qf)  # the search moved too
+    same_qf = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, clearance=jl.ClearanceSettings.off())
+    assert same_qf.collision_free is False  # the limits' optimum on this configuration comes closer
+    assert kept.collision_free is True and kept.feasible
+    assert any(note.startswith("k moved from 0.000770194 to") for note in kept.notes)
+    p = kept.problem
+    lo, hi = (float(v) for v in same_qf.motion.k_interval)
+    segments = clear_k_segments(p, lo, hi, 0.05)
+    assert any(a <= float(kept.motion.k) <= b for a, b in segments)
+    assert clearance_shortfall(p, np.asarray(float(kept.motion.k)), 0.05) <= 0
+    assert clearance_shortfall(p, np.asarray(float(same_qf.motion.k)), 0.05) > 0
+    # a boundary of a stretch is refined: just outside it the halt comes closer
+    a, b = segments[0]
+    width = hi - lo
+    outside = [x for x in (a - 1e-6 * width, b + 1e-6 * width) if lo <= x <= hi]
+    assert outside and np.all(clearance_shortfall(p, np.asarray(outside), 0.05) > 0)
+
+
+def test_dh_tables_and_model_files_carry_link_radii_and_a_bus(tmp_path):
+    one = jl.from_dh("r", a=[0.0, 1.0, 1.0], alpha=[0.0, 0.0, 0.0], d=[0.3, 0.0, 0.0], convention="modified", radius=0.05)
+    assert [s.radius for s in one.root_body.shapes] == [0.05]
+    assert [[s.radius for s in b.shapes] for b in one.bodies] == [[0.05], [0.05], [0.05]]
+    rows = jl.from_dh(
+        "r", a=[0.0, 1.0, 1.0, 0.5], alpha=[0.0] * 4, d=[0.3, 0.0, 0.0, 0.0], convention="modified",
+        radius=[0.1, 0.2, 0.3, 0.4], prismatic=[False, False, True, False],
+    )  # fmt: skip
+    # row 3 is held (prismatic): its link is merged into link 2, so its radius is not used
+    assert [[s.radius for s in b.shapes] for b in rows.bodies] == [[0.1], [0.2], [0.4]]
+    with pytest.raises(ModelError, match="radius must be a length"):
+        jl.from_dh("r", a=[0.0], alpha=[0.0], d=[0.0], convention="modified", radius="thick")
+    with pytest.raises(ModelError, match=r"radius must be lengths in \[0"):
+        jl.from_dh("r", a=[0.0], alpha=[0.0], d=[0.0], convention="modified", radius=-1.0)
+    path = tmp_path / "arm.toml"
+    path.write_text(
+        'name = "boxed"\nconvention = "dh_modified"\n'
+        "[[joint]]\nd_m = 0.5\nradius_m = 0.1\n"
+        "[[joint]]\nalpha_deg = 90.0\nradius_m = 0.1\n"
+        "[[joint]]\na_m = 2.0\nradius_m = 0.1\n"
+        "[base]\nmass_kg = 500.0\ncom_m = [0.0, 0.0, -0.6]\ninertia_kgm2 = [100.0, 100.0, 100.0]\nbox_m = [1.0, 1.0, 1.0]\n"
+    )
+    for base in ("fixed", "floating"):
+        arm = jl.load_robot(str(path), base=base)
+        assert [s.name for s in arm.root_body.shapes] == ["post", "bus"]
+        # the 2 m link 2 level with the shoulder at q = 0 (0.6 m above the bus top, 0.1 m
+        # radius), turned down through it by joint 2
+        assert clearance(arm, [0.0, 0.0, 0.0]).distance == pytest.approx(0.6 - 0.1, abs=1e-12)
+        down = [clearance(arm, [0.0, side * math.pi / 2, 0.0]) for side in (1, -1)]
+        assert min(float(c.distance) for c in down) < 0
+        assert all(c.pair_at().endswith(" - bus") for c in down if c.distance < 0)
+    path.write_text(path.read_text().replace("box_m = [1.0, 1.0, 1.0]", "box_m = [1.0, 0.0, 1.0]"))
+    with pytest.raises(ModelError, match=r"\[base\]: field 'box_m' must be 3 side lengths > 0"):
+        jl.load_robot(str(path))

@@ -259,3 +259,35 @@ def bisect_root(
         xtol=xtol,
     )
     return 0.5 * (br.false_end + br.true_end)
+
+
+def true_segments(
+    predicate: Callable[[FloatArray], ArrayLike], lo: float, hi: float, n_scan: int, rtol: float
+) -> list[tuple[float, float]]:
+    """The stretches of ``[lo, hi]`` where a batched 1-D ``predicate`` (points (m,) -> bool (m,))
+    holds: a scan of ``n_scan`` points, each True/False boundary between neighbours bisected
+    (all at once, :func:`bisect_boundary`) to ``rtol`` of the width, the refined end kept on the
+    True side.  A stretch narrower than the scan's step can be missed."""
+    grid = np.linspace(lo, hi, max(n_scan, 2)) if hi > lo else np.array([lo])
+    ok = np.asarray(predicate(grid), dtype=bool)
+    if not ok.any():
+        return []
+    change = np.flatnonzero(ok[1:] != ok[:-1])  # a boundary between grid[c] and grid[c + 1]
+    refined: dict[int, float] = {}  # c -> the boundary, on its True side
+    if change.size:
+        true_side = np.where(ok[change], grid[change], grid[change + 1])
+        false_side = np.where(ok[change], grid[change + 1], grid[change])
+        ends = bisect_boundary(predicate, false_side, true_side, xtol=rtol * max(hi - lo, 1e-300)).true_end
+        refined = {int(c): float(end) for c, end in zip(change, np.atleast_1d(ends))}
+    segments = []
+    i = 0
+    while i < grid.size:
+        if ok[i]:
+            first = i
+            while i + 1 < grid.size and ok[i + 1]:
+                i += 1
+            a = refined[first - 1] if first > 0 else float(grid[first])
+            b = refined[i] if i + 1 < grid.size else float(grid[i])
+            segments.append((a, b))
+        i += 1
+    return segments

@@ -24,8 +24,9 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .bounds import shown
+from .bounds import MAX_LENGTH_M, shown
 from .errors import ModelError
+from .geometry import with_link_capsules
 from .model import ArmModel, Body, Joint
 from .spatial import rot_x, rot_z, translation
 
@@ -67,6 +68,7 @@ def from_dh(
     base: ArrayLike | None = None,
     flip: Sequence[bool] | None = None,
     prismatic: Sequence[bool] | None = None,
+    radius: float | Sequence[float] | None = None,
 ) -> ArmModel:
     """Build an arm from a DH table.
 
@@ -107,6 +109,11 @@ def from_dh(
         is.  Its limits, if given, are ignored.  The model has one joint fewer, numbered
         1..m along the chain, each named after its table row (a prismatic row 3 of 6: joints
         1-5 named ``joint1, joint2, joint4, joint5, joint6``).  All False when omitted.
+    radius
+        Collision geometry (issue 27): one radius [m], or (n,) one per row, of a capsule along
+        each link of the stick figure (:func:`jointlock.geometry.with_link_capsules`; the root
+        post takes row 1's radius; a prismatic row's link is merged into the one before, so its
+        radius is not used; 0: no shape).  None (default): no shapes.
     """
     if convention not in ("standard", "modified"):
         raise ModelError(f"convention must be 'standard' or 'modified'; got {shown(convention)}")
@@ -209,7 +216,7 @@ def from_dh(
         )
         for k, i in enumerate(kept)
     )
-    return ArmModel(
+    model = ArmModel(
         name=name,
         joints=joints,
         bodies=tuple(frame_bodies[i] for i in kept),
@@ -218,3 +225,12 @@ def from_dh(
         floating=spacecraft is not None,
         description=description,
     )
+    if radius is None:
+        return model
+    try:
+        radii = np.full(n, float(radius)) if np.ndim(radius) == 0 else _column(radius, n, "radius")  # type: ignore[arg-type]
+    except (TypeError, ValueError):
+        raise ModelError(f"radius must be a length [m] or {n} lengths, one per row; got {shown(radius)}") from None
+    if not np.all(np.isfinite(radii)) or np.any(radii < 0) or np.any(radii > MAX_LENGTH_M):
+        raise ModelError(f"radius must be lengths in [0, {MAX_LENGTH_M:g}] m; got {shown(np.asarray(radius).tolist())}")
+    return with_link_capsules(model, [float(radii[kept[0]])] + [float(radii[i]) for i in kept])

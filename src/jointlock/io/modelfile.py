@@ -20,6 +20,7 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     inertia_kgm2 = [0.89, 0.05, 0.89]   # [Ixx, Iyy, Izz], 6 values or 3x3
     flip = false                        # optional: true = turns about -z (theta - q)
     prismatic = false                   # optional: true = slides along z, held at d_m
+    radius_m = 0.1                      # optional: a collision capsule along the link (0: none)
 
     [tool]                              # optional: end effector in the last DH frame
     xyz_m = [0.0, 0.0, 0.1]
@@ -33,6 +34,8 @@ Units are in the field names (``_m``, ``_deg``, ``_kg``, ``_kgm2``, ``_deg_s``):
     mass_kg = 1000.0
     com_m = [0.0, 0.0, -1.0]            # in the root frame (DH frame 0)
     inertia_kgm2 = [667.0, 667.0, 667.0]
+    box_m = [2.0, 2.0, 2.0]             # optional: the bus, a box of these sides centred on
+                                        # com_m (root-frame axes); kept with a fixed base too
 
 Or the chain of a URDF tree (:func:`jointlock.read_urdf`), which every command then takes as
 ``ROBOT``::
@@ -62,8 +65,10 @@ import numpy as np
 from ..bounds import MAX_LENGTH_M, MAX_OPTION_DEG, as_real, shown
 from ..dh import from_dh
 from ..errors import ModelError
+from ..geometry import with_root_shapes
 from ..model import ArmModel, Body
-from ..spatial import pose, rpy_matrix
+from ..shapes import Box
+from ..spatial import pose, rpy_matrix, translation
 from .files import read_toml_file, shorten
 
 _TOP_KEYS = {"name", "convention", "description", "joint", "tool", "base", "mount"}
@@ -82,9 +87,10 @@ _JOINT_KEYS = {
     "name",
     "flip",
     "prismatic",
+    "radius_m",
 }
 _TOOL_KEYS = {"xyz_m", "rpy_deg"}
-_BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2"}
+_BASE_KEYS = {"mass_kg", "com_m", "inertia_kgm2", "box_m"}
 _CONVENTIONS = {"dh_modified": "modified", "dh_standard": "standard"}
 
 
@@ -170,6 +176,7 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
     bodies = []
     flips: list[bool] = []
     slides: list[bool] = []
+    radii: list[float] = []
     for i, row in enumerate(rows, start=1):
         jw = f"{where}: joint {i}"
         if not isinstance(row, dict):
@@ -202,8 +209,12 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
         if not isinstance(slide, bool):
             raise ModelError(f"{jw}: field 'prismatic' must be true or false; got {shown(slide)}")
         slides.append(slide)
+        radii.append(_num(row, "radius_m", jw, 0.0))
+        if radii[-1] < 0:
+            raise ModelError(f"{jw}: field 'radius_m' must be >= 0 [m] (0: no collision shape); got {radii[-1]}")
     tool, mount = _pose_table(data, "tool", where), _pose_table(data, "mount", where)
     spacecraft = None
+    bus: Box | None = None
     if "base" in data:
         bw = f"{where}: [base]"
         if not isinstance(data["base"], dict):
@@ -214,11 +225,16 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
             raise ModelError(
                 f"{bw}: field 'mass_kg' must be > 0 for a free-floating base; got {spacecraft.mass}"
             )
+        if "box_m" in data["base"]:
+            sides = _array(data["base"], "box_m", bw, None)
+            if sides.shape != (3,) or np.any(sides <= 0):
+                raise ModelError(f"{bw}: field 'box_m' must be 3 side lengths > 0 [m]; got {shown(data['base']['box_m'])}")
+            bus = Box(translation(spacecraft.com), sides / 2, name="bus")
     name = data.get("name", "toml-arm")
     if not isinstance(name, str):
         raise ModelError(f"{where}: field 'name' must be a string; got {shown(name)}")
     try:
-        return from_dh(
+        model = from_dh(
             name,
             a=cols["a"],
             alpha=cols["alpha"],
@@ -236,9 +252,11 @@ def model_from_dict(data: dict[str, Any], where: str = "model", folder: str | Pa
             base=mount,
             flip=flips,
             prismatic=slides,
+            radius=radii if any(radii) else None,
         )
     except ModelError as exc:  # e.g. a joint's limits: named with the file
         raise ModelError(f"{where}: {exc}") from None
+    return model if bus is None else with_root_shapes(model, [bus])
 
 
 def read_model_toml(path: str | Path) -> ArmModel:

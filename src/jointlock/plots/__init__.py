@@ -18,7 +18,13 @@ from .arm import arm_figure, draw_arm, plot_arm, set_equal_3d
 
 #: Figure functions of each job's module (imported on first use).
 _FUNCTIONS: dict[str, tuple[str, ...]] = {
-    "halt": ("global_torque_curve", "plot_global_torque_vs_k", "plot_joint_profiles", "plot_base_torque_vs_time"),
+    "halt": (
+        "global_torque_curve",
+        "plot_global_torque_vs_k",
+        "plot_joint_profiles",
+        "plot_base_torque_vs_time",
+        "plot_clearance",
+    ),
     "halt_config": ("plot_section", "section_figures"),
     "jump": (
         "plot_objective_vs_kappa",

@@ -206,3 +206,30 @@ def plot_actuator_loads(
     axes[-1].set_xlabel("t [s]")
     axes[0].set_title(f"actuator torques over the motion ({loads.base} base; dashed: limits)", fontsize=9)
     return fig
+
+
+def plot_clearance(clearance: Any, t: Any, *, margin: float = 0.0, ax: Any | None = None, pairs: int = 3) -> Any:
+    """Clearance over a motion (:class:`~jointlock.clearance.Clearance` of (n_t,) samples at
+    times ``t`` [s]): the smallest over every checked pair (thick), the ``pairs`` pairs that
+    come closest (thin), the clearance required (dashed) and contact (0 m, dotted).  Returns
+    the axis."""
+    ax = new_axes(ax, (7, 4))
+    t = np.asarray(t, dtype=float)
+    ax.plot(t, clearance.distance, lw=2.2, color="k", label="smallest")
+    order: Any = np.argsort(clearance.pair_distance.min(axis=0))[:pairs] if clearance.names else []
+    for p in order:
+        ax.plot(t, clearance.pair_distance[:, p], lw=1.0, label=clearance.names[p])
+    if margin > 0:
+        ax.axhline(margin, color="tab:red", ls="--", lw=1.0, label=f"required {margin:g} m")
+    ax.axhline(0.0, color="tab:red", ls=":", lw=1.0)
+    at = int(np.argmin(clearance.distance)) if clearance.distance.size else 0
+    worst = float(clearance.distance[at]) if clearance.distance.size else math.inf
+    ax.set_xlabel("t [s]")
+    ax.set_ylabel("clearance [m] (< 0: overlap)")
+    ax.set_title(
+        f"clearance over the halt: smallest {worst:+.3f} m ({clearance.pair_at((at,)) if clearance.names else 'no pair'}, "
+        f"t = {t[at]:.3g} s)",
+        fontsize=9,
+    )
+    ax.legend(fontsize=7)
+    return ax

@@ -41,6 +41,7 @@ from ...plots.halt import (
     k_text,
     plot_actuator_loads,
     plot_base_torque_vs_time,
+    plot_clearance,
     plot_global_torque_vs_k,
     plot_joint_profiles,
     plot_spacecraft_response,
@@ -553,6 +554,12 @@ class HaltPlan(JobResult):
             figures += (
                 ("spacecraft_attitude.png", (7, 4), lambda fig: plot_spacecraft_response(sc, fig=fig)),
             )
+        clear = self.clearance()
+        if clear is not None:
+            figures += (
+                ("clearance.png", (7, 4), lambda fig: plot_clearance(
+                    clear, p.times(p.n_check), margin=self.clearance_settings.margin, ax=fig.add_subplot())),
+            )  # fmt: skip
         written = []
         for name, size, draw in figures:
             fig = offscreen_figure(size)
@@ -574,6 +581,11 @@ class HaltPlan(JobResult):
         if loads is not None:
             atomic_write_text(out / "actuators.csv", csv_text({"t_s": loads.t, **loads.columns()}))
             files.append("actuators.csv")
+        if clear is not None:
+            columns = {"t_s": p.times(p.n_check), "clearance_m": clear.distance}
+            columns.update({f"{name}_m": clear.pair_distance[:, i] for i, name in enumerate(clear.names)})
+            atomic_write_text(out / "clearance.csv", csv_text(columns))
+            files.append("clearance.csv")
         if sc is not None:
             cols = {"t_s": sc.t, "attitude_change_deg": sc.attitude_change_deg}
             cols.update({f"q_{c}": sc.attitude[:, i] for i, c in enumerate("wxyz")})

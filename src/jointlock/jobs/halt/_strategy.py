@@ -23,7 +23,14 @@ from ...model import ArmModel, as_joint_array
 from ...papers import p000
 from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
-from ...planning.halt_motion import HaltProblem, MomentAbout, optimal_halt_motion
+from ...planning.halt_motion import (
+    HaltMotion,
+    HaltProblem,
+    MomentAbout,
+    clear_k_segments,
+    clearance_shortfall,
+    optimal_halt_motion,
+)
 from ...progress import Progress
 from ...robots import UrdfChain, load_robot
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_clearance, scenario_locks
@@ -355,12 +362,17 @@ def plan_halt(
         objective=objective,
     )  # fmt: skip
     bar = Progress(ga.n_gen, "GA generations", enabled=None if progress else False) if solver == "ga" else None
-    motion = optimal_halt_motion(
-        problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar,
-        prefer_margin=prefer_margin,
-    )  # fmt: skip
+    def solve(k_bounds: tuple[float, float] | None = None) -> HaltMotion:
+        return optimal_halt_motion(
+            problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar,
+            prefer_margin=prefer_margin, k_bounds=k_bounds,
+        )  # fmt: skip
+
+    motion = solve()
     if bar is not None:
         bar.close()
+    motion, clear_note = _keep_clear(motion, clearance, solve)
+    notes += clear_note
     return HaltPlan(
         motion=motion,
         limits=limits,
@@ -375,6 +387,41 @@ def plan_halt(
         margin=margin,
         notes=notes,
         clearance_settings=clearance,
+    )
+
+
+def _keep_clear(
+    motion: HaltMotion, settings: ClearanceSettings, solve: Any
+) -> tuple[HaltMotion, tuple[str, ...]]:
+    """The halt motion keeping the clearance required (issue 27): the optimum when its halt
+    keeps it; else the best optimum over the stretches of the feasible ``k`` whose halts keep
+    it (:func:`~jointlock.planning.halt_motion.clear_k_segments`, each solved with
+    ``k_bounds``); else the optimum as it is (reported as colliding).  Shared ``k`` (solver
+    "scan" or "ga") only; returns the motion and a note."""
+    problem = motion.problem
+    if (
+        not settings.required
+        or not motion.feasible
+        or motion.per_joint
+        or not collision_pairs(problem.model, settings.keep_out).names
+    ):
+        return motion, ()
+    margin, keep_out = settings.margin, settings.keep_out
+    if clearance_shortfall(problem, np.asarray(float(motion.k)), margin, keep_out) <= 0:
+        return motion, ()
+    lo, hi = (float(v) for v in motion.k_interval)
+    scale = math.pi / 180.0  # deg/s^6
+    candidates = [solve(segment) for segment in clear_k_segments(problem, lo, hi, margin, keep_out)]
+    candidates = [m for m in candidates if m.feasible]
+    if not candidates:
+        return motion, (
+            f"no k in the feasible [{lo / scale:.6g}, {hi / scale:.6g}] deg/s^6 gives a halt that keeps the "
+            f"clearance ({margin:g} m): the halt below is the optimum over the limits alone",
+        )
+    best = min(candidates, key=lambda m: m.objective_value)
+    return best, (
+        f"k moved from {float(motion.k) / scale:.6g} to {float(best.k) / scale:.6g} deg/s^6 to keep the clearance "
+        f"({margin:g} m): the halt at the optimum over the limits alone came closer",
     )
 
 

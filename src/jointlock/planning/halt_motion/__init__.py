@@ -47,6 +47,7 @@ from ._batch_feasibility import (
     _upper_envelope,
     feasible_k_interval_batch,
 )
+from ._clearance_limits import clear_k_segments, clearance_shortfall
 from ._constants import (
     CHUNK_SAMPLES,
     K_UNIT_SCALE,
@@ -93,6 +94,8 @@ __all__ = [
     "Solver",
     "Violation",
     "base_torque_history",
+    "clear_k_segments",
+    "clearance_shortfall",
     "constraint_violations",
     "feasible_k_interval_batch",
     "feasible_k_intervals",

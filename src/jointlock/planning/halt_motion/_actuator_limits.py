@@ -20,7 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._search1d import bisect_boundary
+from ..._search1d import bisect_boundary, true_segments
 from ...analysis.actuators import actuator_torques
 from ...model import FloatArray
 from ._constants import CHUNK_SAMPLES, LIMIT_RTOL, LimitKind
@@ -71,31 +71,7 @@ def torque_feasible_segments(
     """The stretches of ``[lo, hi]`` [rad/s^6] whose halts keep every torque limit: a scan of
     ``n_scan`` points, each feasible/infeasible boundary bisected (batched) to
     :data:`BOUNDARY_RTOL` of the width, the refined end kept on the feasible side."""
-    grid = np.linspace(lo, hi, max(n_scan, 2)) if hi > lo else np.array([lo])
-    ok = _within(problem, grid)
-    if not ok.any():
-        return []
-    change = np.flatnonzero(ok[1:] != ok[:-1])  # a boundary between grid[c] and grid[c + 1]
-    refined: dict[int, float] = {}  # c -> the boundary, on its feasible side
-    if change.size:
-        true_side = np.where(ok[change], grid[change], grid[change + 1])
-        false_side = np.where(ok[change], grid[change + 1], grid[change])
-        ends = bisect_boundary(
-            lambda x: _within(problem, x), false_side, true_side, xtol=BOUNDARY_RTOL * max(hi - lo, 1e-300)
-        ).true_end
-        refined = {int(c): float(end) for c, end in zip(change, np.atleast_1d(ends))}
-    segments = []
-    i = 0
-    while i < grid.size:
-        if ok[i]:
-            first = i
-            while i + 1 < grid.size and ok[i + 1]:
-                i += 1
-            a = refined[first - 1] if first > 0 else float(grid[first])
-            b = refined[i] if i + 1 < grid.size else float(grid[i])
-            segments.append((a, b))
-        i += 1
-    return segments
+    return true_segments(lambda x: _within(problem, x), lo, hi, n_scan, BOUNDARY_RTOL)
 
 
 def torque_violations(problem: HaltProblem, k: float) -> tuple[Violation, ...]:
