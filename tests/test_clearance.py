@@ -388,3 +388,172 @@ def test_dh_tables_and_model_files_carry_link_radii_and_a_bus(tmp_path):
     path.write_text(path.read_text().replace("box_m = [1.0, 1.0, 1.0]", "box_m = [1.0, 0.0, 1.0]"))
     with pytest.raises(ModelError, match=r"\[base\]: field 'box_m' must be 3 side lengths > 0"):
         jl.load_robot(str(path))
+
+
+def test_the_3d_view_marks_the_deepest_overlap_frame_by_frame():
+    """000's halt starts with the boom 0.051 m into the bus (halt7's geometry): the animated
+    view's overlap trace joins the witness points on the first frame, names the pair, and is
+    empty once the arm is clear."""
+    from jointlock.plots.animation import animation_figure
+
+    plan = jl.plan_halt("halt7", samples=500, n_samples=101)
+    model, (motion,) = plan.arm_motions()
+    fig = animation_figure(model, motion, max_frames=30)
+    names = [d.get("name") for d in fig["data"]]
+    slot = names.index("overlap (deepest pair)")
+    first = fig["data"][slot]
+    assert len(first["x"]) == 2 and first["hovertext"][0].startswith("link3 - bus: 0.051 m overlap")
+    gap = np.linalg.norm(np.subtract([first["x"][1], first["y"][1], first["z"][1]], [first["x"][0], first["y"][0], first["z"][0]]))
+    assert gap == pytest.approx(0.051, abs=5e-4)
+    last = fig["frames"][-1]["data"][fig["frames"][-1]["traces"].index(slot)]
+    assert last["x"] == []  # the halt configuration keeps its clearance
+
+
+@pytest.mark.oracle
+def test_exported_urdf_collision_geometry_read_back_by_pinocchio_gives_the_same_distances(tmp_path):
+    """export-urdf writes each capsule as a cylinder and its two end spheres (URDF has no
+    capsule): Pinocchio's buildGeomFromUrdf + computeDistances on the file give, for every
+    separate pair of jointlock's, the same distance (the minimum over the parts' pairs); and
+    jointlock reads the file back to the same clearance."""
+    from pin_oracle import pin
+
+    from jointlock.io.urdf_export import write_urdf
+
+    arm = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
+    path = write_urdf(arm, tmp_path / "arm.urdf")
+    model = pin.buildModelFromUrdf(str(path))
+    geom = pin.buildGeomFromUrdf(model, str(path), pin.GeometryType.COLLISION)
+    # the parts of each of our shapes, in the order they were written (3 for a capsule)
+    parts: list[list[int]] = []
+    by_joint: dict[int, list[int]] = {}
+    for index, obj in enumerate(geom.geometryObjects):
+        by_joint.setdefault(obj.parentJoint, []).append(index)
+    pairs = collision_pairs(arm)
+    shapes = [(-1, s) for s in arm.root_body.shapes] + [(b, s) for b, body in enumerate(arm.bodies) for s in body.shapes]
+    cursor = {joint: 0 for joint in by_joint}
+    for body, shape in shapes:
+        joint = body + 1
+        count = 3 if isinstance(shape, Capsule) and shape.length > 0 else 1
+        parts.append(by_joint[joint][cursor[joint] : cursor[joint] + count])
+        cursor[joint] += count
+    assert all(cursor[j] == len(by_joint[j]) for j in by_joint)
+    capsule_index = [k for k, (_, s) in enumerate(shapes) if not isinstance(s, Box)]
+    box_index = [k for k, (_, s) in enumerate(shapes) if isinstance(s, Box)]
+    element_pairs = []
+    for kind, i, j in pairs.pairs:
+        a, b = parts[capsule_index[i]], parts[capsule_index[j] if kind == 0 else box_index[j]]
+        element_pairs.append([(x, y) for x in a for y in b])
+        for x, y in element_pairs[-1]:
+            geom.addCollisionPair(pin.CollisionPair(x, y))
+    index = {(p.first, p.second): k for k, p in enumerate(geom.collisionPairs)}
+    data, gdata = model.createData(), pin.GeometryData(geom)
+    q = np.random.default_rng(8).uniform(-np.pi, np.pi, (30, arm.dof))
+    ours = clearance(arm, q)
+    checked = 0
+    for n in range(q.shape[0]):
+        pin.computeDistances(model, data, geom, gdata, q[n])
+        results = gdata.distanceResults
+        for p, elems in enumerate(element_pairs):
+            if ours.pair_distance[n, p] > 0.01:  # separate: the union's distance is the capsule's
+                theirs = min(results[index[e]].min_distance for e in elems)
+                assert theirs == pytest.approx(ours.pair_distance[n, p], abs=1e-6)
+                checked += 1
+    assert checked > 500
+    # read back, the joints are numbered 1..n (the merged links 3 and 4 are one link 3, so link 5,
+    # now link 4, is adjacent to both): two pairs fewer, the others' distances the same
+    back = clearance(jl.read_urdf(path, base="floating"), q)
+    assert len(back.names) == len(ours.names) - 2
+    assert np.all(back.distance >= ours.distance - 1e-12)
+    assert np.mean(np.isclose(back.distance, ours.distance, rtol=0, atol=1e-12)) > 0.9
+    found = np.sort(back.pair_distance, axis=1)
+    assert all(np.all(np.isin(np.round(found[n], 9), np.round(ours.pair_distance[n], 9))) for n in range(q.shape[0]))
+
+
+@pytest.mark.oracle
+def test_panda_collision_urdf_equals_pinocchio_geometry_model():
+    """A real robot's collision geometry: example-robot-data's panda_collision.urdf (capsules
+    written as a cylinder and two end spheres, as URDF needs).  jointlock reads each as the
+    capsule; between every two links that jointlock checks and that are apart, the smallest
+    distance equals Pinocchio's GeometryModel (buildGeomFromUrdf + computeDistances over the
+    two links' elements)."""
+    from pin_oracle import pin
+    from robot_data import robot_file
+
+    path = robot_file("panda_description/urdf/panda_collision.urdf")
+    arm = jl.read_urdf(path, tip_link="panda_hand")
+    assert any(isinstance(s, Capsule) for b in arm.bodies for s in b.shapes)
+    ours_pairs = collision_pairs(arm)
+    full = pin.buildModelFromUrdf(str(path))
+    geom = pin.buildGeomFromUrdf(full, str(path), pin.GeometryType.COLLISION)
+    links = [obj.name.rsplit("_", 1)[0] for obj in geom.geometryObjects]
+    link_pairs = sorted({tuple(name.split(" - ")) for name in ours_pairs.names})
+    for a, b in link_pairs:
+        for x in [i for i, n in enumerate(links) if n == a]:
+            for y in [i for i, n in enumerate(links) if n == b]:
+                geom.addCollisionPair(pin.CollisionPair(x, y))
+    data, gdata = full.createData(), pin.GeometryData(geom)
+    for request in gdata.distanceRequests:  # coal's GJK to its tightest (default 1e-6 relative)
+        request.gjk_tolerance = 1e-12
+    q = np.random.default_rng(11).uniform(arm.lower, arm.upper, (25, arm.dof))
+    ours = clearance(arm, q)
+    checked = exact = 0
+    for n in range(q.shape[0]):
+        qq = pin.neutral(full)
+        qq[: arm.dof] = q[n]  # the arm's joints first; the fingers at 0, as read
+        pin.computeDistances(full, data, geom, gdata, qq)
+        theirs: dict[tuple[str, str], float] = {}
+        for pair, result in zip(geom.collisionPairs, gdata.distanceResults):
+            key = (links[pair.first], links[pair.second])
+            theirs[key] = min(theirs.get(key, np.inf), result.min_distance)
+        for a, b in link_pairs:
+            mine = min(d for name, d in zip(ours.names, ours.pair_distance[n]) if name == f"{a} - {b}")
+            if mine > 0.01:
+                # the same to GJK's tolerance, except where the file's cylinder is not quite
+                # between its spheres (the hand's, turned by rpy 1.57, not pi/2: 6e-5 m off), where
+                # jointlock's capsule envelope is closer, never farther
+                gap = theirs[(a, b)] - mine
+                assert -1e-6 <= gap <= 1e-4
+                exact += abs(gap) <= 1e-6
+                checked += 1
+    assert checked > 100 and exact > 0.7 * checked
+
+
+URDF_TWO_LINKS = """<robot name="probe">
+  <link name="base"><collision><origin xyz="0 0 -0.5"/><geometry><box size="1 1 1"/></geometry></collision></link>
+  <link name="arm">COLLISION</link>
+  <joint name="j1" type="revolute"><parent link="base"/><child link="arm"/><axis xyz="0 0 1"/>
+    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+</robot>"""
+
+
+@pytest.mark.parametrize(
+    ("collision", "error"),
+    [
+        ("<collision><geometry><cone radius='1'/></geometry></collision>", "<cone> is not a URDF geometry"),
+        ("<collision><origin xyz='0 0 1'/></collision>", "needs a <geometry>"),
+        ("<collision><geometry><sphere radius='-1'/></geometry></collision>", "radius must be finite, > 0"),
+        ("<collision><geometry><box size='1 1'/></geometry></collision>", "<box size>"),
+    ],
+)
+def test_urdf_collision_elements_are_refused_in_one_line(tmp_path, collision, error):
+    path = tmp_path / "probe.urdf"
+    path.write_text(URDF_TWO_LINKS.replace("COLLISION", collision))
+    with pytest.raises(ModelError, match=error) as info:
+        jl.read_urdf(path)
+    assert "link 'arm' <collision> 1" in str(info.value) and "\n" not in str(info.value)
+
+
+def test_urdf_collision_primitives_are_read_and_meshes_counted(tmp_path):
+    path = tmp_path / "probe.urdf"
+    path.write_text(
+        URDF_TWO_LINKS.replace(
+            "COLLISION",
+            "<collision><origin xyz='0 0 1'/><geometry><cylinder radius='0.1' length='2'/></geometry></collision>"
+            "<collision><geometry><mesh filename='arm.stl'/></geometry></collision>",
+        )
+    )
+    arm = jl.read_urdf(path)
+    (capsule,) = arm.bodies[0].shapes
+    assert isinstance(capsule, Capsule) and np.allclose([capsule.a, capsule.b], [[0, 0, 0], [0, 0, 2]])
+    assert [type(s).__name__ for s in arm.root_body.shapes] == ["Box"]
+    assert "1 <collision> mesh(es) not read" in arm.description

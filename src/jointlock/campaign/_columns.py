@@ -22,7 +22,11 @@ from ._spec import CampaignSpec
 
 #: Headline figures of each job, recorded when a campaign names no ``columns``.
 DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
-    "halt_config": ("halt_config.best.cp", "halt_config.refinement.gain"),
+    "halt_config": (
+        "halt_config.best.cp",
+        "halt_config.refinement.gain",
+        "halt_config.clearance.best.min_clearance_m",
+    ),
     "halt": (
         "halt.feasible",
         "halt.T_s",
@@ -34,6 +38,9 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
         "halt.violations|len",
         "halt.peak_velocity_deg_s|max",
         "halt.peak_acceleration_deg_s2|max",
+        "halt.collision_free",
+        "halt.clearance.motion_min_m",
+        "halt.clearance.halt_configuration_m",
     ),
     "jump": (
         "jump.kappa|mean",

@@ -12,6 +12,14 @@ model has revolute joints only), and so must a mimic joint on it (no coupled joi
 refused in one line naming it.  Planar and floating joints are left out above ``root_link``
 (a ``world`` link joined to the robot's base for a simulator: start the chain at the base) and
 refused below it.
+
+Collision geometry (issue 27): each link's ``<collision>`` primitives become its shapes
+(:mod:`jointlock.shapes`), merged with the link like its inertial: ``<sphere>`` and ``<box>`` as
+they are, ``<cylinder>`` as its capsule envelope (the cylinder with a half-ball on each end:
+conservative, a clearance is never overstated; a cylinder and the two spheres at its ends, as
+:func:`~jointlock.io.urdf_export.urdf_text` writes a capsule, read back as the capsule exactly).
+``<mesh>`` elements are not read (meshes are not supported yet); the model's description says
+how many were left out.
 """
 
 from __future__ import annotations
@@ -20,7 +28,7 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
 
@@ -29,6 +37,7 @@ import numpy as np
 from ..bounds import MAX_JOINT_VALUE, MAX_LENGTH_M, shown
 from ..errors import ModelError
 from ..model import ArmModel, Body, Joint
+from ..shapes import Box, Capsule, Shape, Sphere
 from ..spatial import pose, rpy_matrix
 from ._urdf_chain import Chain, select_chain
 from .files import check_path_text, decode_text, read_input_bytes, shorten
@@ -130,6 +139,59 @@ def _inertial(link: ET.Element, label: str) -> Body:
     except ModelError as exc:
         raise ModelError(f"{where}: {exc}") from None
     return body.transformed(frame)
+
+
+def _collisions(link: ET.Element, label: str) -> tuple[tuple[Shape, ...], int]:
+    """The link's ``<collision>`` primitives as shapes in its frame, and how many meshes were
+    left out (see the module)."""
+    name = link.get("name", "?")
+    shapes: list[Shape] = []
+    meshes = 0
+    for k, collision in enumerate(link.findall("collision")):
+        where = f"{label}: link {shorten(name, 40)!r} <collision> {k + 1}"
+        frame = _origin(collision.find("origin"), where)
+        geometry = collision.find("geometry")
+        element = None if geometry is None else next(iter(geometry), None)
+        if element is None:
+            raise ModelError(f"{where}: needs a <geometry> with a <box>, <cylinder>, <sphere> or <mesh>")
+        label_name = name  # pairs are named after links (a merged link's shapes keep its name)
+        try:
+            if element.tag == "sphere":
+                radius = _number(element, "radius", f"{where} <sphere>")
+                shapes.append(Sphere(frame[:3, 3], radius, name=label_name))
+            elif element.tag == "box":
+                size = _floats(element.get("size"), 3, f"{where} <box size>", [])
+                shapes.append(Box(frame, size / 2, name=label_name))
+            elif element.tag == "cylinder":
+                radius = _number(element, "radius", f"{where} <cylinder>")
+                half = _number(element, "length", f"{where} <cylinder>") / 2
+                ends = frame[:3, 3] + np.outer([-half, half], frame[:3, 2])
+                shapes.append(Capsule(ends[0], ends[1], radius, name=label_name))
+            elif element.tag == "mesh":
+                meshes += 1
+            else:
+                raise ModelError(
+                    f"{where}: <{shorten(element.tag, 40)}> is not a URDF geometry (box, cylinder, sphere, mesh)"
+                )
+        except ModelError as exc:
+            raise ModelError(f"{where}: {exc}" if not str(exc).startswith(label) else str(exc)) from None
+    return _without_contained_spheres(shapes), meshes
+
+
+def _without_contained_spheres(shapes: list[Shape]) -> tuple[Shape, ...]:
+    """``shapes`` without the spheres that lie inside a capsule of the same link (a capsule
+    written as a cylinder and its two end spheres): they change no distance."""
+    capsules = [s for s in shapes if isinstance(s, Capsule)]
+
+    def inside(sphere: Sphere) -> bool:
+        for c in capsules:
+            d = c.b - c.a
+            t = float(np.clip((sphere.center - c.a) @ d / max(float(d @ d), 1e-300), 0.0, 1.0))
+            if np.linalg.norm(sphere.center - c.a - t * d) + sphere.radius <= c.radius * (1 + 1e-12):
+                return True
+        return False
+
+    return tuple(s for s in shapes if not (isinstance(s, Sphere) and inside(s)))
 
 
 # Over 100 lines: parse, walk the tree, merge fixed links and build share the link/joint maps.
@@ -270,12 +332,16 @@ def read_urdf(
 
     bodies = [Body(0.0, name=j.child) for j, _ in movable]
     root_body = Body(0.0, name=chain.root)
+    meshes = 0
     for lname, link in links.items():
         if lname not in owner:  # above root_link: not part of the model
             continue
         body = _inertial(link, label)
-        if body.mass == 0 and not np.any(body.inertia):
+        shapes, skipped = _collisions(link, label)
+        meshes += skipped
+        if body.mass == 0 and not np.any(body.inertia) and not shapes:
             continue
+        body = replace(body, shapes=shapes)
         o = owner[lname]
         if o < 0:
             root_body = root_body.merged(body, in_owner[lname], name=chain.root)
@@ -302,7 +368,8 @@ def read_urdf(
         tool=tool,
         root_body=root_body,
         floating=base == "floating",
-        description=f"read from {label}" + _selection_text(chain),
+        description=f"read from {label}" + _selection_text(chain)
+        + (f"; {meshes} <collision> mesh(es) not read (meshes are not supported yet)" if meshes else ""),
     )
 
 

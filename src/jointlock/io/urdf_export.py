@@ -22,6 +22,12 @@ Conventions a reader of the file needs:
   its finite side (:meth:`ArmModel.angle_range`), every angle it can take once.
 - The base is whatever the reader is asked for (``read_urdf(..., base="floating")``,
   ``--base floating``): the root link's inertial is the spacecraft either way.
+- Collision geometry (issue 27) as ``<collision>`` elements on the link that carries it: a
+  sphere as ``<sphere>``, a box as ``<box>``, and a capsule, which URDF lacks, as a
+  ``<cylinder>`` and a ``<sphere>`` at each end (their union is the capsule, so any reader's
+  distances are the capsule's; :func:`~jointlock.io.urdf.read_urdf` reads the three back as the
+  capsule).  Each element is named after the shape (a capsule's end spheres ``NAME/end1``,
+  ``NAME/end2``).
 """
 
 from __future__ import annotations
@@ -33,6 +39,8 @@ from xml.sax.saxutils import quoteattr
 import numpy as np
 
 from ..model import ArmModel, Body, FloatArray
+from ..shapes import Box, Sphere
+from ..spatial import pose
 from .files import atomic_write_text
 
 #: Name of the end-effector link and of the root link in the files written.
@@ -71,6 +79,31 @@ def _inertial(body: Body) -> str:
     )
 
 
+def _collisions(body: Body) -> str:
+    out = []
+    for shape in body.shapes:
+        name = quoteattr(shape.name or body.name or "shape")
+        if isinstance(shape, Box):
+            parts = [(shape.pose, f'<box size="{_vec(2 * shape.half_extents)}"/>')]
+        elif isinstance(shape, Sphere) or shape.length == 0:
+            center = shape.center if isinstance(shape, Sphere) else shape.a
+            parts = [(pose(np.eye(3), center), f'<sphere radius="{_num(shape.radius)}"/>')]
+        else:
+            axis = (shape.b - shape.a) / shape.length
+            helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+            x = np.cross(helper, axis)
+            x /= np.linalg.norm(x)
+            frame = pose(np.column_stack([x, np.cross(axis, x), axis]), (shape.a + shape.b) / 2)
+            parts = [(frame, f'<cylinder radius="{_num(shape.radius)}" length="{_num(shape.length)}"/>')]
+            parts += [(pose(np.eye(3), end), f'<sphere radius="{_num(shape.radius)}"/>') for end in (shape.a, shape.b)]
+        names = [name] + [quoteattr(f"{shape.name or body.name or 'shape'}/end{k}") for k in (1, 2)]
+        out += [
+            f"<collision name={label}>{_origin(frame)}<geometry>{geometry}</geometry></collision>"
+            for label, (frame, geometry) in zip(names, parts)
+        ]
+    return "".join(out)
+
+
 def urdf_text(model: ArmModel) -> str:
     """The URDF document of ``model`` (see the module docstring)."""
     locked = ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):.12g} deg" for lj in model.locked)
@@ -79,7 +112,7 @@ def urdf_text(model: ArmModel) -> str:
         f"<!-- written by jointlock; locked: {locked or 'none'} "
         f"(folded into the chain, bodies merged); base: {'floating' if model.floating else 'fixed'} -->",
         f"<robot name={quoteattr(model.name)}>",
-        f"  <link name={quoteattr(BASE_LINK)}>{_inertial(model.root_body)}</link>",
+        f"  <link name={quoteattr(BASE_LINK)}>{_inertial(model.root_body)}{_collisions(model.root_body)}</link>",
     ]
     parent = BASE_LINK
     lows, highs = model.angle_range()  # a one-sided limit: one turn from its finite side
@@ -91,7 +124,7 @@ def urdf_text(model: ArmModel) -> str:
         if not continuous:
             limit = [f'lower="{_num(low)}"', f'upper="{_num(high)}"', *limit]
         lines += [
-            f"  <link name={quoteattr(child)}>{_inertial(body)}</link>",
+            f"  <link name={quoteattr(child)}>{_inertial(body)}{_collisions(body)}</link>",
             f"  <joint name={quoteattr(joint.name)} type=\"{'continuous' if continuous else 'revolute'}\">",
             f"    <parent link={quoteattr(parent)}/><child link={quoteattr(child)}/>",
             f"    {_origin(joint.placement)}<axis xyz=\"{_vec(joint.axis)}\"/>",

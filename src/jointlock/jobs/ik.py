@@ -11,20 +11,24 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..clearance import clearance, collision_pairs
 from ..ik import IKResult, solve_ik, zyx_angles
 from ..io.files import atomic_write_json
 from ..model import ArmModel
 from ._common import JobResult, format_matrix, locked_deg, locked_text
 
 
-def _solution(sol: Any) -> dict[str, Any]:
-    return {
+def _solution(sol: Any, clear: tuple[float, str] | None = None) -> dict[str, Any]:
+    out = {
         "branch": sol.branch,
         "q_deg": np.degrees(sol.q_full),
         "position_error_m": sol.position_error,
         "rotation_error_deg": math.degrees(sol.rotation_error),
         "exact": sol.exact,
     }
+    if clear is not None:
+        out.update(clearance_m=clear[0], clearance_pair=clear[1], collides=clear[0] < 0)
+    return out
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside: compare to_dict() instead
@@ -47,6 +51,26 @@ class InverseKinematicsReport(JobResult):
     target: np.ndarray
     result: IKResult
 
+    def clearances(self) -> list[tuple[float, str]] | None:
+        """Clearance [m] and closest pair of each solution (:func:`jointlock.clearance.
+        clearance`; negative: the arm overlaps its spacecraft bus or itself), in the solver's
+        order; None for a model without collision shapes."""
+        solutions = self.result.solutions
+        if not solutions or not collision_pairs(self.model).names:
+            return None
+        q = self.model.healthy(np.array([s.q_full for s in solutions]))
+        result = clearance(self.model, q)
+        return [(float(result.distance[i]), result.pair_at((i,))) for i in range(len(solutions))]
+
+    def ranked(self) -> list[tuple[Any, tuple[float, str] | None]]:
+        """The solutions with their clearance, the colliding ones last (the solver's order
+        otherwise)."""
+        clear = self.clearances()
+        pairs: list[tuple[Any, tuple[float, str] | None]] = list(
+            zip(self.result.solutions, clear if clear is not None else [None] * len(self.result.solutions))
+        )
+        return sorted(pairs, key=lambda item: item[1] is not None and item[1][0] < 0)
+
     def to_dict(self) -> dict[str, Any]:
         """What ``jointlock ik --json`` prints (angles of every joint, the locked ones included)."""
         res, target = self.result, self.target
@@ -63,7 +87,7 @@ class InverseKinematicsReport(JobResult):
             "tolerance": None
             if res.tolerance is None
             else {"position_m": res.tolerance[0], "rotation_deg": math.degrees(res.tolerance[1])},
-            "solutions": [_solution(s) for s in res.solutions],
+            "solutions": [_solution(s, c) for s, c in self.ranked()],
             "candidates": [_solution(s) for s in res.candidates],
             "nearest": None,
         }
@@ -101,11 +125,17 @@ class InverseKinematicsReport(JobResult):
                 f"\n{len(res.solutions)} solution(s){within}, q [deg] (all joints), position error [m], "
                 "rotation error [deg]:"
             )
-            for s in res.solutions:
+            ranked = self.ranked()
+            for s, clear in ranked:
                 q = " ".join(f"{v:9.4f}" for v in np.degrees(s.q_full))
+                flag = "" if clear is None else f"   clearance {clear[0]:+.3f} m" + (f" COLLIDES ({clear[1]})" if clear[0] < 0 else "")
                 lines.append(
-                    f"  branch {s.branch}: {q}   {s.position_error:.2e}  {math.degrees(s.rotation_error):.2e}"
+                    f"  branch {s.branch}: {q}   {s.position_error:.2e}  {math.degrees(s.rotation_error):.2e}{flag}"
                 )
+            colliding = [s.branch for s, clear in ranked if clear is not None and clear[0] < 0]
+            if colliding:
+                verdict = "every branch" if len(colliding) == len(ranked) else f"branches {colliding} (listed last)"
+                lines.insert(0, f"COLLIDES: {verdict} overlap the spacecraft bus or the arm itself")
         else:
             n = self.to_dict()["nearest"]
             lines.append("\nnot reachable by this arm" + (" with the locked joint" if model.locked else ""))

@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..analysis.spacecraft import SpacecraftResponse, spacecraft_response
+from ..clearance import Clearance, clearance, collision_pairs
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, with_svg, write_figure
 from ..kinematics import ee_pose
@@ -83,6 +84,26 @@ class ReplanJobResult(JobResult):
             return None
         return spacecraft_response(self.model, self.plan.times, self.plan.q, self.plan.dq)
 
+    def clearance(self) -> Clearance | None:
+        """Clearance of the plan's waypoints (K,) (:func:`jointlock.clearance.clearance`;
+        negative: the arm overlaps its spacecraft bus or itself); None without the model or its
+        collision shapes."""
+        if self.model is None or not collision_pairs(self.model).names:
+            return None
+        return clearance(self.model, self.plan.q)
+
+    def _clearance_dict(self) -> dict[str, Any] | None:
+        clear = self.clearance()
+        if clear is None:
+            return None
+        worst = clear.worst()
+        return {
+            "min_m": float(clear.distance[worst]),
+            "pair": clear.pair_at(worst),
+            "time_s": float(self.plan.times[worst]),
+            "colliding_waypoints": int(np.count_nonzero(clear.distance < 0)),
+        }
+
     def trajectory(self) -> dict[str, np.ndarray]:
         """The time series of the JSON output: ``time_s`` (K,), ``q_deg`` (K, 6), ``gamma_deg``,
         ``absorbed``, ``position_error_m``, ``rotation_error_deg`` (K,)."""
@@ -128,6 +149,7 @@ class ReplanJobResult(JobResult):
             "max_step_rate_deg_s": np.degrees(res.step_rate.max(axis=0)) if res.joint_step.size else [],
             "velocity_limit_deg_s": [v if math.isfinite(v) else None for v in np.degrees(res.velocity_limit)],
             "jump_threshold_deg": math.degrees(res.jump_threshold),
+            "clearance": self._clearance_dict(),
             "jumps": [step_flag_dict(f, "deg") for f in res.jumps],
             "over_velocity": [step_flag_dict(f, "deg_s") for f in res.over_velocity],
         }
@@ -173,6 +195,15 @@ class ReplanJobResult(JobResult):
         sc = self.spacecraft_response()
         if sc is not None:
             lines += ["  " + line for line in sc.summary("spacecraft (free, zero momentum)")]
+        clear = s["clearance"]
+        if clear is not None:
+            lines.append(f"  clearance: smallest {clear['min_m']:+.3f} m ({clear['pair']}, t = {clear['time_s']:g} s)")
+            if clear["colliding_waypoints"]:
+                lines.insert(
+                    0,
+                    f"COLLIDES: {clear['colliding_waypoints']} of {res.times.size} waypoints overlap the spacecraft "
+                    f"bus or the arm itself; deepest {-clear['min_m']:.3f} m into {clear['pair']} at t = {clear['time_s']:g} s",
+                )
         return lines
 
     def trajectory_csv(self) -> str:

@@ -30,9 +30,10 @@ from typing import Any
 
 import numpy as np
 
+from ..clearance import clearance, collision_pairs
 from ..errors import ConfigurationError
 from ..model import ArmModel
-from .motion import ArmMotion, drawn_arm, frame_times, motion_points, spacecraft_box
+from .motion import ArmMotion, _nearest, drawn_arm, frame_times, motion_points, spacecraft_box
 
 #: Colours of successive motions (plotly's first three).
 MOTION_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd")
@@ -131,6 +132,7 @@ def animation_figure(
     extent = np.vstack([extent, *[m.target for m in motions if m.target is not None]])
     box = spacecraft_box(arm)
     boxes = [None if box is None else p["base"][:, None, :] + np.einsum("fij,kj->fki", p["base_rotation"], box) for p in points]
+    overlaps = [_overlaps(arm, m, p, times) for m, p in zip(motions, points)]
     if box is not None:
         extent = np.vstack([extent, *[b.reshape(-1, 3) for b in boxes if b is not None]])
     centre = (extent.max(axis=0) + extent.min(axis=0)) / 2
@@ -153,6 +155,13 @@ def animation_figure(
             moving.append(len(data))
             name = "spacecraft" if m.moving_base else "spacecraft (held)" if arm.floating else "base body (fixed)"
             data.append(_box_trace(box_i[0], colour, name if len(motions) == 1 else f"{name}, {m.label}"))
+        over = overlaps[i]
+        if over is not None:
+            moving.append(len(data))
+            label = "overlap (deepest pair)" if len(motions) == 1 else f"overlap, {m.label}"
+            data.append({"type": "scatter3d", "mode": "lines+markers", "name": label, "hoverinfo": "text",
+                         "line": {"color": "red", "width": 10}, "marker": {"color": "red", "size": 5},
+                         **_overlap_trace(*over[0])})  # fmt: skip
 
     frames = []
     for f, t in enumerate(times):
@@ -162,6 +171,9 @@ def animation_figure(
             box_i = boxes[i]
             if box_i is not None:
                 traces.append(_xyz(_box_lines(box_i[f])))
+            over = overlaps[i]
+            if over is not None:
+                traces.append(_overlap_trace(*over[f]))
         frames.append({"name": str(f), "data": traces, "traces": moving, "layout": {"title": {"text": _frame_title(title, motions, float(t))}}})
 
     ranges = [[float(c - radius), float(c + radius)] for c in centre]
@@ -210,6 +222,26 @@ def _on_full_arm(model: ArmModel, arm: ArmModel, motion: ArmMotion) -> ArmMotion
         return motion
     locks = (*motion.locks, *((lj.number, float(motion.t[0])) for lj in model.locked if lj.number not in dict(motion.locks)))
     return dataclasses.replace(motion, q=model.expand(motion.q), locks=locks)
+
+
+def _overlaps(arm: ArmModel, motion: ArmMotion, points: dict[str, Any], times: np.ndarray) -> list[tuple[np.ndarray, str]] | None:
+    """Per frame, the witness points (2, 3) of the deepest overlap of the arm with its bus or
+    itself, in the motion's first frame, and a hover text; (0, 3) when it overlaps nothing.
+    None for an arm without collision shapes."""
+    if not collision_pairs(arm).names:
+        return None
+    result = clearance(arm, motion.q[_nearest(motion.t, times)])
+    world = points["base"][:, None, :] + np.einsum("fij,fkj->fki", points["base_rotation"], result.witness)
+    return [
+        (world[f], f"{result.pair_at((f,))}: {-float(result.distance[f]):.3f} m overlap")
+        if result.distance[f] < 0
+        else (np.zeros((0, 3)), "")
+        for f in range(times.size)
+    ]
+
+
+def _overlap_trace(witness: np.ndarray, text: str) -> dict[str, Any]:
+    return {**_xyz(witness), "hovertext": [text] * len(witness)}
 
 
 def _box_lines(corners: np.ndarray) -> np.ndarray:
