@@ -24,7 +24,7 @@ sys.path.insert(0, str(Path(__file__).parent.parent / "tests"))
 from _info import best_of, machine_info  # noqa: E402
 
 import jointlock as jl  # noqa: E402
-from jointlock.clearance import clearance  # noqa: E402
+from jointlock.collision import clearance  # noqa: E402
 from jointlock.planning.halt_config import optimal_halt_configuration  # noqa: E402
 
 
@@ -40,7 +40,7 @@ def main() -> None:
     ours = best_of(lambda: clearance(arm, q), 5)
     result = clearance(arm, q)
     print(f"pairs checked: {len(result.names)}; colliding: {100 * float(np.mean(result.distance < 0)):.1f} %")
-    print(f"jointlock.clearance   {args.samples} configurations: {ours * 1e3:8.1f} ms  ({args.samples / ours / 1e3:7.0f} k/s)")
+    print(f"jointlock.collision   {args.samples} configurations: {ours * 1e3:8.1f} ms  ({args.samples / ours / 1e3:7.0f} k/s)")
 
     from pin_oracle import pin, pin_q, to_pinocchio, to_pinocchio_geometry
 

@@ -88,11 +88,11 @@ def reduced_model(full, keep: list[str], values: dict[str, float]):
 def to_pinocchio_geometry(model: jl.ArmModel, pm):
     """(pin.GeometryModel, pair names) of ``model``'s collision shapes on ``pm`` (from
     :func:`to_pinocchio`, fixed base): coal capsules, spheres and boxes on the joints that
-    carry them, and jointlock's checked pairs (:func:`jointlock.clearance.collision_pairs`) as
+    carry them, and jointlock's checked pairs (:func:`jointlock.collision.collision_pairs`) as
     the collision pairs, in the same order."""
     import coal
 
-    from jointlock.clearance import collision_pairs
+    from jointlock.collision import collision_pairs
 
     pairs = collision_pairs(model)
     geom = pin.GeometryModel()

@@ -71,9 +71,9 @@ _CORE = {
     "Box": "jointlock.shapes",
     "Capsule": "jointlock.shapes",
     "Sphere": "jointlock.shapes",
-    "Clearance": "jointlock.clearance",
-    "clearance": "jointlock.clearance",
-    "ClearanceSettings": "jointlock.clearance",
+    "Clearance": "jointlock.collision",
+    "clearance": "jointlock.collision",
+    "ClearanceSettings": "jointlock.collision",
 }
 
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).

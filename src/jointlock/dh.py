@@ -228,6 +228,8 @@ def from_dh(
     if radius is None:
         return model
     try:
+        if isinstance(radius, (bool, np.bool_, str, bytes)) or np.asarray(radius).dtype.kind == "b":
+            raise TypeError
         radii = np.full(n, float(radius)) if np.ndim(radius) == 0 else _column(radius, n, "radius")  # type: ignore[arg-type]
     except (TypeError, ValueError):
         raise ModelError(f"radius must be a length [m] or {n} lengths, one per row; got {shown(radius)}") from None

@@ -3,7 +3,7 @@ for its spacecraft bus.
 
 The shapes themselves are :mod:`jointlock.shapes`; a model carries them on its bodies
 (``Body.shapes``), so that locking merges them like the inertia.  Distances are
-:mod:`jointlock.clearance`.
+:mod:`jointlock.collision`.
 """
 
 from __future__ import annotations

@@ -299,7 +299,7 @@ class ArmModel:
                 f"[kg]; got {self.root_body.mass}"
             )
         # each shape remembers the link it was made for (0: the root body), whatever is
-        # merged later: it decides the pairs checked and names them (jointlock.clearance)
+        # merged later: it decides the pairs checked and names them (jointlock.collision)
         bodies = tuple(
             b if all(s.link is not None for s in b.shapes) else replace(b, shapes=with_link(b.shapes, j.number))
             for j, b in zip(joints, bodies)

@@ -23,6 +23,7 @@ from .errors import ModelError
 from .geometry import bus_box, with_link_capsules, with_root_shapes
 from .io.files import check_path_text
 from .model import ArmModel, Body, FloatArray, Joint
+from .shapes import Box
 from .spatial import rot_x, translation
 
 BaseMode = Literal["fixed", "floating"]
@@ -154,10 +155,11 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
       formula (each segment of link i scaled by (m_0 + ... + m_i) / M) and reproduces its
       printed virtual lengths; the default ``"vafa-dubowsky"`` weighting is the exact one.
     * Collision geometry: each link's 0.1 m cylinder as a capsule along its segment (the
-      root post, joint 1 at l = 0.5 m, likewise) and the bus as the 2 m cube of the
-      spacecraft's mass and inertia, with either base.  The arm's root lies inside that cube
-      (its centre of mass is the root origin, joint 1 0.5 m above it): the pairs that touch at
-      the zero pose (the bus with links 2 and 3) are not checked (``jointlock.clearance``).
+      root post, joint 1 at l = 0.5 m, likewise) and the bus as a 2 m cube, with either base.
+      004 puts joint 1 only l = 0.5 m from the spacecraft's centre of mass, inside the 2 m cube
+      of its inertia (which the 3-D view draws, centred there): the bus is that cube moved down
+      by 0.5 m so that joint 1 stands on its top face (a spacecraft whose centre of mass is not
+      its middle).  Pairs touching at the zero pose are mounted (:mod:`jointlock.collision`).
     """
     _check_base(base)
     L = CANADARM7_LENGTHS
@@ -207,7 +209,10 @@ def canadarm7(*, base: BaseMode = "fixed") -> ArmModel:
             "(modified DH, zero offsets, frames at 004's joint points); link inertias and spacecraft shape ours."
         ),
     )
-    return with_root_shapes(with_link_capsules(model, radius), [bus_box(spacecraft)])
+    # the cube of the spacecraft's inertia, moved down so that joint 1 stands on its top face
+    cube = bus_box(spacecraft)
+    bus = Box(translation([0.0, 0.0, L["l"] - cube.half_extents[2]]) @ cube.pose, cube.half_extents, name="bus")
+    return with_root_shapes(with_link_capsules(model, radius), [bus])
 
 
 # -- puma6 (seed 002, Table 1) --------------------------------------------------------------

@@ -14,9 +14,9 @@ Shapes move with their body: :meth:`jointlock.model.Body.transformed` turns them
 merges a locked link's shapes into its parent exactly as it merges the inertia.  Each shape
 remembers the link it was made for (``link``: the link's joint number in the full arm, 0 for the
 root body), which decides the pairs that are checked (adjacent links never are) and names the
-closest pair in :func:`jointlock.clearance.clearance`, whatever was locked since.
+closest pair in :func:`jointlock.collision.clearance`, whatever was locked since.
 
-Distances between shapes are computed by :mod:`jointlock.clearance`.
+Distances between shapes are computed by :mod:`jointlock.collision`.
 """
 
 from __future__ import annotations
@@ -40,8 +40,18 @@ def _readonly(array: ArrayLike) -> FloatArray:
     return out
 
 
+def _floats(value: object, what: str) -> FloatArray:
+    try:
+        arr = np.asarray(value, dtype=float)
+    except (TypeError, ValueError, OverflowError):
+        raise ModelError(f"{what} must be numbers; got {shown(value)}") from None
+    if np.asarray(value).dtype.kind == "b":
+        raise ModelError(f"{what} must be numbers, not booleans; got {shown(value)}")
+    return arr
+
+
 def _point(value: ArrayLike, what: str) -> FloatArray:
-    arr = np.asarray(value, dtype=float)
+    arr = _floats(value, what)
     if arr.shape != (3,) or not np.all(np.isfinite(arr)) or np.any(np.abs(arr) > MAX_MODEL_LENGTH_M):
         raise ModelError(
             f"{what} must be 3 finite numbers within +-{MAX_MODEL_LENGTH_M:g} m; got {shown(np.asarray(value).tolist())}"
@@ -51,8 +61,10 @@ def _point(value: ArrayLike, what: str) -> FloatArray:
 
 def _length(value: float, what: str, *, positive: bool) -> float:
     try:
+        if isinstance(value, (bool, np.bool_, str, bytes)):
+            raise TypeError
         out = float(value)
-    except (TypeError, ValueError):
+    except (TypeError, ValueError, OverflowError):
         raise ModelError(f"{what} must be a number [m]; got {shown(value)}") from None
     if not math.isfinite(out) or out < 0 or (positive and out == 0) or out > MAX_MODEL_LENGTH_M:
         bound = "> 0" if positive else ">= 0"
@@ -61,7 +73,7 @@ def _length(value: float, what: str, *, positive: bool) -> float:
 
 
 def _pose(value: ArrayLike, what: str) -> FloatArray:
-    arr = np.asarray(value, dtype=float)
+    arr = _floats(value, what)
     if arr.shape != (4, 4) or not np.all(np.isfinite(arr)):
         raise ModelError(f"{what} must be a finite 4x4 homogeneous transform; got shape {arr.shape}")
     rot = arr[:3, :3]
@@ -75,6 +87,20 @@ def _pose(value: ArrayLike, what: str) -> FloatArray:
 
 def _label(name: str, kind: str) -> str:
     return f"{kind} {shown(name)}" if name else kind
+
+
+def _check_identity(shape: Capsule | Sphere | Box, kind: str) -> None:
+    """``name`` text, ``link`` None or an integer joint number (0: the root body, -1 a keep-out)."""
+    if not isinstance(shape.name, str):
+        raise ModelError(f"{kind}: name must be text; got {shown(shape.name)}")
+    link = shape.link
+    if link is not None and (isinstance(link, (bool, np.bool_)) or not isinstance(link, (int, np.integer)) or link < -1):
+        raise ModelError(
+            f"{_label(shape.name, kind)}: link must be None or the joint number of its link (0: the root body); "
+            f"got {shown(link)}"
+        )
+    if link is not None:
+        object.__setattr__(shape, "link", int(link))
 
 
 @dataclass(frozen=True, eq=False)
@@ -92,6 +118,7 @@ class Capsule:
     link: int | None = None
 
     def __post_init__(self) -> None:
+        _check_identity(self, "capsule")
         label = _label(self.name, "capsule")
         object.__setattr__(self, "a", _point(self.a, f"{label}: a"))
         object.__setattr__(self, "b", _point(self.b, f"{label}: b"))
@@ -131,6 +158,7 @@ class Sphere:
     link: int | None = None
 
     def __post_init__(self) -> None:
+        _check_identity(self, "sphere")
         label = _label(self.name, "sphere")
         object.__setattr__(self, "center", _point(self.center, f"{label}: center"))
         object.__setattr__(self, "radius", _length(self.radius, f"{label}: radius", positive=True))
@@ -156,6 +184,7 @@ class Box:
     link: int | None = None
 
     def __post_init__(self) -> None:
+        _check_identity(self, "box")
         label = _label(self.name, "box")
         object.__setattr__(self, "pose", _pose(self.pose, f"{label}: pose"))
         half = _point(self.half_extents, f"{label}: half_extents")

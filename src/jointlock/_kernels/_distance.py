@@ -1,5 +1,5 @@
 """Signed distances between capsules (a sphere is a capsule of zero length) and boxes, for a batch
-of configurations (issue 27; :func:`jointlock.clearance.clearance` is the public call).
+of configurations (issue 27; :func:`jointlock.collision.clearance` is the public call).
 
 Signed distance: the distance between two separate shapes, minus the penetration depth (the
 length of the smallest translation that separates them) of two that overlap.  Both are exact:
@@ -85,8 +85,11 @@ def _capsule_capsule(c1, r1, c2, r2, w):
     px, py, pz = ax + s1 * dx, ay + s1 * dy, az + s1 * dz
     qx, qy, qz = bx + t2 * ex, by + t2 * ey, bz + t2 * ez
     delta = math.sqrt(best)
-    if delta > 0.0:
-        nx, ny, nz = (qx - px) / delta, (qy - py) / delta, (qz - pz) / delta
+    gx, gy, gz = qx - px, qy - py, qz - pz
+    gap = math.sqrt(gx * gx + gy * gy + gz * gz)
+    scale = math.sqrt(max(aa, ee)) + abs(ax) + abs(ay) + abs(az)
+    if gap > 1e-12 * scale:  # the witness points' own difference: above round-off
+        nx, ny, nz = gx / gap, gy / gap, gz / gap
     else:  # the segments meet: any normal to both separates them
         nx, ny, nz = dy * ez - dz * ey, dz * ex - dx * ez, dx * ey - dy * ex
         norm = math.sqrt(nx * nx + ny * ny + nz * nz)
@@ -251,7 +254,7 @@ def _to_root(box, x, y, z, w, row):
 
 
 @_jit
-def pair_distances(capsules, radii, boxes, halves, pairs, out_distance, out_closest, out_witness):
+def pair_distances(capsules, radii, boxes, halves, pairs, offsets, out_distance, out_closest, out_witness):
     """Signed distances of every pair for every configuration.
 
     Parameters
@@ -266,9 +269,13 @@ def pair_distances(capsules, radii, boxes, halves, pairs, out_distance, out_clos
         (B, 3) box half extents [m].
     pairs
         (P, 3) int64: kind (0 capsule-capsule, 1 capsule-box), index 1, index 2.
+    offsets
+        (P,) subtracted from each pair's signed distance [m] (a mounted pair's depth at the zero
+        pose, :mod:`jointlock.collision`; 0 for the others).
     out_distance, out_closest, out_witness
-        (N, P) signed distances [m], (N,) index of the closest pair, (N, 2, 3) its witness
-        points [m], written in place.
+        (N, P) signed distances [m], (N,) index of the closest pair (a mounted pair only when
+        it is deeper than at the zero pose; 0 when no pair counts), (N, 2, 3) its witness points
+        [m], written in place.
     """
     count = capsules.shape[0]
     w = np.empty((2, 3))
@@ -282,9 +289,12 @@ def pair_distances(capsules, radii, boxes, halves, pairs, out_distance, out_clos
                 value = _capsule_capsule(capsules[n, i], radii[i], capsules[n, j], radii[j], w)
             else:
                 value = _capsule_box(capsules[n, i], radii[i], boxes[n, j], halves[j], w, work)
+            value -= offsets[k]
             out_distance[n, k] = value
-            if value < lowest or k == 0:
-                lowest = value
+            # a mounted pair (offset < 0) counts for the closest only when deeper than mounted
+            rank = np.inf if offsets[k] < 0.0 and value >= 0.0 else value
+            if rank < lowest:
+                lowest = rank
                 closest = k
                 for a in range(2):
                     for b in range(3):

@@ -318,7 +318,7 @@ def add_clearance_options(p: argparse.ArgumentParser) -> None:
 
 
 def clearance_from_args(args: argparse.Namespace) -> Any:
-    """The :class:`~jointlock.clearance.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``."""
+    """The :class:`~jointlock.collision.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``."""
     from ..jobs._common import scenario_clearance
 
     return scenario_clearance(

@@ -25,7 +25,7 @@ from typing import Any, ClassVar, overload
 
 import numpy as np
 
-from ..clearance import DEFAULT_CLEARANCE_MIN_M, ClearanceSettings
+from ..collision import DEFAULT_CLEARANCE_MIN_M, ClearanceSettings
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, figure_png, json_text, to_plain
 from ..model import ArmModel

@@ -22,7 +22,7 @@ import numpy as np
 
 from .._deprecate import renamed_keyword
 from ..analysis.ability import INDEX_NAMES, Assignment, JacobianKind
-from ..clearance import ClearanceSettings
+from ..collision import ClearanceSettings
 from ..errors import ConfigurationError
 from ..io.files import atomic_write_bytes, atomic_write_json, with_svg, write_figure
 from ..locking import lock_joints
@@ -327,8 +327,8 @@ def study_halt_configuration(
         Show a progress bar on stderr (when it is a terminal).
     clearance
         Beyond 000 (issue 27): the clearance a halt configuration must keep between the arm's
-        links, its spacecraft bus and keep-out volumes (:class:`~jointlock.clearance.
-        ClearanceSettings`; default: :data:`~jointlock.clearance.DEFAULT_CLEARANCE_MIN_M`);
+        links, its spacecraft bus and keep-out volumes (:class:`~jointlock.collision.
+        ClearanceSettings`; default: :data:`~jointlock.collision.DEFAULT_CLEARANCE_MIN_M`);
         closer samples are excluded and counted.  ``ClearanceSettings.off()``: 000's search,
         the clearance only reported.
 

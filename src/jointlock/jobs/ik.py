@@ -11,7 +11,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..clearance import clearance, collision_pairs
+from ..collision import clearance, collision_pairs
 from ..ik import IKResult, solve_ik, zyx_angles
 from ..io.files import atomic_write_json
 from ..model import ArmModel
@@ -52,7 +52,7 @@ class InverseKinematicsReport(JobResult):
     result: IKResult
 
     def clearances(self) -> list[tuple[float, str]] | None:
-        """Clearance [m] and closest pair of each solution (:func:`jointlock.clearance.
+        """Clearance [m] and closest pair of each solution (:func:`jointlock.collision.
         clearance`; negative: the arm overlaps its spacecraft bus or itself), in the solver's
         order; None for a model without collision shapes."""
         solutions = self.result.solutions

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ..clearance import Clearance, clearance, collision_pairs
+from ..collision import Clearance, clearance, collision_pairs
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, with_svg, write_figure
 from ..kinematics import ee_pose
@@ -85,7 +85,7 @@ class ReplanJobResult(JobResult):
         return spacecraft_response(self.model, self.plan.times, self.plan.q, self.plan.dq)
 
     def clearance(self) -> Clearance | None:
-        """Clearance of the plan's waypoints (K,) (:func:`jointlock.clearance.clearance`;
+        """Clearance of the plan's waypoints (K,) (:func:`jointlock.collision.clearance`;
         negative: the arm overlaps its spacecraft bus or itself); None without the model or its
         collision shapes."""
         if self.model is None or not collision_pairs(self.model).names:
@@ -101,7 +101,7 @@ class ReplanJobResult(JobResult):
             "min_m": float(clear.distance[worst]),
             "pair": clear.pair_at(worst),
             "time_s": float(self.plan.times[worst]),
-            "colliding_waypoints": int(np.count_nonzero(clear.distance < 0)),
+            "colliding_waypoints": int(np.count_nonzero(clear.colliding(0.0))),
         }
 
     def trajectory(self) -> dict[str, np.ndarray]:

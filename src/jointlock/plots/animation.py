@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from ..clearance import clearance, collision_pairs
+from ..collision import clearance, collision_pairs
 from ..errors import ConfigurationError
 from ..model import ArmModel
 from .motion import ArmMotion, _nearest, drawn_arm, frame_times, motion_points, spacecraft_box

@@ -209,7 +209,7 @@ def plot_actuator_loads(
 
 
 def plot_clearance(clearance: Any, t: Any, *, margin: float = 0.0, ax: Any | None = None, pairs: int = 3) -> Any:
-    """Clearance over a motion (:class:`~jointlock.clearance.Clearance` of (n_t,) samples at
+    """Clearance over a motion (:class:`~jointlock.collision.Clearance` of (n_t,) samples at
     times ``t`` [s]): the smallest over every checked pair (thick), the ``pairs`` pairs that
     come closest (thin), the clearance required (dashed) and contact (0 m, dotted).  Returns
     the axis."""

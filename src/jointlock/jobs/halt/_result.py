@@ -14,7 +14,7 @@ import numpy as np
 from ..._cache import cached_on
 from ...analysis.actuators import ActuatorLoads, actuator_loads
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ...clearance import Clearance, ClearanceSettings, clearance, collision_pairs
+from ...collision import Clearance, ClearanceSettings, clearance, collision_pairs
 from ...io.files import (
     atomic_write_bytes,
     atomic_write_json,
@@ -108,9 +108,9 @@ class HaltPlan(JobResult):
     notes
         Plain-language notes on how the halt was planned (printed with the summary).
     clearance_settings
-        The clearance required and the keep-out volumes (:class:`~jointlock.clearance.
-        ClearanceSettings`); with a clearance required, a halt that comes closer is not
-        :attr:`feasible`.
+        The clearance required and the keep-out volumes (:class:`~jointlock.collision.
+        ClearanceSettings`); whether the halt keeps it is :attr:`collision_free`
+        (:attr:`feasible` is the limits' verdict).
     """
 
     job: ClassVar[str] = "halt"
@@ -256,7 +256,7 @@ class HaltPlan(JobResult):
         return halt_motions(self)
 
     def clearance(self) -> Clearance | None:
-        """Clearance of the halt motion (:func:`jointlock.clearance.clearance`) on the
+        """Clearance of the halt motion (:func:`jointlock.collision.clearance`) on the
         constraint grid (``n_check`` samples, the halt configuration last); None for a model
         without collision shapes.  ``distance`` (n_check,) [m]; negative: the arm overlaps the
         spacecraft bus or itself."""
@@ -275,44 +275,47 @@ class HaltPlan(JobResult):
         if motion is None:
             return None
         t = self.problem.times(self.problem.n_check)
-        worst = motion.worst()
-        start = motion.pair_distance[0]
-        # a pair already closer than required at the failure may not come closer still
-        floor = np.minimum(self.clearance_settings.margin, start)
-        shortfall = floor - motion.pair_distance  # (n_check, P): > 0 where the halt makes it worse
-        first = int(np.argmin(start)) if start.size else 0
+        d = motion.pair_distance  # (n_check, P)
+        # a pair already closer than allowed at the failure may not come closer still
+        allowed = np.where(motion.mounted_pairs, 0.0, self.clearance_settings.margin)
+        shortfall = np.minimum(allowed, d[0]) - d  # > 0: closer than allowed, and than at the start
+        collides = bool(np.any(shortfall > 0))
+        at, pair = np.unravel_index(int(np.argmax(shortfall) if collides else np.argmin(d)), d.shape)
+        start_pair = int(np.argmax(allowed - d[0]))
         return {
             "halt_configuration_m": float(motion.distance[-1]),
             "halt_configuration_pair": motion.pair_at((motion.distance.size - 1,)),
-            "start_m": float(motion.distance[0]),
-            "start_pair": motion.names[first] if motion.names else "",
-            "motion_min_m": float(motion.distance[worst]),
-            "motion_min_pair": motion.pair_at(worst),
-            "motion_min_time_s": float(t[worst]),
+            "start_m": float(d[0, start_pair]),
+            "start_pair": motion.names[start_pair],
+            "start_closer_than_allowed": bool(allowed[start_pair] > d[0, start_pair]),
+            "motion_min_m": float(d[at, pair]),
+            "motion_min_pair": motion.names[pair],
+            "motion_min_time_s": float(t[at]),
             "required_m": self.clearance_settings.min_m,
-            "collides": bool(np.any(shortfall > 0)),
-            "worst_shortfall_m": float(max(shortfall.max(), 0.0)) if shortfall.size else 0.0,
+            "collides": collides,
+            "worst_shortfall_m": float(max(shortfall.max(), 0.0)),
             "samples": int(motion.distance.size),
-            "ignored_pairs": list(motion.ignored),
+            "mounted_pairs": list(motion.mounted),
         }
 
     def _collision_line(self) -> list[str]:
         """The first line of the summary when the halt comes closer than required."""
         data = self._clearance_dict()
-        margin = self.clearance_settings.margin
-        if data is None or (not data["collides"] and data["start_m"] >= margin):
+        if data is None or not (data["collides"] or data["start_closer_than_allowed"]):
             return []
 
         def reach(d: float) -> str:
             return f"{-d:.3f} m into" if d < 0 else f"within {d:.3f} m of"
 
         head = "COLLIDES" if data["collides"] else "CLEARANCE"
+        minimum = self.clearance_settings.min_m
+        required = "clearance reported, not required" if minimum is None else f"required {minimum:g} m"
         text = f"{head}: "
-        if data["start_m"] < margin:
+        if data["start_closer_than_allowed"]:
             text += (
-                f"the state at failure already reaches {reach(data['start_m'])} {data['start_pair']} (required "
-                f"{margin:g} m: check the state, or the collision geometry: {self.problem.model.name}'s is "
-                "documented with its factory); "
+                f"the state at failure already reaches {reach(data['start_m'])} {data['start_pair']} ({required}: "
+                f"check the state, or the collision geometry: {self.problem.model.name}'s is documented with its "
+                "factory); "
             )
         if data["collides"]:
             text += f"the halt reaches {reach(data['motion_min_m'])} {data['motion_min_pair']} at t = {data['motion_min_time_s']:.3g} s"

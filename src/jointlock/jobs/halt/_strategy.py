@@ -15,11 +15,11 @@ from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
 from ...bounds import as_real
-from ...clearance import ClearanceSettings, collision_pairs
-from ...clearance import clearance as clearance_of
+from ...collision import ClearanceSettings, collision_pairs
+from ...collision import clearance as clearance_of
 from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
-from ...model import ArmModel, as_joint_array
+from ...model import ArmModel
 from ...papers import p000
 from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
@@ -290,10 +290,11 @@ def plan_halt(
         (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
     clearance
         Beyond 000 (issue 27): the clearance required between the arm's links, its spacecraft
-        bus and keep-out volumes (:class:`~jointlock.clearance.ClearanceSettings`; default: no
+        bus and keep-out volumes (:class:`~jointlock.collision.ClearanceSettings`; default: no
         overlap, 0 m).  The search excludes configurations closer than that; a given ``qf``
-        closer than that is refused; a halt motion that comes closer is not feasible and says
-        which pair, when and by how much.  ``ClearanceSettings.off()``: reported only (000's
+        closer than that is refused; ``k`` keeps to the halts that keep it; a halt motion that
+        still comes closer is reported (:attr:`HaltPlan.collision_free` False, the first line
+        of the summary: which pair, when and by how much; ``feasible`` is the limits' verdict).  ``ClearanceSettings.off()``: reported only (000's
         way; ``paper_qf`` is 000's configuration and is only reported).
 
     Raises
@@ -335,7 +336,6 @@ def plan_halt(
     configuration, reach_note = None, None
     if qf is not None:
         qf_arr, qf_source = np.asarray(qf, dtype=float), _names["qf"]
-        _check_qf_clearance(model, qf_arr, clearance, _names["qf"])
     elif paper_qf:
         if not paper:
             raise ScenarioError(
@@ -361,11 +361,13 @@ def plan_halt(
         base=base, n_samples=n_samples, moment_about=moment_about, tau_max=kept.torque, brake_max=kept.brake,
         objective=objective,
     )  # fmt: skip
+    if qf is not None:  # checked by HaltProblem first: one value or one per healthy joint
+        _check_qf_clearance(model, problem.qf, clearance, _names["qf"])
     bar = Progress(ga.n_gen, "GA generations", enabled=None if progress else False) if solver == "ga" else None
     def solve(k_bounds: tuple[float, float] | None = None) -> HaltMotion:
         return optimal_halt_motion(
-            problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T, progress=bar,
-            prefer_margin=prefer_margin, k_bounds=k_bounds,
+            problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T,
+            progress=bar if k_bounds is None else None, prefer_margin=prefer_margin, k_bounds=k_bounds,
         )  # fmt: skip
 
     motion = solve()
@@ -396,17 +398,19 @@ def _keep_clear(
     """The halt motion keeping the clearance required (issue 27): the optimum when its halt
     keeps it; else the best optimum over the stretches of the feasible ``k`` whose halts keep
     it (:func:`~jointlock.planning.halt_motion.clear_k_segments`, each solved with
-    ``k_bounds``); else the optimum as it is (reported as colliding).  Shared ``k`` (solver
-    "scan" or "ga") only; returns the motion and a note."""
+    ``k_bounds``; the result keeps the limits' interval of ``k``, the note gives the stretch);
+    else the optimum as it is (reported as colliding).  Shared ``k`` (solver "scan" or "ga")
+    only: the per-joint solver's halt is reported, with a note.  Returns the motion and the
+    notes."""
     problem = motion.problem
-    if (
-        not settings.required
-        or not motion.feasible
-        or motion.per_joint
-        or not collision_pairs(problem.model, settings.keep_out).names
-    ):
+    if not settings.required or not motion.feasible or not collision_pairs(problem.model, settings.keep_out).names:
         return motion, ()
     margin, keep_out = settings.margin, settings.keep_out
+    if motion.per_joint:
+        return motion, (
+            "solver 'vector' (one k per joint) does not keep the clearance, it reports it: solver 'scan' or 'ga' "
+            "restricts the shared k to the halts that keep it",
+        )
     if clearance_shortfall(problem, np.asarray(float(motion.k)), margin, keep_out) <= 0:
         return motion, ()
     lo, hi = (float(v) for v in motion.k_interval)
@@ -419,9 +423,11 @@ def _keep_clear(
             f"clearance ({margin:g} m): the halt below is the optimum over the limits alone",
         )
     best = min(candidates, key=lambda m: m.objective_value)
-    return best, (
+    stretch = tuple(float(v) / scale for v in best.k_interval)
+    return replace(best, k_interval=motion.k_interval, joint_intervals=motion.joint_intervals), (
         f"k moved from {float(motion.k) / scale:.6g} to {float(best.k) / scale:.6g} deg/s^6 to keep the clearance "
-        f"({margin:g} m): the halt at the optimum over the limits alone came closer",
+        f"({margin:g} m): the halts of k in [{stretch[0]:.6g}, {stretch[1]:.6g}] deg/s^6 keep it, the optimum "
+        "over the limits alone came closer",
     )
 
 
@@ -429,8 +435,8 @@ def _check_qf_clearance(model: ArmModel, qf: np.ndarray, settings: ClearanceSett
     """Refuse a given halt configuration closer than the clearance required (naming the pair)."""
     if not settings.required or not collision_pairs(model, settings.keep_out).names:
         return
-    result = clearance_of(model, as_joint_array(model, qf, name), keep_out=settings.keep_out)
-    if float(result.distance) < settings.margin:
+    result = clearance_of(model, qf, keep_out=settings.keep_out, margin=settings.margin)
+    if bool(result.colliding()):
         raise ScenarioError(
             f"{name}: the halt configuration keeps {float(result.distance):+.3f} m between {result.pair_at()} "
             f"(clearance required: {settings.margin:g} m); choose another, or turn the requirement off "

@@ -10,7 +10,7 @@ from typing import Any, Literal
 import numpy as np
 
 from ...analysis.ability import INDEX_NAMES, AbilityModel, JacobianKind, KinematicIndices
-from ...clearance import Clearance
+from ...collision import Clearance
 from ...model import FloatArray
 from ._bound import ReachabilityBound
 from ._reachability import HaltReachability
@@ -104,7 +104,7 @@ class HaltConfiguration:
     colliding_samples
         Samples excluded for coming closer than that (None when not required).
     best_clearance
-        Clearance of :attr:`q_best` (:class:`jointlock.clearance.Clearance`), whenever the
+        Clearance of :attr:`q_best` (:class:`jointlock.collision.Clearance`), whenever the
         model has collision shapes (None otherwise).
 
     With ``clearance_min_m``, :attr:`reachable` marks the samples that are reachable *and*

@@ -22,7 +22,7 @@ from ...analysis.ability import (
     configuration_indices,
     fit_ability_model,
 )
-from ...clearance import clearance, collision_pairs
+from ...collision import check_clearance_m, clearance, collision_pairs
 from ...errors import ConfigurationError, InfeasibleError
 from ...forward import COMPILED_MIN_BATCH
 from ...model import ArmModel, FloatArray, as_joint_array
@@ -132,7 +132,7 @@ def optimal_halt_configuration(
     clearance_min_m
         Beyond 000 (issue 27): the clearance a halt configuration must keep [m] between the
         arm's links, its spacecraft bus and the ``keep_out`` volumes
-        (:func:`jointlock.clearance.clearance`).  Samples closer than that are excluded like
+        (:func:`jointlock.collision.clearance`).  Samples closer than that are excluded like
         unreachable ones (they keep their CP in the fitted scale, but can be neither the best
         nor the runner-up; counted in ``colliding_samples``), and a refined point that comes
         closer is pulled back along its path from its start.  None (default, 000's search):
@@ -159,10 +159,7 @@ def optimal_halt_configuration(
         raise ConfigurationError(f"jacobian must be 'generalized' or 'fixed'; got {jacobian!r}")
     if int(refine_starts) < 1:
         raise ConfigurationError(f"refine_starts must be >= 1; got {refine_starts!r}")
-    if clearance_min_m is not None and not (
-        isinstance(clearance_min_m, (int, float)) and not isinstance(clearance_min_m, bool) and math.isfinite(clearance_min_m)
-    ):
-        raise ConfigurationError(f"clearance_min_m must be a finite number [m] or None; got {clearance_min_m!r}")
+    margin = 0.0 if clearance_min_m is None else check_clearance_m(clearance_min_m, "clearance_min_m")
     generator, seed = resolve_rng(rng)
     lo, hi, reachability, k_range = _search_box(model_locked, lower, upper, reachability)
     exact_reach = reachability if isinstance(reachability, HaltReachability) else None
@@ -182,8 +179,7 @@ def optimal_halt_configuration(
     checked = bool(collision_pairs(model_locked, keep_out).names)
     clear = None
     if clearance_min_m is not None and checked:
-        margin = float(clearance_min_m)
-        clear = clearance(model_locked, q, keep_out=keep_out).distance >= margin
+        clear = ~clearance(model_locked, q, keep_out=keep_out).colliding(margin)
         admissible = clear if reachable is None else clear & reachable
         if not admissible.any():
             raise InfeasibleError(
@@ -223,7 +219,7 @@ def optimal_halt_configuration(
         starts = q[order[: min(int(refine_starts), n_ok)]]
 
         def keeps_clear(qs: FloatArray) -> np.ndarray:
-            return clearance(model_locked, qs, keep_out=keep_out).distance >= float(clearance_min_m)  # type: ignore[arg-type]
+            return ~clearance(model_locked, qs, keep_out=keep_out).colliding(margin)
 
         refined_q, refined_cp, evaluations = _refine(
             exact, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None
@@ -271,9 +267,9 @@ def optimal_halt_configuration(
         reachable=reachable,
         reachable_samples=n_reachable,
         k_range=k_range,
-        clearance_min_m=None if clear is None else float(clearance_min_m),  # type: ignore[arg-type]
+        clearance_min_m=None if clear is None else margin,
         colliding_samples=None if clear is None else int(k - np.count_nonzero(clear)),
-        best_clearance=clearance(model_locked, best.q, keep_out=keep_out, margin=max(float(clearance_min_m or 0.0), 0.0))
+        best_clearance=clearance(model_locked, best.q, keep_out=keep_out, margin=margin)
         if checked
         else None,
     )

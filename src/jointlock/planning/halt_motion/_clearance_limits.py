@@ -1,6 +1,6 @@
 """Clearance of a halt (issue 27): which values of the shared ``k`` give a halt motion that keeps
 the clearance required between the arm's links, its spacecraft bus and keep-out volumes
-(:func:`jointlock.clearance.clearance`) on every sample of the constraint grid.
+(:func:`jointlock.collision.clearance`) on every sample of the constraint grid.
 
 A pair that is already closer than required at the state at failure (the same for every ``k``:
 the halt polynomial starts there) may not come closer still: its floor is its distance at
@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from ..._search1d import true_segments
-from ...clearance import clearance
+from ...collision import clearance
 from ...model import FloatArray
 from ...shapes import Shape
 from ._constants import CHUNK_SAMPLES
@@ -32,13 +32,14 @@ def clearance_shortfall(
     problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = ()
 ) -> FloatArray:
     """(...) the largest amount [m] by which a halt at ``k`` (...) [rad/s^6] comes closer than
-    allowed (``min(margin, distance at t = 0)`` for each pair) on the constraint grid; <= 0:
-    clear."""
+    allowed on the constraint grid (for each pair the smaller of its allowance, ``margin`` or 0
+    for a mounted pair, and its distance at ``t = 0``); <= 0: clear."""
     k = np.asarray(k, dtype=float)
     flat = k.reshape(-1)
     t = problem.times(problem.n_check)
     q0 = problem.trajectory(np.zeros(1), t[:1])[0][0, 0]
-    floor = np.minimum(margin, clearance(problem.model, q0, keep_out=keep_out).pair_distance)
+    at_failure = clearance(problem.model, q0, keep_out=keep_out)
+    floor = np.minimum(np.where(at_failure.mounted_pairs, 0.0, margin), at_failure.pair_distance)
     out = np.empty(flat.size)
     step = max(1, CHUNK_SAMPLES // t.size)
     for start in range(0, flat.size, step):

@@ -13,9 +13,13 @@ the full arm, 0 for the root body), so the pairs are the same before and after a
 * two shapes of one rigid body (a locked joint's two links included) are never checked;
 * adjacent links (``|i - j| = 1``, the root body being link 0) are never checked: a joint
   keeps them in contact by design;
-* pairs that overlap at the full arm's zero pose (every joint at 0) are listed in
-  :attr:`Clearance.ignored` and not checked: mounted parts (canadarm7's root lies inside the
-  box of its spacecraft's mass and inertia), not collisions;
+* pairs that overlap at the full arm's zero pose (every joint at 0) are *mounted*: parts in
+  contact by design (canadarm7's root lies inside the box of its spacecraft's mass and
+  inertia; puma6's zero-length elbow joins its upper arm and forearm).  Each is measured from
+  its depth there (its distance is how much less deep it is than at the zero pose: 0 as
+  mounted, negative when it goes deeper) and is exempt from a clearance margin, so that a boom
+  mounted on the bus's face is flagged when it swings into the bus, never for touching it;
+  :attr:`Clearance.mounted` lists them;
 * a keep-out volume is checked against every link but not the root body (both are fixed).
 
 Distances are exact for capsule-capsule (spheres included) and capsule-box pairs and are
@@ -26,7 +30,6 @@ supported yet (refused in one line).
 
 from __future__ import annotations
 
-import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
@@ -35,7 +38,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._cache import cached_on
-from .bounds import shown
+from .bounds import MAX_LENGTH_M, as_real, shown
 from .errors import ConfigurationError, ModelError
 from .forward import DEFAULT_CHUNK, chain_state
 from .model import ArmModel, FloatArray, as_joint_array
@@ -64,8 +67,9 @@ class CollisionPairs:
         (P,) ``"link3 - bus"``: the two shapes' names.
     links
         (P, 2) the two shapes' links (full-arm joint numbers, 0 the root body, -1 a keep-out).
-    ignored
-        The pairs in contact at the zero pose, not checked.
+    offsets
+        (P,) a mounted pair's signed distance at the full arm's zero pose [m] (< 0), from which
+        it is measured; 0 for the others.
     keys
         (P,) each pair's shapes as ``(link, name, link, name)``.
     """
@@ -79,8 +83,13 @@ class CollisionPairs:
     pairs: np.ndarray
     names: tuple[str, ...]
     links: np.ndarray
-    ignored: tuple[str, ...] = ()
+    offsets: FloatArray = field(default_factory=lambda: np.zeros(0))
     keys: tuple[tuple[int, str, int, str], ...] = ()
+
+    @property
+    def mounted(self) -> tuple[str, ...]:
+        """The mounted pairs (in contact at the full arm's zero pose)."""
+        return tuple(name for name, offset in zip(self.names, self.offsets) if offset < 0)
 
 
 def _shape_name(shape: Shape) -> str:
@@ -108,7 +117,7 @@ def _checked(link_a: int, link_b: int, body_a: int, body_b: int) -> bool:
     return abs(link_a - link_b) > 1
 
 
-def _build(model: ArmModel, keep_out: Sequence[Shape], ignored: frozenset[tuple[int, str, int, str]]) -> CollisionPairs:
+def _build(model: ArmModel, keep_out: Sequence[Shape], mounted: dict[tuple[int, str, int, str], float]) -> CollisionPairs:
     shapes = _collect(model, keep_out)
     capsules = [(b, s) for b, s in shapes if isinstance(s, (Capsule, Sphere))]
     boxes = [(b, s) for b, s in shapes if isinstance(s, Box)]
@@ -116,21 +125,22 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], ignored: frozenset[tuple[
     names: list[str] = []
     links: list[tuple[int, int]] = []
     keys: list[tuple[int, str, int, str]] = []
-    skipped: list[str] = []
+    offsets: list[float] = []
+    seen: dict[tuple[int, str, int, str], int] = {}
 
     def add(kind: int, i: int, j: int, a: tuple[int, Shape], b: tuple[int, Shape]) -> None:
         la, lb = int(a[1].link), int(b[1].link)  # type: ignore[arg-type]
         if not _checked(la, lb, a[0], b[0]):
             return
         key = (la, _shape_name(a[1]), lb, _shape_name(b[1]))
-        name = f"{key[1]} - {key[3]}"
-        if key in ignored:
-            skipped.append(name)
-            return
+        seen[key] = seen.get(key, 0) + 1
+        if seen[key] > 1:  # two shapes of one name on a link: every pair keeps its own name
+            key = (la, key[1], lb, f"{key[3]} #{seen[key]}")
         pairs.append((kind, i, j))
-        names.append(name)
+        names.append(f"{key[1]} - {key[3]}")
         links.append((la, lb))
         keys.append(key)
+        offsets.append(mounted.get(key, 0.0))
 
     for i in range(len(capsules)):
         for j in range(i + 1, len(capsules)):
@@ -161,34 +171,35 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], ignored: frozenset[tuple[
         pairs=np.array(pairs, dtype=np.int64).reshape(-1, 3),
         names=tuple(names),
         links=np.array(links, dtype=np.int64).reshape(-1, 2),
-        ignored=tuple(skipped),
+        offsets=np.array(offsets, dtype=float),
         keys=tuple(keys),
     )
 
 
-def _zero_pose_contacts(model: ArmModel) -> frozenset[tuple[int, str, int, str]]:
-    """The model's own pairs (no keep-outs) that overlap at the full arm's zero pose."""
+def _zero_pose_contacts(model: ArmModel) -> dict[tuple[int, str, int, str], float]:
+    """The model's own pairs (no keep-outs) that overlap at the full arm's zero pose, with their
+    signed distance there [m] (a pair touching at exactly 0 is mounted at -1e-12 m)."""
     full = model.unlocked if model.locked and model.unlocked is not None else model
-    pairs = _build(full, (), frozenset())
+    pairs = _build(full, (), {})
     if not len(pairs.names):
-        return frozenset()
+        return {}
     distance, _, _ = _distances(full, pairs, np.zeros((1, full.dof)))
-    return frozenset(key for key, d in zip(pairs.keys, distance[0]) if d <= 0.0)
+    return {key: min(float(d), -1e-12) for key, d in zip(pairs.keys, distance[0]) if d <= 0.0}
 
 
 def collision_pairs(model: ArmModel, keep_out: Sequence[Shape] = ()) -> CollisionPairs:
     """The shapes and the pairs :func:`clearance` checks on ``model`` with ``keep_out`` volumes
     (shapes in the root frame); see the module for the rules."""
     keep = check_shapes(keep_out, "keep_out")
-    ignored = cached_on(model, "zero_pose_contacts", lambda: _zero_pose_contacts(model))
+    mounted = cached_on(model, "zero_pose_contacts", lambda: _zero_pose_contacts(model))
     if not keep:
-        return cached_on(model, "collision_pairs", lambda: _build(model, (), ignored))
-    return _build(model, keep, ignored)
+        return cached_on(model, "collision_pairs", lambda: _build(model, (), mounted))
+    return _build(model, keep, mounted)
 
 
 def _distances(model: ArmModel, pairs: CollisionPairs, q: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
-    """(N, P) signed distances, (N,) closest pair and (N, 2, 3) its witness points of
-    configurations q (N, n)."""
+    """(N, P) signed distances (a mounted pair's from its zero-pose depth), (N,) closest pair and
+    (N, 2, 3) its witness points of configurations q (N, n)."""
     from ._kernels._distance import pair_distances
 
     count = q.shape[0]
@@ -229,6 +240,7 @@ def _distances(model: ArmModel, pairs: CollisionPairs, q: FloatArray) -> tuple[F
             boxes,
             np.ascontiguousarray(pairs.box_halves if n_boxes else np.ones((1, 3))),
             np.ascontiguousarray(pairs.pairs),
+            np.ascontiguousarray(pairs.offsets),
             distance[start:stop],
             closest[start:stop],
             witness[start:stop],
@@ -243,18 +255,25 @@ class Clearance:
     Attributes
     ----------
     distance
-        (...,) smallest signed distance over the checked pairs [m]; negative: overlap.  +inf
-        when no pair is checked.
+        (...,) smallest signed distance over the checked pairs [m]; negative: overlap.  A mounted
+        pair counts only when it is deeper than at the zero pose (then by how much deeper).
+        +inf when no pair counts.
     closest
         (...,) index into ``names`` of the pair that gives it.
     witness
-        (..., 2, 3) points on its two shapes, root frame [m] (``|w[1] - w[0]| = |distance|``).
+        (..., 2, 3) points on its two shapes, root frame [m]: the closest points of separate
+        shapes, the deepest point of the first and where it would have to go for overlapping
+        ones (``|w[1] - w[0]|`` is the raw distance, a mounted pair's too).
     pair_distance
-        (..., P) every checked pair's signed distance [m].
+        (..., P) every checked pair's signed distance [m] (a mounted pair's from its depth at the
+        zero pose).
     names
         (P,) the checked pairs, ``"link3 - bus"``.
-    ignored
-        The pairs not checked because they overlap at the full arm's zero pose.
+    mounted_pairs
+        (P,) True for the mounted pairs (in contact at the full arm's zero pose): exempt from
+        the margin, they must not go deeper than there.
+    margin
+        The clearance required of the other pairs [m] (:meth:`colliding`).
     """
 
     distance: FloatArray
@@ -262,63 +281,80 @@ class Clearance:
     witness: FloatArray
     pair_distance: FloatArray
     names: tuple[str, ...]
-    ignored: tuple[str, ...] = ()
-    margin: float = field(default=0.0)
+    mounted_pairs: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    margin: float = 0.0
 
     @property
-    def closest_pair(self) -> np.ndarray:
-        """(...,) the name of the closest pair of each configuration (``""`` without pairs)."""
-        table = np.array(self.names + ("",), dtype=object)
-        index = np.where(np.isfinite(self.distance), self.closest, len(self.names))
-        return np.asarray(table[index], dtype=object)
+    def mounted(self) -> tuple[str, ...]:
+        """The names of the mounted pairs."""
+        return tuple(n for n, m in zip(self.names, self.mounted_pairs) if m)
 
     def pair_at(self, index: tuple[int, ...] = ()) -> str:
         """The name of the closest pair of the configuration at ``index``."""
         return self.names[int(self.closest[index])] if self.names else ""
 
+    def shortfall(self, margin: float | None = None) -> FloatArray:
+        """(..., P) by how much [m] each pair comes closer than allowed: ``margin`` (default the
+        result's) for most pairs, 0 for a mounted one (no deeper than at the zero pose); <= 0:
+        allowed."""
+        margin = self.margin if margin is None else check_clearance_m(margin, "margin")
+        return np.where(self.mounted_pairs, 0.0, margin) - self.pair_distance
+
     def colliding(self, margin: float | None = None) -> np.ndarray:
-        """(...,) True where the clearance is below ``margin`` [m] (default: the result's)."""
-        return np.asarray(self.distance < (self.margin if margin is None else margin))
+        """(...,) True where a pair comes closer than allowed (:meth:`shortfall`)."""
+        if not self.names:
+            return np.zeros(self.distance.shape, dtype=bool)
+        return np.asarray(np.any(self.shortfall(margin) > 0, axis=-1))
 
     def worst(self) -> tuple[int, ...]:
-        """Index of the configuration with the smallest clearance."""
-        return tuple(int(i) for i in np.unravel_index(int(np.argmin(self.distance)), self.distance.shape)) if self.distance.size else ()
+        """Index of the configuration with the smallest clearance (``()`` for one configuration
+        or none)."""
+        if self.distance.size == 0 or self.distance.ndim == 0:
+            return ()
+        return tuple(int(i) for i in np.unravel_index(int(np.argmin(self.distance)), self.distance.shape))
 
     def summary(self) -> str:
-        """One line: the smallest clearance, the pair and, for a batch, how many are below the
-        margin."""
+        """One line: the smallest clearance, the pair and, for a batch, how many come closer than
+        allowed."""
         if not self.names:
             return "clearance: no pair checked (the model has no collision shapes)"
+        if self.distance.size == 0:
+            return f"clearance: no configuration ({len(self.names)} pairs checked)"
         at = self.worst()
         d = float(self.distance[at])
-        pair = self.pair_at(at)
-        verdict = "COLLIDES" if d < 0 else ("below the margin" if d < self.margin else "clear")
-        text = f"clearance {d:+.4f} m ({pair}): {verdict}"
+        verdict = "COLLIDES" if d < 0 else ("below the margin" if bool(self.colliding()[at]) else "clear")
+        text = f"clearance {d:+.4f} m ({self.pair_at(at)}): {verdict}"
         if self.margin:
             text += f" (margin {self.margin:g} m)"
         if self.distance.size > 1:
             below = int(np.count_nonzero(self.colliding()))
-            text = f"smallest {text}; {below} of {self.distance.size} configurations below {self.margin:g} m"
+            text = f"smallest {text}; {below} of {self.distance.size} configurations closer than allowed"
         return text
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data: the smallest clearance [m], its pair and witness points, each pair's
-        smallest distance, the margin and how many configurations are below it."""
+        smallest distance, the margin and how many configurations come closer than allowed."""
+        base = {"checked_pairs": list(self.names), "mounted_pairs": list(self.mounted), "margin_m": self.margin}
         if not self.names or not self.distance.size:
-            return {"checked_pairs": [], "ignored_pairs": list(self.ignored), "min_clearance_m": None}
+            return {**base, "min_clearance_m": None, "configurations": int(self.distance.size)}
         at = self.worst()
         flat = self.pair_distance.reshape(-1, len(self.names))
         return {
+            **base,
             "min_clearance_m": float(self.distance[at]),
             "closest_pair": self.pair_at(at),
             "witness_points_m": self.witness[at].tolist(),
-            "margin_m": self.margin,
             "configurations": int(self.distance.size),
-            "below_margin": int(np.count_nonzero(self.colliding())),
+            "closer_than_allowed": int(np.count_nonzero(self.colliding())),
             "pair_min_clearance_m": {name: float(v) for name, v in zip(self.names, flat.min(axis=0))},
-            "checked_pairs": list(self.names),
-            "ignored_pairs": list(self.ignored),
         }
+
+
+def check_clearance_m(value: object, name: str) -> float:
+    """``value`` as a clearance [m]: a real number (numpy's too), finite, >= 0, at most
+    :data:`~jointlock.bounds.MAX_LENGTH_M`; a :class:`~jointlock.errors.ConfigurationError`
+    naming ``name`` otherwise."""
+    return as_real(value, name, lo=0.0, hi=MAX_LENGTH_M, unit="m", error=ConfigurationError)
 
 
 def clearance(
@@ -345,20 +381,22 @@ def clearance(
         Negative distances are penetration depths; see the module for the pairs checked.
     """
     q = as_joint_array(model, q)
-    if not (isinstance(margin, (int, float)) and not isinstance(margin, bool) and math.isfinite(margin) and margin >= 0):
-        raise ConfigurationError(f"margin must be a finite clearance >= 0 [m]; got {shown(margin)}")
+    margin = check_clearance_m(margin, "margin")
     pairs = collision_pairs(model, keep_out)
     batch = q.shape[:-1]
     distance, closest, witness = _distances(model, pairs, q.reshape(-1, model.dof))
-    smallest = distance.min(axis=1) if distance.shape[1] else np.full(distance.shape[0], np.inf)
+    # the smallest over the pairs, a mounted one only when it is deeper than at the zero pose
+    mounted = pairs.offsets < 0
+    ranked = np.where(mounted & (distance >= 0.0), np.inf, distance)
+    smallest = ranked.min(axis=1) if distance.shape[1] else np.full(distance.shape[0], np.inf)
     return Clearance(
         distance=smallest.reshape(batch),
         closest=closest.reshape(batch),
         witness=witness.reshape(batch + (2, 3)),
         pair_distance=distance.reshape(batch + (distance.shape[1],)),
         names=pairs.names,
-        ignored=pairs.ignored,
-        margin=float(margin),
+        mounted_pairs=mounted,
+        margin=margin,
     )
 
 
@@ -388,16 +426,13 @@ class ClearanceSettings:
 
     def __post_init__(self) -> None:
         if self.min_m is not None:
-            value = self.min_m
-            if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) or value < 0:
-                raise ConfigurationError(f"clearance min_m must be a finite clearance >= 0 [m] or None; got {shown(value)}")
-            object.__setattr__(self, "min_m", float(value))
+            object.__setattr__(self, "min_m", check_clearance_m(self.min_m, "clearance min_m"))
         object.__setattr__(self, "keep_out", check_shapes(self.keep_out, "keep_out"))
 
     @classmethod
     def off(cls, keep_out: Sequence[Shape] = ()) -> ClearanceSettings:
         """Clearance reported, not required (the papers' way)."""
-        return cls(min_m=None, keep_out=tuple(keep_out))
+        return cls(min_m=None, keep_out=keep_out)  # type: ignore[arg-type]
 
     @property
     def required(self) -> bool:
