@@ -295,6 +295,9 @@ def test_the_search_excludes_configurations_closer_than_required_and_refines_wit
     assert kept.to_dict()["clearance"]["colliding_samples"] == kept.colliding_samples
     with pytest.raises(jl.InfeasibleError, match="keeps a clearance of 50 m"):
         optimal_halt_configuration(arm, samples=200, rng=1, clearance_min_m=50.0)
+    # the post and link 2 are 0.3 m apart whatever the angles: the error names them
+    with pytest.raises(jl.InfeasibleError, match=r"of 0.4 m .*the nearest keeps \+0.300 m between post - link2"):
+        optimal_halt_configuration(arm, samples=200, rng=1, clearance_min_m=0.4)
 
 
 def test_a_given_halt_configuration_closer_than_required_is_refused_naming_the_pair():
@@ -596,3 +599,18 @@ def test_crossing_capsules_have_witness_points_their_depth_apart():
                    np.array([[0, 0, 1]], dtype=np.int64), np.zeros(1), dist, closest, witness)  # fmt: skip
     assert np.allclose(dist[:, 0], -0.1, atol=1e-12)
     assert np.allclose(np.linalg.norm(witness[:, 1] - witness[:, 0], axis=1), 0.1, atol=1e-9)
+
+
+def test_a_report_opens_with_the_clearance_verdict(tmp_path):
+    """000's scenario: the state at failure is already 0.051 m into halt7's bus, so the run
+    report's first section says so, before the scenario itself."""
+    from pathlib import Path
+
+    examples = Path(__file__).resolve().parents[1] / "examples"
+    scenario = jl.load_scenario(examples / "halt_000.toml", {"halt_config.samples": 2000, "halt.n_samples": 101})
+    jl.run_scenario(scenario).write(tmp_path)
+    page = (tmp_path / "report.html").read_text()
+    first = page.index("<h2")
+    assert page[first:].startswith('<h2 id="') and "Clearance: read this first" in page[first : first + 200]
+    assert "the state at failure already reaches 0.051 m into link3 - bus" in page
+    assert page.index("Clearance: read this first</h2>") < page.index("Scenario</h2>")

@@ -319,8 +319,6 @@ def add_clearance_options(p: argparse.ArgumentParser) -> None:
 
 def clearance_from_args(args: argparse.Namespace) -> Any:
     """The :class:`~jointlock.collision.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``."""
-    from ..jobs._common import scenario_clearance
+    from ..jobs._common import clearance_settings
 
-    return scenario_clearance(
-        {"limits": {"clearance_min_m": args.clearance_min_m, "check_clearance": not args.no_clearance}}
-    )
+    return clearance_settings(args.clearance_min_m, not args.no_clearance)

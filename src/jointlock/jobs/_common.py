@@ -159,14 +159,20 @@ def scenario_locks(data: Mapping[str, Any]) -> dict[int, float]:
     return {**{int(j): math.radians(float(a)) for j, a in earlier.items()}, lk[0]: lk[1]}
 
 
-def scenario_clearance(data: Mapping[str, Any]) -> ClearanceSettings:
-    """The clearance a resolved scenario requires (``[limits] clearance_min_m``, turned off by
-    ``[limits] check_clearance = false``: reported only)."""
-    lim = data.get("limits") or {}
-    minimum = lim.get("clearance_min_m")
-    if lim.get("check_clearance") is False:
+def clearance_settings(minimum_m: float | None, check: bool = True) -> ClearanceSettings:
+    """The clearance required: ``minimum_m`` [m] (None: the default,
+    :data:`~jointlock.collision.DEFAULT_CLEARANCE_MIN_M`), or reported only when ``check`` is
+    False (``--no-clearance``, ``[limits] check_clearance = false``)."""
+    if not check:
         return ClearanceSettings.off()
-    return ClearanceSettings(DEFAULT_CLEARANCE_MIN_M if minimum is None else float(minimum))
+    return ClearanceSettings(DEFAULT_CLEARANCE_MIN_M if minimum_m is None else minimum_m)
+
+
+def scenario_clearance(data: Mapping[str, Any]) -> ClearanceSettings:
+    """The clearance a resolved scenario requires (``[limits] clearance_min_m`` and
+    ``check_clearance``, :func:`clearance_settings`)."""
+    lim = data.get("limits") or {}
+    return clearance_settings(lim.get("clearance_min_m"), lim.get("check_clearance") is not False)
 
 
 def locked_deg(model: ArmModel) -> dict[str, float]:

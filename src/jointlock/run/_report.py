@@ -72,6 +72,7 @@ def report_sections(
     locks = scenario_locks(scenario.data)
     locked = lock_joints(full, locks) if locks else None
     return [
+        *_safety_section(jobs),
         *_scenario_section(scenario, jobs, full, locked, results["versions"]),
         *_failure_section(scenario, jobs, full, locked),
         *_decisions_section(scenario, jobs, full, locked),
@@ -79,6 +80,31 @@ def report_sections(
         *_figure_sections(scenario, jobs, full, locked, typed, out),
         Section("Assumptions and readings", notes=assumptions(scenario, full)),
         _references_section(scenario),
+    ]
+
+
+def _safety_section(jobs: dict[str, Any]) -> list[Section]:
+    """First, when a job's answer comes closer than allowed to the spacecraft bus or the arm
+    itself (issue 27): the verdict each such job gives as its first line."""
+    lines = []
+    halt = (jobs.get("halt") or {}).get("result") or {}
+    verdict = (halt.get("clearance") or {}).get("verdict")
+    if verdict:
+        lines.append(("halt", verdict))
+    replan = ((jobs.get("replan") or {}).get("result") or {}).get("clearance") or {}
+    if replan.get("colliding_waypoints"):
+        lines.append(
+            ("replan", f"COLLIDES: {replan['colliding_waypoints']} waypoints overlap; deepest {-replan['min_m']:.3f} m "
+                       f"into {replan['pair']} at t = {replan['time_s']:g} s")
+        )  # fmt: skip
+    if not lines:
+        return []
+    return [
+        Section(
+            "Clearance: read this first",
+            paragraphs=[f"<b>{html.escape(job)}</b>: {html.escape(text)}" for job, text in lines],
+            notes=["Collision geometry, the pairs checked and the mounted pairs: docs/clearance.md."],
+        )
     ]
 
 

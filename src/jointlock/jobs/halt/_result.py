@@ -264,8 +264,12 @@ class HaltPlan(JobResult):
         settings = self.clearance_settings
         if not collision_pairs(p.model, settings.keep_out).names:
             return None
-        q, _, _ = self.motion.trajectory(p.times(p.n_check))
-        return clearance(p.model, q, keep_out=settings.keep_out, margin=settings.margin)
+
+        def compute() -> Clearance:
+            q, _, _ = self.motion.trajectory(p.times(p.n_check))
+            return clearance(p.model, q, keep_out=settings.keep_out, margin=settings.margin)
+
+        return cached_on(self, "clearance", compute)
 
     def _clearance_dict(self) -> dict[str, Any] | None:
         return cached_on(self, "clearance_dict", self._compute_clearance_dict)

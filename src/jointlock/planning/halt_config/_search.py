@@ -179,13 +179,20 @@ def optimal_halt_configuration(
     checked = bool(collision_pairs(model_locked, keep_out).names)
     clear = None
     if clearance_min_m is not None and checked:
-        clear = ~clearance(model_locked, q, keep_out=keep_out).colliding(margin)
+        sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin)
+        clear = ~sampled.colliding()
         admissible = clear if reachable is None else clear & reachable
         if not admissible.any():
+            # the sample that comes nearest to keeping it, and the pair that stops it
+            short = sampled.shortfall()
+            pool = np.flatnonzero(reachable) if reachable is not None and reachable.any() else np.arange(k)
+            near = pool[int(np.argmin(short[pool].max(axis=1)))]
+            pair = int(np.argmax(short[near]))
             raise InfeasibleError(
                 f"none of the {k} samples keeps a clearance of {margin:g} m"
                 + ("" if reachable is None else f" among the {int(reachable.sum())} reachable")
-                + " (links, spacecraft bus, keep-outs): lower clearance_min_m, widen the ranges or raise samples"
+                + f" (links, spacecraft bus, keep-outs); the nearest keeps {sampled.pair_distance[near, pair]:+.3f} m "
+                f"between {sampled.names[pair]}: lower clearance_min_m, widen the ranges or raise samples"
             )
         reachable = admissible
     ind = configuration_indices(
