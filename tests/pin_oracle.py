@@ -104,20 +104,9 @@ def to_pinocchio_geometry(model: jl.ArmModel, pm):
 
     capsules = []
     for c, (body, points, radius) in enumerate(zip(pairs.capsule_body, pairs.capsule_points, pairs.capsule_radii)):
-        a, b = points[:3], points[3:]
-        length = float(np.linalg.norm(b - a))
-        frame = np.eye(4)
-        frame[:3, 3] = (a + b) / 2
-        if length > 0:
-            z = (b - a) / length
-            helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-            x = np.cross(helper, z)
-            x /= np.linalg.norm(x)
-            frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
-            shape = coal.Capsule(float(radius), length)
-        else:
-            shape = coal.Sphere(float(radius))
-        capsules.append(add(f"capsule{c}", int(body), shape, frame))
+        capsule = jl.Capsule(points[:3], points[3:], float(radius))
+        shape = coal.Capsule(capsule.radius, capsule.length) if capsule.length > 0 else coal.Sphere(capsule.radius)
+        capsules.append(add(f"capsule{c}", int(body), shape, capsule.frame))
     boxes = [
         add(f"box{b}", int(body), coal.Box(*(2 * half)), pose)
         for b, (body, pose, half) in enumerate(zip(pairs.box_body, pairs.box_poses, pairs.box_halves))

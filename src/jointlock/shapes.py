@@ -129,6 +129,21 @@ class Capsule:
         """Length of the segment [m]."""
         return float(np.linalg.norm(self.b - self.a))
 
+    @property
+    def frame(self) -> FloatArray:
+        """(4, 4) a frame at the segment's middle with its ``z`` axis along ``b - a`` (any
+        orientation for a sphere): where tools that centre a capsule or cylinder on its ``z``
+        axis (URDF, coal) place it."""
+        frame = np.eye(4)
+        frame[:3, 3] = (self.a + self.b) / 2
+        if self.length > 0:
+            z = (self.b - self.a) / self.length
+            helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+            x = np.cross(helper, z)
+            x /= np.linalg.norm(x)
+            frame[:3, :3] = np.column_stack([x, np.cross(z, x), z])
+        return frame
+
     def transformed(self, pose: ArrayLike) -> Capsule:
         """The same capsule in another frame; ``pose`` (4, 4) is T_new_old."""
         pose = np.asarray(pose, dtype=float)

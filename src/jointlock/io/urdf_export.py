@@ -89,12 +89,7 @@ def _collisions(body: Body) -> str:
             center = shape.center if isinstance(shape, Sphere) else shape.a
             parts = [(pose(np.eye(3), center), f'<sphere radius="{_num(shape.radius)}"/>')]
         else:
-            axis = (shape.b - shape.a) / shape.length
-            helper = np.array([1.0, 0.0, 0.0]) if abs(axis[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-            x = np.cross(helper, axis)
-            x /= np.linalg.norm(x)
-            frame = pose(np.column_stack([x, np.cross(axis, x), axis]), (shape.a + shape.b) / 2)
-            parts = [(frame, f'<cylinder radius="{_num(shape.radius)}" length="{_num(shape.length)}"/>')]
+            parts = [(shape.frame, f'<cylinder radius="{_num(shape.radius)}" length="{_num(shape.length)}"/>')]
             parts += [(pose(np.eye(3), end), f'<sphere radius="{_num(shape.radius)}"/>') for end in (shape.a, shape.b)]
         names = [name] + [quoteattr(f"{shape.name or body.name or 'shape'}/end{k}") for k in (1, 2)]
         out += [

@@ -11,6 +11,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .._cache import cached_on
 from ..collision import clearance, collision_pairs
 from ..ik import IKResult, solve_ik, zyx_angles
 from ..io.files import atomic_write_json
@@ -58,9 +59,12 @@ class InverseKinematicsReport(JobResult):
         solutions = self.result.solutions
         if not solutions or not collision_pairs(self.model).names:
             return None
-        q = self.model.healthy(np.array([s.q_full for s in solutions]))
-        result = clearance(self.model, q)
-        return [(float(result.distance[i]), result.pair_at((i,))) for i in range(len(solutions))]
+
+        def compute() -> list[tuple[float, str]]:
+            result = clearance(self.model, self.model.healthy(np.array([s.q_full for s in solutions])))
+            return [(float(result.distance[i]), result.pair_at((i,))) for i in range(len(solutions))]
+
+        return cached_on(self, "clearances", compute)
 
     def ranked(self) -> list[tuple[Any, tuple[float, str] | None]]:
         """The solutions with their clearance, the colliding ones last (the solver's order

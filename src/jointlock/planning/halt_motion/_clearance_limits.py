@@ -37,8 +37,7 @@ def clearance_shortfall(
     k = np.asarray(k, dtype=float)
     flat = k.reshape(-1)
     t = problem.times(problem.n_check)
-    q0 = problem.trajectory(np.zeros(1), t[:1])[0][0, 0]
-    at_failure = clearance(problem.model, q0, keep_out=keep_out)
+    at_failure = clearance(problem.model, problem.q0, keep_out=keep_out)
     floor = np.minimum(np.where(at_failure.mounted_pairs, 0.0, margin), at_failure.pair_distance)
     out = np.empty(flat.size)
     step = max(1, CHUNK_SAMPLES // t.size)
