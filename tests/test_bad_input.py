@@ -399,6 +399,36 @@ def test_a_long_value_is_shortened_in_the_error(capsys):
     assert shown("y" * 5000).endswith("...") and len(shown("y" * 5000)) == 80
 
 
+@pytest.mark.parametrize(
+    "urdf",
+    [
+        "<" + "N" * 10_000 + "/>",  # the root element's tag
+        '<?xml version="1.0"?><!DOCTYPE r [<!ENTITY a "' + "A" * 100 + '"><!ENTITY b "' + "&a;" * 100
+        + '">]><robot name="r"><link name="base"/><joint name="j" type="revolute"><parent link="base"/>'
+        '<child link="&b;"/><axis xyz="0 0 1"/></joint></robot>',
+    ],
+    ids=["long-root-tag", "entity-in-a-link-name"],
+)
+def test_a_urdf_with_a_very_long_name_is_shortened_in_the_error(tmp_path, capsys, urdf):
+    """The held-out fuzz (issue 30): a 10,000-character name, or an entity expanded to one, is
+    echoed shortened (the URDF reader shortens what it quotes; the command line cuts any longer
+    run as the net)."""
+    path = tmp_path / "long.urdf"
+    path.write_text(urdf)
+    code, _, err = cli(capsys, "kinematics", str(path))
+    assert_one_error_line(code, err)
+    assert len(err) < 400 and "..." in err
+
+
+def test_the_error_line_net_cuts_long_words():
+    from jointlock.cli import LONGEST_WORD, _short_words
+
+    assert _short_words("ok: short words stay") == "ok: short words stay"
+    cut = _short_words("name 'x" + "y" * 5000 + "' is bad")
+    assert cut.startswith("name 'xyy") and cut.endswith("... is bad") and len(cut) < 100
+    assert _short_words("p" * LONGEST_WORD) == "p" * LONGEST_WORD
+
+
 def test_a_scenario_field_holding_a_long_string_is_shortened(tmp_path):
     path = _write(tmp_path / "s.toml", 'robot = "halt7"\nbase = "' + "z" * 5000 + '"\n[workspace]\n')
     with pytest.raises(ScenarioError) as info:

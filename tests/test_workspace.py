@@ -144,3 +144,37 @@ def test_cli_workspace_text_has_few_digits_and_the_half_estimate(capsys):
     assert main(["workspace", "halt7", "--lock", "4=0", "--samples", "20000", "--json"]) == 0
     out = json.loads(capsys.readouterr().out)
     assert out["warnings"] and 0 < out["share_kept_half_samples"] < 2 and out["samples_per_voxel"] > 2
+
+
+# -- held-out fuzz loose ends (issue 30): no estimate said in words, warnings after the figures ----
+
+
+def test_comparison_without_estimate_says_so(puma):
+    """``compare_workspaces`` with too few samples: the NaN volumes and share read "no estimate"
+    in ``summary()`` and ``to_dict()`` (numbers None, the text beside them), not a bare NaN."""
+    cmp = jl.compare_workspaces(puma, 3, 0.0, samples=1000, rng=0)
+    assert math.isnan(cmp.volume_full) and math.isnan(cmp.share_kept)
+    d = cmp.to_dict()
+    assert d["volume_full_m3"] is None and d["share_kept"] is None and d["share_kept_error"] is None
+    assert d["volume_full_text"] == "no estimate (too few samples)" and d["share_kept_text"] == "no estimate"
+    json.dumps(d, allow_nan=False)  # strict JSON: no NaN anywhere
+    text = "\n".join(cmp.summary())
+    assert "nan" not in text.lower() and text.count("no estimate") == 3
+    # a converged run has numbers in both forms
+    ok = jl.compare_workspaces(puma, 2, math.radians(60), samples=200_000, rng=0)
+    assert ok.to_dict()["share_kept"] == pytest.approx(ok.share_kept) and "%" in ok.to_dict()["share_kept_text"]
+    one = sample_workspace(puma, samples=1000, rng=0).to_dict()
+    assert one["volume_full_m3"] is None and one["volume_full_text"].startswith("no estimate")
+
+
+def test_one_joint_left_has_no_share_and_no_traceback(capsys):
+    """Every joint but one locked: the arm before the failure has a one-joint curve (volume 0),
+    so the share kept has no estimate (it divided by zero before); the warnings come after every
+    figure is computed, and the run exits 0."""
+    locks = [a for j in range(1, 6) for a in ("--lock", f"{j}=0")]
+    assert main(["workspace", "puma6", *locks, "--samples", "1000"]) == 0
+    captured = capsys.readouterr()
+    assert "share kept        : no estimate" in captured.out
+    assert "warning" in captured.err and "Traceback" not in captured.err
+    assert main(["workspace", "puma6", *locks, "--samples", "1000", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["share_kept"] is None

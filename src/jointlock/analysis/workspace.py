@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -50,8 +51,14 @@ __all__ = [
     "projection_extent",
     "sample_configurations",
     "sample_workspace",
+    "share_text",
+    "volume_text",
     "voxel_keys",
 ]
+
+#: What the text forms say for a NaN or missing volume, and for a share without one.
+NO_VOLUME = "no estimate (too few samples)"
+NO_SHARE = "no estimate"
 
 #: Mean full-arm samples per voxel of the bounding box when the voxel side is chosen [-].
 SAMPLES_PER_VOXEL = 16.0
@@ -110,6 +117,24 @@ def _auto_voxel(points: FloatArray) -> float:
     return (box * SAMPLES_PER_VOXEL / points.shape[0]) ** (1.0 / 3.0)
 
 
+def volume_text(volume: float | None, error: float | None) -> str:
+    """``"V ± err m^3"`` (the error to 2 significant digits, the volume to the same decimal
+    place: ``"13.9 ± 1.0 m^3"``, ``"14.10 ± 0.63 m^3"``), or ``"no estimate (too few samples)"``
+    for a NaN or missing volume (``None``: the JSON form)."""
+    if volume is None or error is None or not (math.isfinite(volume) and math.isfinite(error)):
+        return NO_VOLUME
+    if error <= 0:
+        return f"{volume:.3g} ± 0 m^3"
+    places = max(0, 1 - math.floor(math.log10(error)))
+    return f"{volume:.{places}f} ± {error:.{places}f} m^3"
+
+
+def share_text(share: float | None, error: float | None) -> str:
+    """``"S ± err %"`` (whole percent), or ``"no estimate"`` for a NaN or missing share."""
+    if share is None or error is None or not (math.isfinite(share) and math.isfinite(error)):
+        return NO_SHARE
+    return f"{100 * share:.0f} ± {100 * error:.0f} %"
+
 @dataclass(frozen=True)
 class Workspace:
     """Monte Carlo workspace of one arm.
@@ -154,6 +179,28 @@ class Workspace:
     def warnings(self) -> list[str]:
         """Why there is no volume estimate (empty when there is one)."""
         return [self.estimate.warning] if self.estimate.warning else []
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON values: the volume, its error and the samples per voxel as numbers, ``None``
+        where there is no estimate, and ``volume_text`` saying so in words ("no estimate (too
+        few samples)")."""
+        return {
+            "voxel_m": self.voxel,
+            "volume_full_m3": _number(self.volume),
+            "volume_full_error_m3": _number(self.volume_error),
+            "occupancy_full_m3": self.occupancy,
+            "extent_full_m": projection_extent(self.points),
+            "samples_per_voxel": _number(self.samples_per_voxel),
+            "volume_full_text": volume_text(self.volume, self.volume_error),
+            "warnings": self.warnings(),
+        }
+
+    def summary(self, name: str = "full arm") -> list[str]:
+        """The volume line, indented (``name``: how the arm is called)."""
+        return [
+            f"  {name + ' volume':<18}: {volume_text(self.volume, self.volume_error)} "
+            f"(occupancy at the voxel: {self.occupancy:.3g} m^3)"
+        ]
 
 
 def sample_workspace(
@@ -248,16 +295,18 @@ class WorkspaceComparison:
 
     @property
     def share_kept(self) -> float:
-        """``volume_locked / volume_full`` [-], at most 1 (the locked workspace is a subset)."""
-        ratio = self.volume_locked / self.volume_full
+        """``volume_locked / volume_full`` [-], at most 1 (the locked workspace is a subset); NaN
+        without both volumes, or with a full volume of 0 (a one-joint arm's curve)."""
+        ratio = _ratio(self.volume_locked, self.volume_full)
         return min(1.0, ratio) if math.isfinite(ratio) else math.nan
 
     @property
     def share_kept_error(self) -> float:
         """Stated error of :attr:`share_kept` [-]: ``(e_locked + share e_full) / V_full``, the
-        relative errors of both volumes added (finite for a locked volume of 0)."""
-        ratio = self.volume_locked / self.volume_full
-        return (self.volume_locked_error + abs(ratio) * self.volume_full_error) / abs(self.volume_full)
+        relative errors of both volumes added (finite for a locked volume of 0; NaN with
+        :attr:`share_kept`)."""
+        ratio = _ratio(self.volume_locked, self.volume_full)
+        return _ratio(self.volume_locked_error + abs(ratio) * self.volume_full_error, abs(self.volume_full))
 
     @property
     def samples_per_voxel(self) -> float:
@@ -300,6 +349,64 @@ class WorkspaceComparison:
                 f"({self.voxel:.3g} m) is too small for the samples, the volumes are meaningless"
             )
         return out
+
+    def to_dict(self) -> dict[str, Any]:
+        """Plain JSON values: every figure as a number, ``None`` where there is no estimate
+        (too few samples, or a full volume of 0), and the ``*_text`` entries saying so in words
+        ("no estimate (too few samples)", "no estimate") next to the numbers."""
+        return {
+            "lock": {"joint": self.joint, "angle_deg": math.degrees(self.angle)},
+            "voxel_m": self.voxel,
+            "volume_full_m3": _number(self.volume_full),
+            "volume_full_error_m3": _number(self.volume_full_error),
+            "volume_locked_m3": _number(self.volume_locked),
+            "volume_locked_error_m3": _number(self.volume_locked_error),
+            "share_kept": _number(self.share_kept),
+            "share_kept_error": _number(self.share_kept_error),
+            "occupancy_full_m3": self.occupancy_full,
+            "occupancy_locked_m3": self.occupancy_locked,
+            "share_kept_occupancy": _number(self.share_kept_occupancy),
+            "share_kept_half_samples": _number(self.share_kept_half),
+            "voxel_half_samples_m": self.voxel_half,
+            "locked_voxels_outside_full": _number(self.outside),
+            "extent_full_m": projection_extent(self.full),
+            "extent_locked_m": projection_extent(self.locked),
+            "samples_per_voxel": _number(self.samples_per_voxel),
+            "volume_full_text": volume_text(self.volume_full, self.volume_full_error),
+            "volume_locked_text": volume_text(self.volume_locked, self.volume_locked_error),
+            "share_kept_text": share_text(self.share_kept, self.share_kept_error),
+            "warnings": self.warnings(),
+        }
+
+    def summary(self, before: str = "full arm") -> list[str]:
+        """The volume, share-kept and sampling lines, indented (``before``: how the arm before
+        the failure is called); "no estimate" where a figure has none."""
+        converged = "; not converged, see the warnings" if self.warnings() else ""
+        return [
+            f"  {before + ' volume':<18}: {volume_text(self.volume_full, self.volume_full_error)} "
+            f"(occupancy at the voxel: {self.occupancy_full:.3g} m^3)",
+            f"  locked arm volume : {volume_text(self.volume_locked, self.volume_locked_error)} (joint "
+            f"{self.joint} at {math.degrees(self.angle):g} deg; occupancy {self.occupancy_locked:.3g} m^3)",
+            f"  share kept        : {share_text(self.share_kept, self.share_kept_error)} (occupancy: "
+            f"{_percent(self.share_kept_occupancy)}, from half the samples: {_percent(self.share_kept_half)})"
+            + converged,
+            f"  locked voxels outside the full cloud (sampling): {_percent(self.outside, 1)}",
+        ]
+
+
+def _ratio(num: float, den: float) -> float:
+    """``num / den``, NaN for a zero or non-finite denominator (no ZeroDivisionError)."""
+    return num / den if math.isfinite(den) and den != 0 else math.nan
+
+
+def _number(x: float) -> float | None:
+    """``x`` as a JSON number, None for NaN or an infinity (no estimate)."""
+    return float(x) if math.isfinite(x) else None
+
+
+def _percent(share: float, places: int = 0) -> str:
+    """``"75 %"``, or ``"no estimate"`` for NaN."""
+    return f"{100 * share:.{places}f} %" if math.isfinite(share) else NO_SHARE
 
 
 def compare_workspaces(

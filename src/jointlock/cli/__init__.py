@@ -10,6 +10,7 @@ import argparse
 import importlib
 import importlib.util
 import os
+import re
 import sys
 import warnings
 from collections.abc import Sequence
@@ -171,7 +172,7 @@ def _main(argv: Sequence[str] | None) -> int:
         except JointlockError as exc:
             if args.debug:
                 raise
-            print(f"{prefix}: error: {exc}", file=sys.stderr)
+            print(f"{prefix}: error: {_short_words(str(exc))}", file=sys.stderr)
             return 2
         except BrokenPipeError:  # e.g. `jointlock ... | head`: the reader left; exit quietly
             _silence_stdout()
@@ -194,6 +195,18 @@ def _main(argv: Sequence[str] | None) -> int:
                 raise
             print(f"{prefix}: error: {_numerical_text(exc)}", file=sys.stderr)
             return 2
+
+
+#: Longest run of characters without a space an error line echoes whole: every message
+#: shortens the names it quotes (:func:`jointlock.bounds.shown`); this is the net for one that
+#: does not (a 10,000-character link name, an XML entity expanded to a page).
+LONGEST_WORD = 200
+
+
+def _short_words(message: str) -> str:
+    """``message`` with every run of more than :data:`LONGEST_WORD` non-space characters cut
+    to its first 77 and "..." (one error line stays one screen line or two)."""
+    return re.sub(rf"\S{{{LONGEST_WORD + 1},}}", lambda m: m.group(0)[:77] + "...", message)
 
 
 def _forgiving_streams() -> None:

@@ -80,15 +80,17 @@ def run(args: argparse.Namespace) -> int:
         )
     except VoxelTooSmallError as exc:
         raise ScenarioError(exc.message("--voxel")) from None
-    for w in result.warnings():
-        print(f"jointlock workspace: warning: {w}", file=sys.stderr)
     out = result.to_dict()
     if args.out is not None:
         out["files"] = [str(Path(args.out) / name) for name in result.write(args.out)]
+    lines = result.summary()
+    # the warnings only once every figure is computed and written: a failure is the last line
+    for w in result.warnings():
+        print(f"jointlock workspace: warning: {w}", file=sys.stderr)
     if args.json:
         print_json(out)
         return 0
-    for line in result.summary():
+    for line in lines:
         print(line)
     for f in out.get("files", []):
         print(f"wrote {f}")

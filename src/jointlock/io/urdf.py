@@ -249,7 +249,7 @@ def read_urdf(
     except (ET.ParseError, LookupError, ValueError) as exc:  # LookupError: an unknown declared encoding
         raise ModelError(f"{label}: malformed XML: {exc}") from None
     if root.tag != "robot":
-        raise ModelError(f"{label}: the root element must be <robot>; got <{root.tag}>")
+        raise ModelError(f"{label}: the root element must be <robot>; got <{shorten(root.tag, 40)}>")
     if base not in ("fixed", "floating"):
         raise ModelError(f"base must be 'fixed' or 'floating'; got {shown(base)}")
 

@@ -27,7 +27,6 @@ from ..analysis.workspace import (
     WorkspaceComparison,
     _auto_voxel,
     compare_workspaces,
-    projection_extent,
     sample_workspace,
 )
 from ..errors import ScenarioError
@@ -46,25 +45,6 @@ CLOUD_POINTS = 5000
 #: Size of the projections figure [inch], and of the clouds figure.
 PROJECTIONS_FIGSIZE = (14.0, 4.5)
 CLOUDS_FIGSIZE = (11.0, 5.0)
-
-
-def volume_text(volume: float | None, error: float | None) -> str:
-    """``"V ± err m^3"`` (the error to 2 significant digits, the volume to the same decimal
-    place: ``"13.9 ± 1.0 m^3"``, ``"14.10 ± 0.63 m^3"``), or ``"no estimate (too few samples)"``
-    for a NaN or missing volume (``None``: the JSON form)."""
-    if volume is None or error is None or not (math.isfinite(volume) and math.isfinite(error)):
-        return "no estimate (too few samples)"
-    if error <= 0:
-        return f"{volume:.3g} ± 0 m^3"
-    places = max(0, 1 - math.floor(math.log10(error)))
-    return f"{volume:.{places}f} ± {error:.{places}f} m^3"
-
-
-def share_text(share: float | None, error: float | None) -> str:
-    """``"S ± err %"`` (whole percent), or ``"no estimate"`` for a NaN or missing share."""
-    if share is None or error is None or not (math.isfinite(share) and math.isfinite(error)):
-        return "no estimate"
-    return f"{100 * share:.0f} ± {100 * error:.0f} %"
 
 
 class VoxelTooSmallError(ScenarioError):
@@ -163,46 +143,14 @@ class WorkspaceStudy(JobResult):
         return self.workspace.warnings()
 
     def to_dict(self) -> dict[str, Any]:
-        """The JSON object of ``jointlock workspace --json`` (without ``files``)."""
-        ws = self.workspace
-        if isinstance(ws, WorkspaceComparison):
-            out = {
-                "robot": self.robot,
-                "samples": self.samples,
-                "seed": self.seed,
-                "lock": {"joint": ws.joint, "angle_deg": math.degrees(ws.angle)},
-                "voxel_m": ws.voxel,
-                "volume_full_m3": ws.volume_full,
-                "volume_full_error_m3": ws.volume_full_error,
-                "volume_locked_m3": ws.volume_locked,
-                "volume_locked_error_m3": ws.volume_locked_error,
-                "share_kept": ws.share_kept,
-                "share_kept_error": ws.share_kept_error,
-                "occupancy_full_m3": ws.occupancy_full,
-                "occupancy_locked_m3": ws.occupancy_locked,
-                "share_kept_occupancy": ws.share_kept_occupancy,
-                "share_kept_half_samples": ws.share_kept_half,
-                "voxel_half_samples_m": ws.voxel_half,
-                "locked_voxels_outside_full": ws.outside,
-                "extent_full_m": projection_extent(ws.full),
-                "extent_locked_m": projection_extent(ws.locked),
-                "samples_per_voxel": ws.samples_per_voxel,
-                "warnings": ws.warnings(),
-            }
-        else:
-            out = {
-                "robot": self.robot,
-                "samples": self.samples,
-                "seed": self.seed,
-                "lock": None,
-                "voxel_m": ws.voxel,
-                "volume_full_m3": ws.volume,
-                "volume_full_error_m3": ws.volume_error,
-                "occupancy_full_m3": ws.occupancy,
-                "extent_full_m": projection_extent(ws.points),
-                "samples_per_voxel": ws.samples_per_voxel,
-                "warnings": ws.warnings(),
-            }
+        """The JSON object of ``jointlock workspace --json`` (without ``files``): the robot, the
+        samples and the seed, then the workspace's own :meth:`~jointlock.analysis.workspace.
+        WorkspaceComparison.to_dict` (numbers, ``None`` and a "no estimate" text where a figure
+        has no estimate)."""
+        head: dict[str, Any] = {"robot": self.robot, "samples": self.samples, "seed": self.seed}
+        if not self.locked:
+            head["lock"] = None
+        out = head | self.workspace.to_dict()
         if self.already_locked:  # "full" is the arm before the failure
             out["already_locked_deg"] = dict(self.already_locked)
         return out
@@ -212,33 +160,14 @@ class WorkspaceStudy(JobResult):
         stderr, are :meth:`warnings`)."""
         ws = self.workspace
         density = self.samples_per_voxel
-        lines = [
+        density_text = f"{density:.3g}" if math.isfinite(density) else "no"
+        return [
             f"{self.robot}: {self.samples} samples per arm (seed {self.seed}), voxel {ws.voxel:.3g} m "
-            f"({density:.3g} samples per occupied voxel)"
-        ]
-        if isinstance(ws, WorkspaceComparison):
-            warnings = ws.warnings()
-            lines += [
-                f"  {self._before + ' volume':<18}: {volume_text(ws.volume_full, ws.volume_full_error)} "
-                f"(occupancy at the voxel: {ws.occupancy_full:.3g} m^3)",
-                f"  locked arm volume : {volume_text(ws.volume_locked, ws.volume_locked_error)} (joint "
-                f"{ws.joint} at {math.degrees(ws.angle):g} deg; occupancy {ws.occupancy_locked:.3g} m^3)",
-                f"  share kept        : {share_text(ws.share_kept, ws.share_kept_error)} (occupancy: "
-                f"{100 * ws.share_kept_occupancy:.0f} %, from half the samples: "
-                f"{100 * ws.share_kept_half:.0f} %)"
-                + ("; not converged, see the warnings" if warnings else ""),
-                f"  locked voxels outside the full cloud (sampling): {100 * ws.outside:.1f} %",
-            ]
-        else:
-            lines.append(
-                f"  {self._before + ' volume':<18}: {volume_text(ws.volume, ws.volume_error)} "
-                f"(occupancy at the voxel: {ws.occupancy:.3g} m^3)"
-            )
-        lines.append(
+            f"({density_text} samples per occupied voxel)",
+            *ws.summary(self._before),
             "  volumes extrapolated to a zero voxel side; ± bounds the extrapolation's bias and the sampling "
-            "(not a standard deviation)"
-        )
-        return lines
+            "(not a standard deviation)",
+        ]
 
     def file_names(self) -> list[str]:
         """The names :meth:`write` writes (its JSON lists them as paths)."""

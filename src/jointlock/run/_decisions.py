@@ -7,8 +7,8 @@ from typing import Any
 
 import numpy as np
 
+from ..analysis.workspace import share_text, volume_text
 from ..jobs.jump import KAPPA_UNIT, _points_text
-from ..jobs.workspace import share_text, volume_text
 from ..papers import p004
 from ..report import Section
 from ..scenario import Scenario

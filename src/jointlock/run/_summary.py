@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from ..jobs.workspace import share_text, volume_text
+from ..analysis.workspace import share_text, volume_text
 
 
 def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
