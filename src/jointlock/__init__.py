@@ -122,6 +122,9 @@ _LAZY = {
     "run_scenario": "jointlock.run",
     "RunResult": "jointlock.run",
     "run_demo": "jointlock.run._demo",
+    # simulators
+    "mjcf_text": "jointlock.mjcf",
+    "write_mjcf": "jointlock.mjcf",
 }
 
 #: Subpackages reachable as attributes (``jl.plots``, ``jl.jobs``, ``jl.papers``), imported on first use.
@@ -132,6 +135,8 @@ __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals()
 
 
 __all__ = [
+    "mjcf_text",
+    "write_mjcf",
     "ArmModel",
     "InverseDynamics",
     "base_wrench",

@@ -37,6 +37,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "workspace": ("workspace", "Monte Carlo workspace, full arm vs locked arm: clouds, projections, volume, share kept"),
     "singular": ("singular", "singular values, rank, lost directions; 004's Cond1-Cond5; singularity search"),
     "export-urdf": ("export_urdf", "write the (locked) arm as URDF, locked joints folded in and bodies merged"),
+    "export-mjcf": ("export_mjcf", "write the (locked) arm and its spacecraft as a MuJoCo model (MJCF)"),
     "run": ("run", "run every job of a scenario file; results.json, CSV, plots and report.html in one folder"),
     "campaign": ("campaign", "sweep thousands of failure cases (process pool or Dask), resumable"),
     "reproduce": ("reproduce", "re-run each seed paper's published experiment and compare with its printed numbers"),

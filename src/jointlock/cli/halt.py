@@ -224,6 +224,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write plots (PNG), time series (CSV, NPZ) and result.json")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
+    p.add_argument(
+        "--check-in",
+        choices=("none", "mujoco"),
+        default="none",
+        help="replay the halt in this simulator, the spacecraft free, and compare its attitude, drift and brake "
+        "torque with jointlock's (mujoco: the optional extra jointlock[mujoco]; written as mujoco.* with --out)",
+    )
     add_clearance_options(p)
     p.set_defaults(func=run)
 
@@ -338,12 +345,27 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
     plan = plan_from_args(args, not args.quiet and sys.stderr.isatty())
+    replays = {}
+    if args.check_in == "mujoco":
+        from ..sim import replay_jobs
+
+        replays = replay_jobs({"halt": plan})  # free, and held when the torques hold the spacecraft
     written = plan.write(Path(args.out)) if args.out else []
+    if args.out:
+        for key, replay in replays.items():
+            written += replay.write(Path(args.out), "mujoco" + key[len("halt") :])
     if args.json:
-        print_json(plan.to_dict())
+        data = plan.to_dict()
+        if replays:
+            data["checked_in_mujoco"] = {key: replay.to_dict() for key, replay in replays.items()}
+        print_json(data)
         return 0
     for line in plan.summary():
         print(line)
+    for replay in replays.values():
+        print()
+        for line in replay.summary():
+            print(line)
     if written:
         print(f"\nwrote {', '.join(written)} to {args.out}")
     return 0

@@ -52,6 +52,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="TABLE.FIELD=VALUE",
         help="override any field, value in TOML syntax (e.g. --set halt.T=12 --set workspace.samples=5000)",
     )
+    p.add_argument(
+        "--check-in",
+        choices=("none", "mujoco"),
+        help="replay the halt in this simulator and compare (overrides check_in; mujoco: the optional extra "
+        "jointlock[mujoco])",
+    )
     p.add_argument("--json", action="store_true", help="print results.json on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress bars, no summary")
     p.set_defaults(func=run)
@@ -80,6 +86,8 @@ def overrides_from_args(args: argparse.Namespace) -> dict[str, Any]:
         out["jobs"] = list(args.jobs)
     if args.out is not None:
         out["out"] = args.out
+    if args.check_in is not None:
+        out["check_in"] = args.check_in
     return out
 
 

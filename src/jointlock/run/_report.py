@@ -78,6 +78,7 @@ def report_sections(
         *_decisions_section(scenario, jobs, full, locked),
         *_limits_section(scenario, jobs, full, locked),
         *_figure_sections(scenario, jobs, full, locked, typed, out),
+        *_checks_section(results.get("checks") or {}, out),
         Section("Assumptions and readings", notes=assumptions(scenario, full)),
         _references_section(scenario),
     ]
@@ -104,6 +105,39 @@ def _safety_section(jobs: dict[str, Any]) -> list[Section]:
             "Clearance: read this first",
             paragraphs=[f"<b>{html.escape(job)}</b>: {html.escape(text)}" for job, text in lines],
             notes=["Collision geometry, the pairs checked and the mounted pairs: docs/clearance.md."],
+        )
+    ]
+
+
+def _checks_section(checks: dict[str, Any], out: Path) -> list[Section]:
+    """"Checked in MuJoCo": per replayed job, the table quantity / jointlock / MuJoCo /
+    difference and the figure with both traces (:mod:`jointlock.sim`)."""
+    if not checks:
+        return []
+    tables, images = [], []
+    for job, check in checks.items():
+        rows = [[r["quantity"], r["unit"], f"{r['jointlock']:.6g}", f"{r['mujoco']:.6g}", f"{r['difference']:+.3g}"]
+                for r in check["rows"]]  # fmt: skip
+        caption = (
+            f"{job}: {check['steps']} steps of {check['timestep_s']:g} s (RK4), the spacecraft {check['spacecraft']}"
+        )
+        tables.append((["quantity", "unit", "jointlock", check["simulator"], "difference"], rows, caption))
+        png = out / "checks" / f"mujoco_{job}.png"
+        if png.is_file():
+            images.append((f"checks/mujoco_{job}.png", png.read_bytes()))
+    return [
+        Section(
+            f"Checked in {next(iter(checks.values()))['simulator']}",
+            paragraphs=[
+                "Each motion below was played in MuJoCo: the healthy joints driven by jointlock's inverse-dynamics "
+                "torques plus a stiff tracking correction, the locked joints held by joint equalities (their "
+                "constraint torque is the brake's), the spacecraft a free body starting with zero momentum, "
+                "contacts off. The difference is MuJoCo minus jointlock (for the attitude: the angle between the "
+                "two final attitudes)."
+            ],
+            tables=tables,
+            images=images,
+            notes=["How the replay is set up, and what it checks: docs/simulators.md."],
         )
     ]
 

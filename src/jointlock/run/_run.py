@@ -98,7 +98,9 @@ def _with_context(exc: JointlockError, where: str) -> JointlockError:
         return ScenarioError(message)
 
 
-def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> RunResult:
+def run_scenario(
+    scenario: Scenario | str | Path, *, progress: bool = False, check_in: str | None = None
+) -> RunResult:
     """Run every job of ``scenario`` in-process, each on the typed results of those before it.
 
     Parameters
@@ -109,6 +111,10 @@ def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> 
         with :func:`~jointlock.scenario.load_scenario`, no overrides).
     progress
         Show progress bars on stderr.
+    check_in
+        ``"mujoco"``: replay the motions the jobs produce in MuJoCo and compare
+        (:func:`jointlock.sim.replay_jobs`; the optional extra ``jointlock[mujoco]``); default:
+        the scenario's ``check_in`` field ("none": no replay).
 
     Raises
     ------
@@ -128,7 +134,22 @@ def run_scenario(scenario: Scenario | str | Path, *, progress: bool = False) -> 
             results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
         except JointlockError as exc:
             raise _with_context(exc, f"{scenario.source}: job [{job}]") from exc
-    return RunResult(scenario, results, versions())
+    simulator = check_in if check_in is not None else scenario.data.get("check_in", "none")
+    if simulator not in CHECK_IN:
+        raise ScenarioError(f"check_in must be one of {', '.join(map(repr, CHECK_IN))}; got {simulator!r}")
+    checks: dict[str, Any] = {}
+    if simulator == "mujoco":
+        from ..sim import replay_jobs
+
+        try:
+            checks = dict(replay_jobs(results))
+        except JointlockError as exc:
+            raise _with_context(exc, f"{scenario.source}: check in MuJoCo") from exc
+    return RunResult(scenario, results, versions(), checks)
+
+
+#: The simulators a run can replay its motions in (``check_in``).
+CHECK_IN = ("none", "mujoco")
 
 
 #: Keys before which a command's JSON lists its ``files`` (else they come last).
@@ -158,11 +179,15 @@ class RunResult:
         Each job's typed result, in the order they ran.
     versions
         Versions of jointlock, Python and the core dependencies.
+    checks
+        ``{job: Replay}``: the job's motion replayed in MuJoCo (:mod:`jointlock.sim`), with
+        ``check_in="mujoco"``; empty otherwise.
     """
 
     scenario: Scenario
     jobs: Mapping[str, JobResult]
     versions: Mapping[str, str] = field(default_factory=dict)
+    checks: Mapping[str, Any] = field(default_factory=dict)
 
     @property
     def title(self) -> str:
@@ -206,6 +231,7 @@ class RunResult:
             "versions": dict(self.versions),
             "jobs": jobs,
             "summary": to_plain(summarize(jobs)),
+            **({"checks": {job: to_plain(r.to_dict()) for job, r in self.checks.items()}} if self.checks else {}),
         }
 
     def summary(self) -> list[str]:
@@ -234,6 +260,8 @@ class RunResult:
                 atomic_write_text(out / "jump" / "task.toml", jump_task_toml(self.scenario))
             if not result.write(out / job):  # a job with no files of its own: its result dictionary
                 atomic_write_json(out / job / "result.json", results["jobs"][job]["result"])
+        for job, replay in self.checks.items():
+            replay.write(out / "checks", f"mujoco_{job}")
         results.update(to_plain(dict(extra or {})))
         sections = report_sections(self.scenario, results, dict(self.jobs), out) + list(extra_sections)
         files = {str(p.relative_to(out)) for p in out.rglob("*") if p.is_file() and not p.name.startswith(".")}

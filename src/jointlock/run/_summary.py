@@ -202,4 +202,14 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
             )
         else:
             lines.append("  singular: " + ", ".join(f"{k} {v}" for k, v in g.items()))
+    for job, check in (results.get("checks") or {}).items():
+        lines.append(f"  checked in {check['simulator']} ({job}): " + check_text(check))
     return lines
+
+
+def check_text(check: dict[str, Any]) -> str:
+    """A replay's rows (:meth:`jointlock.sim.Replay.to_dict`) in one line: each figure's
+    jointlock value and the simulator's difference from it."""
+    return ", ".join(
+        f"{r['short']} {r['jointlock']:.4g} {r['unit']} (MuJoCo {r['difference']:+.1e})" for r in check["rows"] if r.get("short")
+    )

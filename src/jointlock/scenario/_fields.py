@@ -148,6 +148,13 @@ TOP_FIELDS: dict[str, Field] = {
         "in the working folder); --out overrides, with any folder",
     ),
     "jobs": Field("strings", None, choices=JOB_ORDER, help="jobs to run (default: every job table given)"),
+    "check_in": Field(
+        "choice",
+        "none",
+        choices=("none", "mujoco"),
+        help="replay the halt in this simulator and compare its spacecraft attitude, drift and brake torque with "
+        "jointlock's ('mujoco': the optional extra jointlock[mujoco]; docs/simulators.md)",
+    ),
 }
 
 #: Tables shared by the jobs.
