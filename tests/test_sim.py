@@ -164,3 +164,55 @@ def test_run_check_in_mujoco_writes_the_table_and_the_figure(tmp_path):
     # without the flag nothing is replayed and results.json has no "checks"
     plain = jl.run_scenario(jl.load_scenario("examples/halt_000.toml", {"jobs": ["halt_config"]}))
     assert plain.checks == {} and "checks" not in plain.to_dict()
+
+
+# -- the jump study's runs and the re-plan ---------------------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def floating_jump():
+    """001's task on the free-floating canadarm7, joint 2 locking at 6 s; the limits relaxed so
+    that kappa(t) can be fitted (with 001's limits the floating arm breaks them without a
+    failure: tests/test_jobs_jump.py)."""
+    scenario = jl.load_scenario(
+        "examples/jump_001.toml",
+        {"jobs": ["jump"], "base": "floating", "limits.vmax_deg_s": 60.0, "limits.amax_deg_s2": 60.0,
+         "limits.eps_m": 0.01, "jump.sweep": 8},
+    )  # fmt: skip
+    return jl.run_scenario(scenario)["jump"]
+
+
+def test_jump_runs_replayed_with_the_spacecraft_free(floating_jump):
+    """The rates change at every 50 ms control step and jump at the lock: MuJoCo's spacecraft
+    takes each step as a momentum-keeping impulse computed from its own mass matrix.  Measured:
+    attitude 2.4e-6 deg apart (26.74 deg turned), drift 7e-9 m, brake peak 5.8e-5 N m of 1.62."""
+    from jointlock.sim import replay_jump
+
+    replays = replay_jump(floating_jump)
+    assert set(replays) == {"jump_uncompensated", "jump_compensated"}
+    own = floating_jump.spacecraft_responses()
+    for key, replay in replays.items():
+        assert replay.attitude_difference_deg < ATTITUDE_TOL_DEG, key
+        assert np.linalg.norm(replay.com_displacement[-1] - replay.reference.com_displacement[-1]) < DRIFT_TOL_M
+        assert np.abs(replay.brake).max() == pytest.approx(np.abs(replay.brake_ref).max(), rel=1e-4)
+        assert replay.tracking_error_deg < TRACKING_TOL_DEG and replay.locked_numbers == (2,)
+        # the study's own figure integrates the attitude at the 50 ms control step (first order):
+        # 0.17 % off the fine one, which MuJoCo confirms
+        ref = replay.reference.final_attitude_change_deg
+        mine = own[key.removeprefix("jump_")].final_attitude_change_deg
+        assert 0 < abs(mine - ref) < 0.005 * ref
+
+
+def test_replan_replayed(tmp_path):
+    """002's re-plan (puma6, joint 2 locked at 59.4 deg) on a free spacecraft: the waypoints joined
+    by a cubic spline; fixed base (the example's), only the brake."""
+    from jointlock.sim import replay_replan
+
+    floating = jl.run_scenario(jl.load_scenario("examples/replan_002.toml", {"jobs": ["replan"], "base": "floating"}))
+    replay = replay_replan(floating["replan"])
+    assert replay.attitude_difference_deg < ATTITUDE_TOL_DEG and replay.reference is not None
+    own = floating["replan"].spacecraft_response()  # central differences on the waypoints
+    assert abs(replay.reference.final_attitude_change_deg - own.final_attitude_change_deg) < 1e-3
+    assert np.abs(replay.brake).max() == pytest.approx(np.abs(replay.brake_ref).max(), rel=1e-4)
+    fixed = jl.run_scenario(jl.load_scenario("examples/replan_002.toml", {"jobs": ["replan"], "check_in": "mujoco"}))
+    assert set(fixed.checks) == {"replan"} and fixed.checks["replan"].spacecraft == "held"

@@ -144,6 +144,7 @@ def mjcf_text(
     brakes: bool = False,
     timestep: float = TIMESTEP_S,
     base: str | None = None,
+    brakes_engaged: bool = True,
 ) -> str:
     """The MJCF document of ``model`` (see the module docstring).
 
@@ -161,6 +162,10 @@ def mjcf_text(
         ``<option timestep>`` [s].
     base
         ``"floating"`` (a free spacecraft) or ``"fixed"`` (welded); default the model's.
+    brakes_engaged
+        With ``brakes``: False writes each brake inactive (``active="false"``) and gives its
+        joint a motor too, for a replay in which the joint moves until it locks (the replay turns
+        the brake on: ``MjData.eq_active``).
     """
     g = np.asarray(gravity, dtype=float)
     if g.shape != (3,) or not np.all(np.isfinite(g)):
@@ -220,12 +225,13 @@ def mjcf_text(
         for shape in body.shapes:
             body_of_link.setdefault(shape.link if shape.link is not None else joint.number, body_name)
         if joint.number in held:
+            active = "" if brakes_engaged else ' active="false"'
             equalities.append(
                 f'    <joint name="brake{joint.number}" joint1={joint_name} '
                 f'polycoef="{_num(held[joint.number])} 0 0 0 0" solref="{_vec(BRAKE_SOLREF)}" '
-                f'solimp="{_vec(BRAKE_SOLIMP)}"/>'
+                f'solimp="{_vec(BRAKE_SOLIMP)}"{active}/>'
             )
-        else:
+        if joint.number not in held or not brakes_engaged:
             effort = f' ctrlrange="{_num(-joint.effort_limit)} {_num(joint.effort_limit)}"' if math.isfinite(joint.effort_limit) else ""
             actuators.append(f"    <motor name={joint_name} joint={joint_name} gear=\"1\"{effort}/>")
         indent += "  "

@@ -1,5 +1,8 @@
 """Replay a motion in MuJoCo and compare what the simulator's spacecraft and brakes do with
-what jointlock computes (issue 30; optional extra ``jointlock[mujoco]``).
+what jointlock computes (issue 30; optional extra ``jointlock[mujoco]``): a halt
+(:func:`replay_halt`), the jump study's runs (:func:`replay_jump`: a control loop's rates,
+:func:`replay_steps`), a re-plan (:func:`replay_replan`: waypoints joined by a spline), or any
+motion (:func:`replay_motion`); every one of a run (:func:`replay_jobs`).
 
 The arm is written by :func:`jointlock.mjcf.mjcf_text` with ``brakes=True``: the unlocked chain,
 each locked joint a hinge held at its lock angle by a joint equality (its constraint torque is
@@ -24,7 +27,7 @@ dynamics, the zero-momentum spacecraft kinematics and the brake torque at once.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -36,10 +39,23 @@ from .analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from .dynamics import BaseMode, generalized_inertia, mass_matrix, rnea
 from .errors import ConfigurationError, ModelError
 from .io.files import atomic_write_json, atomic_write_text, csv_text, with_svg, write_figure
+from .locking import lock_joints
 from .mjcf import TIMESTEP_S, mjcf_text
 from .model import ArmModel, FloatArray
 
-__all__ = ["MUJOCO_MISSING", "REPLAYED_JOBS", "TRACKING_RAD_S", "Replay", "replay_halt", "replay_jobs", "replay_motion"]
+__all__ = [
+    "MUJOCO_MISSING",
+    "REPLAYED_JOBS",
+    "TRACKING_RAD_S",
+    "Replay",
+    "replay_halt",
+    "replay_jobs",
+    "replay_jump",
+    "replay_motion",
+    "replay_replan",
+    "replay_steps",
+    "replay_waypoints",
+]
 
 #: The one line a user without the extra sees.
 MUJOCO_MISSING = "the MuJoCo check needs MuJoCo: pip install 'jointlock[mujoco]' (or pip install mujoco)"
@@ -137,8 +153,11 @@ class Replay:
         """Angle of the rotation between MuJoCo's and jointlock's final attitudes [deg]."""
         if self.attitude is None or self.reference is None:
             return None
-        dot = abs(float(np.dot(self.attitude[-1], self.reference.attitude[-1])))
-        return float(np.degrees(2.0 * math.acos(min(1.0, dot))))
+        a, b = self.attitude[-1], self.reference.attitude[-1]
+        # the rotation a^-1 b: its vector part without cancellation (acos of the dot is 0 below 1e-8)
+        vector = a[0] * b[1:] - b[0] * a[1:] - np.cross(a[1:], b[1:])
+        scalar = float(np.dot(a, b))
+        return float(np.degrees(2.0 * math.atan2(float(np.linalg.norm(vector)), abs(scalar))))
 
     def rows(self) -> list[dict[str, Any]]:
         """The comparison: ``{"quantity", "short", "unit", "jointlock", "mujoco", "difference"}``
@@ -253,21 +272,165 @@ class Replay:
 
 
 #: The jobs whose motion :func:`replay_jobs` plays.
-REPLAYED_JOBS = ("halt",)
+REPLAYED_JOBS = ("halt", "jump", "replan")
 
 
 def replay_jobs(jobs: Mapping[str, Any], *, timestep: float = TIMESTEP_S) -> dict[str, Replay]:
     """Replay every motion among a run's typed job results (``{job: result}``) that MuJoCo can
-    play (:data:`REPLAYED_JOBS`): ``{job: Replay}``.  A halt whose torques hold the spacecraft
+    play (:data:`REPLAYED_JOBS`): ``{key: Replay}``.  A halt whose torques hold the spacecraft
     (000's reading) on a model with one is played twice: free (``"halt"``: the attitude, the
-    drift) and held (``"halt_held"``: the brake torque 000's reading gives)."""
+    drift) and held (``"halt_held"``: the brake torque 000's reading gives); the jump study's
+    two runs are ``"jump_uncompensated"`` and ``"jump_compensated"``; the re-plan ``"replan"``."""
     out: dict[str, Replay] = {}
     if "halt" in jobs:
         plan = jobs["halt"]
         out["halt"] = replay_halt(plan, timestep=timestep)
         if plan.problem.model.floating and plan.problem.base == "fixed":  # 000's torques: the spacecraft held
             out["halt_held"] = replay_halt(plan, timestep=timestep, base="fixed")
+    if "jump" in jobs:
+        out.update(replay_jump(jobs["jump"], timestep=timestep))
+    if "replan" in jobs and jobs["replan"].model is not None:
+        out["replan"] = replay_replan(jobs["replan"], timestep=timestep)
     return out
+
+
+def replay_jump(result: Any, *, timestep: float = TIMESTEP_S) -> dict[str, Replay]:
+    """The jump study's two runs (:meth:`~jointlock.jobs.JumpJobResult.runs`: without and with
+    the compensation, the joint locking at the failure instant) played with
+    :func:`replay_steps`: ``{"jump_uncompensated": ..., "jump_compensated": ...}``."""
+    r0, r1, _ = result.runs()
+    return {
+        f"jump_{key}": replay_steps(
+            result.model,
+            run.t,
+            run.q,
+            run.qd,
+            [(int(j), float(t)) for j, t, _ in run.failures],
+            label=f"jump, {label}",
+            timestep=timestep,
+        )
+        for key, label, run in (("uncompensated", "kappa = 0", r0), ("compensated", "compensated", r1))
+    }
+
+
+def replay_replan(result: Any, *, timestep: float = TIMESTEP_S) -> Replay:
+    """The re-planned waypoints (:class:`~jointlock.jobs.ReplanJobResult`'s ``plan.times`` and
+    ``plan.q``) joined by a cubic spline and played with :func:`replay_waypoints`."""
+    if result.model is None:
+        raise ConfigurationError("this re-plan result has no model to replay (built without one)")
+    return replay_waypoints(result.model, result.plan.times, result.plan.q, label="re-plan", timestep=timestep)
+
+
+class _Player:
+    """A locked arm in MuJoCo (:func:`~jointlock.mjcf.mjcf_text` with brakes), contacts and
+    control limits off, with the indices a replay needs, and what it records at each instant.
+    Used as a context manager: MuJoCo's warnings are caught (no ``MUJOCO_LOG.TXT`` in the
+    user's folder) and an unstable replay raises one :class:`ModelError`."""
+
+    def __init__(
+        self, model: ArmModel, floating: bool, timestep: float, samples: int, *, brakes_engaged: bool = True
+    ) -> None:
+        mujoco = self.mujoco = _mujoco()
+        chain = model.unlocked if model.locked else model
+        assert chain is not None
+        mode = "floating" if floating else "fixed"
+        text = mjcf_text(model, brakes=True, timestep=timestep, base=mode, brakes_engaged=brakes_engaged)
+        self.mm = mujoco.MjModel.from_xml_string(text)
+        self.mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        self.mm.actuator_ctrllimited[:] = 0
+        self.data = mujoco.MjData(self.mm)
+        self.floating, self.timestep = floating, timestep
+        free = 7 if floating else 0
+        numbers = list(chain.joint_numbers)
+        #: qpos index of each joint of the chain (its number's order), and of the model's healthy
+        #: and locked joints; qvel has 6 free coordinates where qpos has 7
+        self.qpos = np.array([free + numbers.index(j) for j in numbers], dtype=int)
+        self.healthy = np.array([free + numbers.index(j) for j in model.joint_numbers], dtype=int)
+        self.braked = np.array([free + numbers.index(lj.number) for lj in model.locked], dtype=int)
+        self.shift = 1 if floating else 0
+        self.lock_angles = np.array([lj.angle for lj in model.locked])
+        self.base_body = mujoco.mj_name2id(self.mm, mujoco.mjtObj.mjOBJ_BODY, "base")
+        if floating:
+            self.data.qpos[3:7] = [1.0, 0.0, 0.0, 0.0]
+        self.q = np.empty((samples, self.healthy.size))
+        self.locked_angle = np.empty((samples, self.braked.size))
+        self.brake = np.empty((samples, self.braked.size))
+        self.attitude = np.empty((samples, 4)) if floating else None
+        self.com = np.empty((samples, 3)) if floating else None
+        self.rate = np.empty((samples, 3)) if floating else None
+        self.caught: list[str] = []
+
+    def __enter__(self) -> _Player:
+        self._previous = self.mujoco.get_mju_user_warning()
+        self.mujoco.set_mju_user_warning(self.caught.append)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.mujoco.set_mju_user_warning(self._previous)
+
+    def record(self, k: int) -> bool:
+        """Compute the state's forces (:func:`mujoco.mj_forward`: the brake's constraint torque)
+        and record sample ``k``; False once MuJoCo has warned (the replay is unstable)."""
+        data = self.data
+        self.mujoco.mj_forward(self.mm, data)
+        self.q[k] = data.qpos[self.healthy]
+        self.locked_angle[k] = data.qpos[self.braked] - self.lock_angles
+        self.brake[k] = data.qfrc_constraint[self.braked - self.shift]
+        if self.attitude is not None and self.com is not None and self.rate is not None:
+            self.attitude[k] = data.qpos[3:7]
+            self.com[k] = data.xipos[self.base_body]
+            self.rate[k] = data.qvel[3:6]
+        return not self.caught
+
+    def step(self, ctrl: FloatArray) -> None:
+        self.data.ctrl[:] = ctrl
+        self.mujoco.mj_step(self.mm, self.data)
+
+    def result(
+        self,
+        model: ArmModel,
+        label: str,
+        t: FloatArray,
+        q_ref: FloatArray,
+        brake_ref: FloatArray,
+        reference: SpacecraftResponse | None,
+    ) -> Replay:
+        """The :class:`Replay` of what was recorded (one :class:`ModelError` if it diverged)."""
+        if self.caught or not (np.all(np.isfinite(self.q)) and np.all(np.isfinite(self.brake))):
+            raise ModelError(
+                f"the MuJoCo replay of {label} became unstable ({(self.caught or ['non-finite state'])[0].strip()}); "
+                f"try a smaller timestep than {self.timestep:g} s"
+            )
+        com = None if self.com is None else self.com - self.com[0]
+        return Replay(
+            label=label,
+            t=t,
+            joint_numbers=model.joint_numbers,
+            locked_numbers=tuple(lj.number for lj in model.locked),
+            q=self.q,
+            q_ref=q_ref,
+            locked_angle=self.locked_angle,
+            brake=self.brake,
+            brake_ref=brake_ref.reshape(t.size, -1),
+            attitude=self.attitude,
+            com_displacement=com,
+            angular_velocity=self.rate,
+            reference=reference if self.floating else None,
+            timestep=float(self.timestep),
+            mujoco_version=str(self.mujoco.__version__),
+        )
+
+
+def _check_base(model: ArmModel, base: str | None) -> bool:
+    """Whether the replay floats the spacecraft (``base``: None, the model's; or as given)."""
+    if base not in (None, "fixed", "floating") or (base == "floating" and not model.floating):
+        raise ConfigurationError(
+            f"base must be 'fixed', or 'floating' for a model with a spacecraft ({model.name!r} floats: "
+            f"{model.floating}); got {base!r}"
+        )
+    if model.locked and model.unlocked is None:
+        raise ModelError(f"{model.name!r}: the replay needs the unlocked arm to hold the locked joints by brakes")
+    return model.floating if base is None else base == "floating"
 
 
 def replay_motion(
@@ -290,37 +453,14 @@ def replay_motion(
     ConfigurationError
         MuJoCo is not installed (:data:`MUJOCO_MISSING`), or a bad duration or step.
     ModelError
-        A locked model without its unlocked arm.
+        A locked model without its unlocked arm; a replay that diverged.
     """
-    mujoco = _mujoco()
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ConfigurationError(f"duration must be a positive number of seconds; got {duration!r}")
     if not (isinstance(timestep, (int, float)) and 0 < timestep <= duration):
         raise ConfigurationError(f"timestep must be in (0, duration] [s]; got {timestep!r}")
-    if model.locked and model.unlocked is None:
-        raise ModelError(f"{model.name!r}: the replay needs the unlocked arm to hold the locked joints by brakes")
-    if base not in (None, "fixed", "floating") or (base == "floating" and not model.floating):
-        raise ConfigurationError(
-            f"base must be 'fixed', or 'floating' for a model with a spacecraft ({model.name!r} floats: "
-            f"{model.floating}); got {base!r}"
-        )
-    chain = model.unlocked if model.locked else model
-    assert chain is not None
-    floating = model.floating if base is None else base == "floating"
+    floating = _check_base(model, base)
     mode: BaseMode = "floating" if floating else "fixed"
-    mm = mujoco.MjModel.from_xml_string(mjcf_text(model, brakes=True, timestep=timestep, base=mode))
-    mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
-    mm.actuator_ctrllimited[:] = 0
-    data = mujoco.MjData(mm)
-
-    free = 7 if floating else 0
-    numbers = list(chain.joint_numbers)
-    healthy = np.array([free + numbers.index(j) for j in model.joint_numbers], dtype=int)
-    braked = np.array([free + numbers.index(lj.number) for lj in model.locked], dtype=int)
-    healthy_v = healthy - (1 if floating else 0)  # qvel has 6 free coordinates, qpos 7
-    braked_v = braked - (1 if floating else 0)
-    lock_angles = np.array([lj.angle for lj in model.locked])
-
     steps = max(1, round(duration / timestep))
     t = np.linspace(0.0, steps * timestep, steps + 1)
     q_ref, dq_ref, ddq_ref = trajectory(t)
@@ -332,72 +472,188 @@ def replay_motion(
     inertia = generalized_inertia(model, q_ref) if floating else mass_matrix(model, q_ref)
     kp, kd = tracking**2, 2.0 * tracking
 
-    data.qpos[braked] = lock_angles
-    data.qpos[healthy] = q_ref[0]
-    data.qvel[healthy_v] = dq_ref[0]
-    if floating:
-        data.qpos[3:7] = [1.0, 0.0, 0.0, 0.0]
-        twist = rnea(model, q_ref[0], dq_ref[0], np.zeros(model.dof), base="floating").base_twist
-        v_com, omega = twist[:3], twist[3:]
-        data.qvel[0:3] = v_com - np.cross(omega, model.root_body.com)  # the body origin's velocity
-        data.qvel[3:6] = omega
-    base_body = mujoco.mj_name2id(mm, mujoco.mjtObj.mjOBJ_BODY, "base")
-
-    m = steps + 1
-    q_out = np.empty((m, model.dof))
-    locked_out = np.empty((m, braked.size))
-    brake_out = np.empty((m, braked.size))
-    attitude = np.empty((m, 4)) if floating else None
-    com = np.empty((m, 3)) if floating else None
-    rate = np.empty((m, 3)) if floating else None
-    caught: list[str] = []
-    previous = mujoco.get_mju_user_warning()
-    mujoco.set_mju_user_warning(caught.append)  # MuJoCo's warnings here, not in MUJOCO_LOG.TXT
-    try:
-        for k in range(m):
+    with _Player(model, floating, timestep, steps + 1) as player:
+        data, healthy, healthy_v = player.data, player.healthy, player.healthy - player.shift
+        data.qpos[player.braked] = player.lock_angles
+        data.qpos[healthy] = q_ref[0]
+        data.qvel[healthy_v] = dq_ref[0]
+        if floating:  # the twist of zero momentum, at the body origin
+            twist = rnea(model, q_ref[0], dq_ref[0], np.zeros(model.dof), base="floating").base_twist
+            data.qvel[0:3] = twist[:3] - np.cross(twist[3:], model.root_body.com)
+            data.qvel[3:6] = twist[3:]
+        for k in range(steps + 1):
             correction = inertia[k] @ (kp * (q_ref[k] - data.qpos[healthy]) + kd * (dq_ref[k] - data.qvel[healthy_v]))
             data.ctrl[:] = feed_now[k] + correction
-            mujoco.mj_forward(mm, data)  # the constraint (brake) torque at this instant
-            q_out[k] = data.qpos[healthy]
-            locked_out[k] = data.qpos[braked] - lock_angles
-            brake_out[k] = data.qfrc_constraint[braked_v]
-            if attitude is not None and com is not None and rate is not None:
-                attitude[k] = data.qpos[3:7]
-                com[k] = data.xipos[base_body]
-                rate[k] = data.qvel[3:6]
-            if caught:
+            if not player.record(k):
                 break
             if k < steps:
-                data.ctrl[:] = feed_mid[k] + correction
-                mujoco.mj_step(mm, data)
-    finally:
-        mujoco.set_mju_user_warning(previous)
-    if caught or not (np.all(np.isfinite(q_out)) and np.all(np.isfinite(brake_out))):
-        raise ModelError(
-            f"the MuJoCo replay of {label} became unstable ({(caught or ['non-finite state'])[0].strip()}); try a "
-            f"smaller timestep than {timestep:g} s"
-        )
-    reference = None
-    if com is not None:
-        com = com - com[0]
-        reference = spacecraft_response(model, t, q_ref, dq_ref)
-    return Replay(
-        label=label,
-        t=t,
-        joint_numbers=model.joint_numbers,
-        locked_numbers=tuple(lj.number for lj in model.locked),
-        q=q_out,
-        q_ref=q_ref,
-        locked_angle=locked_out,
-        brake=brake_out,
-        brake_ref=brake_ref.reshape(m, -1),
-        attitude=attitude,
-        com_displacement=com,
-        angular_velocity=rate,
-        reference=reference,
-        timestep=float(timestep),
-        mujoco_version=str(mujoco.__version__),
+                player.step(feed_mid[k] + correction)
+    reference = spacecraft_response(model, t, q_ref, dq_ref) if floating else None
+    return player.result(model, label, t, q_ref, brake_ref, reference)
+
+
+def replay_waypoints(
+    model: ArmModel,
+    times: FloatArray,
+    q: FloatArray,
+    *,
+    label: str = "waypoints",
+    timestep: float = TIMESTEP_S,
+    tracking: float = TRACKING_RAD_S,
+) -> Replay:
+    """Play waypoints ``q`` (K, n) of the healthy joints at ``times`` (K,) [s], joined by a
+    cubic spline (twice differentiable, not-a-knot ends: :class:`scipy.interpolate.CubicSpline`),
+    with :func:`replay_motion`.  jointlock's figures in the replay are computed on that spline."""
+    from scipy.interpolate import CubicSpline
+
+    times = np.asarray(times, dtype=float)
+    if times.ndim != 1 or times.size < 3 or np.any(np.diff(times) <= 0):
+        raise ConfigurationError(f"times must be 3 or more increasing times [s]; got shape {times.shape}")
+    spline = CubicSpline(times - times[0], np.asarray(q, dtype=float), axis=0)
+
+    def trajectory(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return spline(t), spline(t, 1), spline(t, 2)
+
+    return replay_motion(
+        model, trajectory, float(times[-1] - times[0]), label=label, timestep=timestep, tracking=tracking
     )
+
+
+def replay_steps(
+    model: ArmModel,
+    t: FloatArray,
+    q: FloatArray,
+    qd: FloatArray,
+    failures: Sequence[tuple[int, float]],
+    *,
+    label: str = "control steps",
+    timestep: float = TIMESTEP_S,
+    tracking: float = TRACKING_RAD_S,
+) -> Replay:
+    """Play a control loop's run: joint rates ``qd`` (N, n) held over each step
+    ``[t_k, t_k+1)`` from ``q`` (N + 1, n) of the whole arm ``model``, each joint of ``failures``
+    (``(joint number, time [s])``) locking at its time (rate 0 from that step on, then held by
+    its brake: :func:`jointlock.planning.jump.simulate`'s runs).
+
+    At every control step MuJoCo's joint velocities are set to the step's rates (the command of
+    an ideal rate servo) and the spacecraft's twist changed by the impulse that keeps the total
+    momentum, computed from MuJoCo's own mass matrix (:func:`mujoco.mj_mulM`); within the step
+    the motors hold the rates: jointlock's inverse dynamics at zero joint acceleration plus the
+    correction of :func:`replay_motion`.  A joint that locks has its brake turned on (a joint
+    equality at the angle it has in MuJoCo) and its motor off.  jointlock's figures are the
+    spacecraft's response on every MuJoCo step, each control step integrated with its constant
+    rates (second order) and the steps chained."""
+    t = np.asarray(t, dtype=float)
+    q = np.asarray(q, dtype=float)
+    qd = np.asarray(qd, dtype=float)
+    n_steps = qd.shape[0]
+    if t.shape != (n_steps + 1,) or q.shape != (n_steps + 1, model.dof) or qd.shape != (n_steps, model.dof):
+        raise ConfigurationError(
+            f"t (N+1,), q (N+1, {model.dof}) and qd (N, {model.dof}) must agree; got {t.shape}, {q.shape}, {qd.shape}"
+        )
+    dt = np.diff(t)
+    if n_steps < 1 or not np.allclose(dt, dt[0], rtol=1e-9, atol=0.0) or not dt[0] > 0:
+        raise ConfigurationError("the control steps must be equal and positive")
+    if model.locked:
+        raise ConfigurationError(f"replay_steps takes the whole arm (its joints lock during the run); {model.name!r} is locked")
+    floating = _check_base(model, None)
+    sub = max(1, math.ceil(dt[0] / timestep - 1e-9))
+    h = float(dt[0]) / sub
+    lock_steps = {int(j): int(np.searchsorted(t, tf - 1e-9 * dt[0])) for j, tf in failures}
+    locked = lock_joints(model, {j: float(q[k, model.joint_numbers.index(j)]) for j, k in lock_steps.items()})
+    index = {j: i for i, j in enumerate(model.joint_numbers)}
+
+    # the reference on every MuJoCo step: q linear within each control step, rates constant
+    step_of = np.repeat(np.arange(n_steps), sub)
+    frac = np.tile(np.arange(sub) * h, n_steps)
+    fine_t = np.append(t[0] + np.arange(n_steps * sub) * h, t[-1]) - t[0]
+    fine_q = np.vstack([q[step_of] + frac[:, None] * qd[step_of], q[-1:]])
+    mid_q = q[step_of] + (frac + 0.5 * h)[:, None] * qd[step_of]
+    mode: BaseMode = "floating" if floating else "fixed"
+    zero = np.zeros_like(mid_q)
+    feed = rnea(model, mid_q, qd[step_of], zero, base=mode).torques
+    loads = rnea(model, fine_q[:-1], qd[step_of], zero, base=mode).torques
+    brake_ref = np.zeros((fine_t.size, len(lock_steps)))
+    for i, (j, k) in enumerate(lock_steps.items()):
+        brake_ref[k * sub : n_steps * sub, i] = loads[k * sub :, index[j]]
+    inertia = generalized_inertia(model, fine_q[:-1]) if floating else mass_matrix(model, fine_q[:-1])
+    kp, kd = tracking**2, 2.0 * tracking
+
+    with _Player(locked, floating, h, fine_t.size, brakes_engaged=False) as player:
+        mujoco, mm, data = player.mujoco, player.mm, player.data
+        joints_v = player.qpos - player.shift
+        data.qpos[player.qpos] = q[0]
+        healthy_cols = [index[j] for j in locked.joint_numbers]
+        mask = np.ones(model.dof, dtype=bool)
+        brake_id = {j: mujoco.mj_name2id(mm, mujoco.mjtObj.mjOBJ_EQUALITY, f"brake{j}") for j in lock_steps}
+        stable = True
+        for k in range(n_steps):
+            for j, kf in lock_steps.items():
+                if kf == k:  # the brake engages where the joint is
+                    mm.eq_data[brake_id[j], 0] = data.qpos[player.qpos[index[j]]]
+                    data.eq_active[brake_id[j]] = 1
+                    mask[index[j]] = False
+            mujoco.mj_forward(mm, data)
+            _set_rates(mujoco, mm, data, joints_v, qd[k], floating)
+            for s in range(sub):
+                i = k * sub + s
+                error = kp * (fine_q[i] - data.qpos[player.qpos]) + kd * (qd[k] - data.qvel[joints_v])
+                ctrl = (feed[i] + inertia[i] @ error) * mask
+                data.ctrl[:] = ctrl
+                if not (stable := player.record(i)):
+                    break
+                player.step(ctrl)
+            if not stable:
+                break
+        if stable:
+            player.record(fine_t.size - 1)
+    for i, k in enumerate(lock_steps.values()):
+        player.locked_angle[: k * sub, i] = 0.0  # the joint moves until it locks: no brake to give yet
+    reference = _stepwise_response(model, fine_t, fine_q, qd, sub) if floating else None
+    return player.result(locked, label, fine_t, fine_q[:, healthy_cols], brake_ref, reference)
+
+
+def _set_rates(mujoco: Any, mm: Any, data: Any, joints_v: np.ndarray, rates: FloatArray, floating: bool) -> None:
+    """Set the joints' velocities to ``rates``; a free spacecraft takes the impulse that keeps the
+    system's momentum (the base rows of MuJoCo's ``M v``) unchanged."""
+    before = data.qvel.copy()
+    data.qvel[joints_v] = rates
+    if not floating:
+        return
+    nv = mm.nv
+    change = np.zeros(nv)
+    change[joints_v] = rates - before[joints_v]
+    pushed = np.zeros(nv)
+    mujoco.mj_mulM(mm, data, pushed, change)
+    block = np.empty((6, 6))
+    unit, column = np.zeros(nv), np.zeros(nv)
+    for i in range(6):
+        unit[:] = 0.0
+        unit[i] = 1.0
+        mujoco.mj_mulM(mm, data, column, unit)
+        block[:, i] = column[:6]
+    data.qvel[:6] = before[:6] - np.linalg.solve(block, pushed[:6])
+
+
+def _stepwise_response(model: ArmModel, t: FloatArray, q: FloatArray, qd: FloatArray, sub: int) -> SpacecraftResponse:
+    """The spacecraft's response to rates ``qd`` (N, n) held over control steps of ``sub`` samples
+    of ``t``, ``q``: each step integrated with its constant rates (second order,
+    :func:`spacecraft_response`), the steps chained (attitude products, drift in the first frame)."""
+    from .analysis.spacecraft import _quaternion_product
+    from .spatial import quaternion_matrix
+
+    attitude = np.empty((t.size, 4))
+    drift = np.empty((t.size, 3))
+    rate = np.empty((t.size, 3))
+    start_q, start_d = np.array([1.0, 0.0, 0.0, 0.0]), np.zeros(3)
+    for k in range(qd.shape[0]):
+        a, b = k * sub, (k + 1) * sub
+        seg = spacecraft_response(model, t[a : b + 1], q[a : b + 1], np.repeat(qd[k : k + 1], b - a + 1, axis=0))
+        attitude[a : b + 1] = _quaternion_product(np.broadcast_to(start_q, seg.attitude.shape), seg.attitude)
+        drift[a : b + 1] = start_d + seg.com_displacement @ quaternion_matrix(start_q).T
+        rate[a : b + 1] = seg.angular_velocity  # a step's end is the next one's start: overwritten there
+        start_q, start_d = attitude[b] / np.linalg.norm(attitude[b]), drift[b].copy()
+    return SpacecraftResponse(t, attitude, rate, drift)
 
 
 def replay_halt(

@@ -55,8 +55,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--check-in",
         choices=("none", "mujoco"),
-        help="replay the halt in this simulator and compare (overrides check_in; mujoco: the optional extra "
-        "jointlock[mujoco])",
+        help="replay the halt, the jump runs and the re-plan in this simulator and compare (overrides check_in; "
+        "mujoco: the optional extra jointlock[mujoco])",
     )
     p.add_argument("--json", action="store_true", help="print results.json on stdout")
     p.add_argument("--quiet", action="store_true", help="no progress bars, no summary")

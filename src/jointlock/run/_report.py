@@ -130,10 +130,11 @@ def _checks_section(checks: dict[str, Any], out: Path) -> list[Section]:
             f"Checked in {next(iter(checks.values()))['simulator']}",
             paragraphs=[
                 "Each motion below was played in MuJoCo: the healthy joints driven by jointlock's inverse-dynamics "
-                "torques plus a stiff tracking correction, the locked joints held by joint equalities (their "
-                "constraint torque is the brake's), the spacecraft a free body starting with zero momentum, "
-                "contacts off. The difference is MuJoCo minus jointlock (for the attitude: the angle between the "
-                "two final attitudes)."
+                "torques plus a stiff tracking correction (a control loop's rates, as the jump study's: set at "
+                "each control step, the spacecraft taking the momentum-keeping impulse from MuJoCo's own mass "
+                "matrix), the locked joints held by joint equalities (their constraint torque is the brake's), "
+                "the spacecraft a free body starting with zero momentum, contacts off. The difference is MuJoCo "
+                "minus jointlock (for the attitude: the angle between the two final attitudes)."
             ],
             tables=tables,
             images=images,

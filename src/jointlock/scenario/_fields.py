@@ -152,8 +152,8 @@ TOP_FIELDS: dict[str, Field] = {
         "choice",
         "none",
         choices=("none", "mujoco"),
-        help="replay the halt in this simulator and compare its spacecraft attitude, drift and brake torque with "
-        "jointlock's ('mujoco': the optional extra jointlock[mujoco]; docs/simulators.md)",
+        help="replay the halt, the jump runs and the re-plan in this simulator and compare the spacecraft's attitude, "
+        "drift and the brake torque with jointlock's ('mujoco': the optional extra jointlock[mujoco]; docs/simulators.md)",
     ),
 }
 
