@@ -88,6 +88,10 @@ _LAZY = {
     "HaltMotion": "jointlock.planning.halt_motion",
     "optimal_halt_motion": "jointlock.planning.halt_motion",
     "adaptive_ga": "jointlock.planning.ga",
+    "Task": "jointlock.planning.task",
+    "load_task_file": "jointlock.planning.task",
+    "WheelCapacity": "jointlock.analysis.attitude_control",
+    "attitude_control_check": "jointlock.analysis.attitude_control",
     "JumpScenario": "jointlock.planning.jump",
     "simulate": "jointlock.planning.jump",
     "jump_at_time": "jointlock.planning.jump",
@@ -135,6 +139,10 @@ __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals()
 
 
 __all__ = [
+    "Task",
+    "load_task_file",
+    "WheelCapacity",
+    "attitude_control_check",
     "mjcf_text",
     "write_mjcf",
     "ArmModel",

@@ -232,11 +232,26 @@ def register(sub: argparse._SubParsersAction) -> None:
         "torque with jointlock's (mujoco: the optional extra jointlock[mujoco]; written as mujoco.* with --out)",
     )
     add_clearance_options(p)
+    p.add_argument(
+        "--wheel-torque-max-Nm",
+        type=field_arg("spacecraft", "wheel_torque_max_Nm"),
+        metavar="T",
+        help="torque the attitude control can give [N m]: the halt's peak base moment (spacecraft held) is "
+        "judged against it (default: reported only)",
+    )
+    p.add_argument(
+        "--wheel-momentum-max-Nms",
+        type=field_arg("spacecraft", "wheel_momentum_max_Nms"),
+        metavar="H",
+        help="angular momentum the wheels can store [N m s]: the momentum the halt hands them is judged "
+        "against it (default: reported only)",
+    )
     p.set_defaults(func=run)
 
 
 def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
     """The options as :func:`plan_halt`'s inputs (errors name the options), and its result."""
+    from ..analysis.attitude_control import WheelCapacity
     from ..jobs._common import joint_vector_deg, locked_text
     from ..jobs.halt import (
         CLI_NAMES,
@@ -338,6 +353,7 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
         objective=args.objective,
         prefer_margin=args.prefer_margin,
         clearance=clearance_from_args(args),
+        wheels=WheelCapacity(args.wheel_torque_max_Nm, args.wheel_momentum_max_Nms),
         _names=CLI_NAMES,
     )
 

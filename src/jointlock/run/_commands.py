@@ -108,6 +108,8 @@ def job_argv(
         for key, option in (("torque_max_Nm", "--torque-max-Nm"), ("brake_max_Nm", "--brake-max-Nm")):
             argv += [option, _num(lim[key])] if lim.get(key) is not None else []
         argv += _clearance_args(lim)
+        for key, option in (("wheel_torque_max_Nm", "--wheel-torque-max-Nm"), ("wheel_momentum_max_Nms", "--wheel-momentum-max-Nms")):
+            argv += [option, _num(d["spacecraft"][key])] if d["spacecraft"].get(key) is not None else []
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]
         argv += ["--n-samples", str(t["n_samples"]), "--generations", str(t["generations"])]
         argv += ["--population", str(t["population"])] + (["--minimum-T"] if t["minimum_T"] else [])

@@ -86,12 +86,16 @@ def report_sections(
 
 def _safety_section(jobs: dict[str, Any]) -> list[Section]:
     """First, when a job's answer comes closer than allowed to the spacecraft bus or the arm
-    itself (issue 27): the verdict each such job gives as its first line."""
+    itself (issue 27), or needs more than the attitude control can give (issue 28): the verdict
+    each such job gives as its first line."""
     lines = []
     halt = (jobs.get("halt") or {}).get("result") or {}
     verdict = (halt.get("clearance") or {}).get("verdict")
     if verdict:
         lines.append(("halt", verdict))
+    wheels = halt.get("attitude_control") or {}
+    if wheels.get("within") is False:
+        lines.append(("halt", wheels["verdict"]))
     replan = ((jobs.get("replan") or {}).get("result") or {}).get("clearance") or {}
     if replan.get("colliding_waypoints"):
         lines.append(
@@ -100,11 +104,14 @@ def _safety_section(jobs: dict[str, Any]) -> list[Section]:
         )  # fmt: skip
     if not lines:
         return []
+    clearance = any(not text.startswith("ATTITUDE CONTROL") for _, text in lines)
     return [
         Section(
-            "Clearance: read this first",
+            "Clearance: read this first" if clearance else "Attitude control: read this first",
             paragraphs=[f"<b>{html.escape(job)}</b>: {html.escape(text)}" for job, text in lines],
-            notes=["Collision geometry, the pairs checked and the mounted pairs: docs/clearance.md."],
+            notes=["Collision geometry, the pairs checked and the mounted pairs: docs/clearance.md."]
+            if clearance
+            else ["The attitude control's load with the spacecraft held: jointlock.analysis.attitude_control."],
         )
     ]
 

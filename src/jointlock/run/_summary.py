@@ -44,6 +44,12 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
                 key: clear[key]
                 for key in ("collides", "start_m", "motion_min_m", "motion_min_pair", "motion_min_time_s", "verdict")
             }
+        if (wheels := r.get("attitude_control")) is not None:
+            s["halt"]["attitude_control"] = {
+                key: wheels[key] for key in ("peak_torque_Nm", "peak_momentum_Nms", "within", "verdict")
+            }
+        if r.get("state_source", "").startswith("task at"):
+            s["halt"]["state_source"] = r["state_source"]
     if "jump" in jobs:
         r = jobs["jump"]["result"]
         s["jump"] = {
@@ -127,6 +133,9 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     verdict = ((s.get("halt") or {}).get("clearance") or {}).get("verdict")
     if verdict:  # a halt that comes too close says so first
         lines.insert(0, verdict)
+    wheels = (s.get("halt") or {}).get("attitude_control") or {}
+    if wheels.get("within") is False:  # ... and one that needs more than the wheels can give
+        lines.insert(0, wheels["verdict"])
     if "halt_config" in s:
         h = s["halt_config"]
         q = ", ".join(f"{v:.2f}" for v in h["q_best_deg"])
@@ -150,6 +159,10 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
                 f"  halt motion: INFEASIBLE, {h['violations']} limit(s) broken at the least-violating k; "
                 f"smallest feasible halt time {'n/a' if t is None else f'{t:.3f} s'}"
             )
+        if h.get("state_source"):
+            lines.append(f"  state at failure: the {h['state_source']}")
+        if (wheels := h.get("attitude_control")) is not None:
+            lines.append(f"  {wheels['verdict']}")
     if "jump" in s:
         j = s["jump"]
         lines.append(

@@ -13,6 +13,7 @@ from ..robots import BUILTIN_ROBOTS, CHAIN_FIELDS, UrdfChain
 from ._defaults import _defaults_000, _is_000_failure
 from ._fields import _BASE2, NEEDS_LOCK, _hint
 from ._jump import _check_jump
+from ._task import state_from_task
 
 
 def _inherit_singular_base(out: dict[str, Any], jobs: tuple[str, ...], *, given_base: bool) -> None:
@@ -135,6 +136,7 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
             _load(out, b, source, cache)
     fail = out["failure"]
     n = model.dof
+    state_from_task(out, jobs, source, model)  # [task] + failure.time_s: the state and the angle from it
     if fail["joint"] is not None and not 1 <= fail["joint"] <= n:
         raise ScenarioError(
             f"{source}: failure.joint must be a joint number 1..{n} of {model.name}; got {fail['joint']}"

@@ -11,6 +11,7 @@ from ..bounds import (
     MAX_GAIN,
     MAX_KAPPA,
     MAX_LENGTH_M,
+    MAX_OPTION_DEG,
     MAX_RATE_DEG,
     MAX_SEED,
     MAX_TIME_S,
@@ -55,8 +56,9 @@ class Field:
     """Schema of one scenario field.
 
     ``kind``: ``"int"``, ``"number"``, ``"bool"``, ``"str"``, ``"choice"``, ``"numbers"``
-    (list of numbers), ``"strings"`` (list of choices), ``"locks"`` (a table of joint
-    numbers to angles), ``"joint_values"`` (a table of joint names to numbers).  ``lo``/``hi`` bound numbers
+    (list of numbers), ``"rows"`` (a list of equally long lists of numbers: waypoints),
+    ``"strings"`` (list of choices), ``"locks"`` (a table of joint numbers to angles),
+    ``"joint_values"`` (a table of joint names to numbers).  ``lo``/``hi`` bound numbers
     (``lo_open``: strictly greater); ``choices`` lists allowed strings.
     """
 
@@ -84,9 +86,12 @@ class Field:
         if self.kind in ("choice", "strings"):
             opts = ", ".join(repr(c) for c in self.choices)
             return ("one of " if self.kind == "choice" else "a list of ") + opts
-        what = {"int": "an integer", "number": "a finite number", "numbers": "a list of finite numbers"}[
-            self.kind
-        ]
+        what = {
+            "int": "an integer",
+            "number": "a finite number",
+            "numbers": "a list of finite numbers",
+            "rows": "a list of 2 or more equally long rows of finite numbers",
+        }[self.kind]
         if self.length is not None:
             what = f"a list of {self.length} finite numbers"
         rng = []
@@ -98,7 +103,7 @@ class Field:
             rng.append(f"{'>' if self.lo_open else '>='} {num(self.lo)}")
         if self.hi is not None:
             rng.append(f"<= {num(self.hi)}")
-        each = " each" if self.kind == "numbers" else ""
+        each = " each" if self.kind in ("numbers", "rows") else ""
         return what + (f"{each} " + " and ".join(rng) if rng else "") + unit
 
 
@@ -165,7 +170,13 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
             "number", None, lo=-MAX_ABS_DEG, hi=MAX_ABS_DEG, unit="deg", help="angle it locks at"
         ),
         "time_s": Field(
-            "number", None, lo=0.0, hi=MAX_TIME_S, unit="s", help="time it locks during a task (jump)"
+            "number",
+            None,
+            lo=0.0,
+            hi=MAX_TIME_S,
+            unit="s",
+            help="time it locks during a task: the jump study's, or [task]'s (then the halt starts from the task's "
+            "state at that instant and the joint locks at the task's angle)",
         ),
         "also_locked_deg": Field(
             "locks",
@@ -205,6 +216,37 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         ),
         "check_clearance": Field(
             "bool", True, help="require the clearance (false: report it only, the papers' way) (halt_config, halt)"
+        ),
+    },
+    "task": {
+        "file": Field(
+            "str",
+            None,
+            help="the planned motion as a CSV (header, then t_s and one angle per joint [deg] per row) or NPZ "
+            "(t_s, q_deg) file, relative to the scenario's folder; joined by a cubic spline",
+        ),
+        "waypoints_deg": Field(
+            "rows",
+            None,
+            lo=-MAX_OPTION_DEG,
+            hi=MAX_OPTION_DEG,
+            unit="deg",
+            help="or the planned motion as waypoints, every joint of the arm per row, rest at each",
+        ),
+        "durations_s": Field(
+            "numbers", None, lo=0.0, lo_open=True, hi=MAX_TIME_S, unit="s", help="time from each waypoint to the next"
+        ),
+        "scaling": Field(
+            "choice", "quintic", choices=("quintic", "trapezoidal"), help="time scaling of each waypoint segment"
+        ),
+    },
+    "spacecraft": {
+        "wheel_torque_max_Nm": _pos(
+            "N m", "torque the attitude control can give (halt: its peak base moment is judged against it)",
+            hi=MAX_TORQUE_NM,
+        ),  # fmt: skip
+        "wheel_momentum_max_Nms": _pos(
+            "N m s", "angular momentum the wheels can store (halt: the momentum it hands them)", hi=MAX_TORQUE_NM
         ),
     },
 }

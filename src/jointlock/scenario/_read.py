@@ -30,6 +30,7 @@ from ._fields import (
     _spellings,
 )
 from ._scenario import Scenario
+from ._task import resolve_task_file
 
 
 def load_scenario(path: str | Path, overrides: Mapping[str, Any] | None = None) -> Scenario:
@@ -206,6 +207,15 @@ def check_value(value: Any, spec: Field, where: str) -> Any:
                 raise bad(f" (key {shown(key)} is no joint name)")
         number_spec = dataclasses.replace(spec, kind="number")
         return {key: check_value(v, number_spec, f"{where}.{key}") for key, v in value.items()}
+    if kind == "rows":
+        if not isinstance(value, list) or len(value) < 2:
+            raise bad(f" ({type(value).__name__})" if not isinstance(value, list) else f" ({len(value)} row)")
+        row_spec = dataclasses.replace(spec, kind="numbers")
+        rows = [check_value(row, row_spec, f"{where} row {k + 1}") for k, row in enumerate(value)]
+        for k, row in enumerate(rows[1:], start=2):
+            if len(row) != len(rows[0]):
+                raise ScenarioError(f"{where} row {k} has {len(row)} values; row 1 has {len(rows[0])}")
+        return rows
     if kind == "numbers":
         if not isinstance(value, list) or not value:
             raise bad(f" ({type(value).__name__})" if not isinstance(value, list) else " (empty)")
@@ -300,5 +310,6 @@ def scenario_from_dict(
     out.pop("jobs", None)
     _inherit_singular_base(out, jobs, given_base="base" in data)
     _resolve_robot(out, source, base_dir)
+    resolve_task_file(out, source, base_dir)
     _check_semantics(out, jobs, source)
     return Scenario(data=out, jobs=jobs, source=source, base_dir=base_dir)

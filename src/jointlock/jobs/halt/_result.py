@@ -13,6 +13,7 @@ import numpy as np
 
 from ..._cache import cached_on
 from ...analysis.actuators import ActuatorLoads, actuator_loads
+from ...analysis.attitude_control import AttitudeControlCheck, WheelCapacity, attitude_control_check
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...collision import Clearance, ClearanceSettings, clearance, collision_pairs
 from ...io.files import (
@@ -111,6 +112,9 @@ class HaltPlan(JobResult):
         The clearance required and the keep-out volumes (:class:`~jointlock.collision.
         ClearanceSettings`); whether the halt keeps it is :attr:`collision_free`
         (:attr:`feasible` is the limits' verdict).
+    wheels
+        What the spacecraft's attitude control can absorb (:class:`~jointlock.analysis.
+        attitude_control.WheelCapacity`); the halt's load on it is :meth:`attitude_control`.
     """
 
     job: ClassVar[str] = "halt"
@@ -128,6 +132,7 @@ class HaltPlan(JobResult):
     margin: float = 0.0
     notes: tuple[str, ...] = ()
     clearance_settings: ClearanceSettings = field(default_factory=ClearanceSettings)
+    wheels: WheelCapacity = field(default_factory=WheelCapacity)
 
     @property
     def problem(self) -> HaltProblem:
@@ -220,6 +225,7 @@ class HaltPlan(JobResult):
             "clearance": None
             if (clear := self._clearance_dict()) is None
             else {**clear, "verdict": next(iter(self._collision_line()), None)},
+            "attitude_control": self.attitude_control().to_dict(),
             "torque_limit_Nm": _none_for_inf(self.limits.torque),
             "brake_limit_Nm": _none_for_inf(self.limits.brake),
             "torque_limit_source": list(self.limits.torque_source),
@@ -328,6 +334,25 @@ class HaltPlan(JobResult):
         text += f"; the halt configuration keeps {data['halt_configuration_m']:+.3f} m ({data['halt_configuration_pair']})"
         return [text]
 
+    def attitude_control(self) -> AttitudeControlCheck:
+        """What the attitude control must absorb to hold the spacecraft during the halt
+        (:func:`~jointlock.analysis.attitude_control.attitude_control_check`, issue 28): the
+        peak base moment [N m] and the angular momentum handed to the wheels [N m s], about the
+        spacecraft's centre of mass, on the constraint grid, against :attr:`wheels`."""
+        p = self.problem
+
+        def compute() -> AttitudeControlCheck:
+            t = p.times(p.n_check)
+            q, dq, ddq = self.motion.trajectory(t)
+            return attitude_control_check(p.model, t, q, dq, ddq, self.wheels)
+
+        return cached_on(self, "attitude_control", compute)
+
+    def _attitude_line(self) -> list[str]:
+        """The first line of the summary when the halt needs more than the wheels can give."""
+        check = self.attitude_control()
+        return [check.verdict()] if check.within is False else []
+
     def actuator_loads(self) -> ActuatorLoads | None:
         """Motor torques of the healthy joints and brake torques of the locked joints over the
         halt (:func:`~jointlock.analysis.actuators.actuator_loads`), with the base of the
@@ -416,7 +441,7 @@ class HaltPlan(JobResult):
         """The lines ``jointlock halt`` prints."""
         res, p = self.motion, self.problem
         nums = list(p.model.joint_numbers)
-        lines = self._collision_line() + [
+        lines = self._collision_line() + self._attitude_line() + [
             f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
             f"base torque with {p.base} base about {MOMENT_TEXT[p.moment_about]}",
             f"halt configuration ({self.qf_source}): "
@@ -486,6 +511,8 @@ class HaltPlan(JobResult):
             f"global base torque: k = 0: {res.global_torque_k0:.4f} N m; {at}: {res.global_torque:.4f} N m "
             f"({_change_text(res)})"
         )
+        if self.attitude_control().within is not False:  # (over capacity: the first line says so)
+            lines.append(self.attitude_control().verdict())
         if p.objective != "mean_torque" and res.objective_value is not None:
             unit = OBJECTIVES[p.objective]
             lines.append(

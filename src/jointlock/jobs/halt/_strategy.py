@@ -14,6 +14,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._random import resolve_seed
+from ...analysis.attitude_control import WheelCapacity
 from ...bounds import as_real
 from ...collision import ClearanceSettings, collision_pairs
 from ...collision import clearance as clearance_of
@@ -33,6 +34,7 @@ from ...planning.halt_motion import (
 )
 from ...progress import Progress
 from ...robots import UrdfChain, load_robot
+from ...scenario._task import task_given
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_clearance, scenario_locks
 from ._checks import (
     LIBRARY_NAMES,
@@ -215,6 +217,7 @@ def plan_halt(
     objective: str = "mean_torque",
     prefer_margin: float = 0.0,
     clearance: ClearanceSettings | None = None,
+    wheels: WheelCapacity | None = None,
     _names: Mapping[str, Any] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
 ) -> HaltPlan:
@@ -296,6 +299,12 @@ def plan_halt(
         still comes closer is reported (:attr:`HaltPlan.collision_free` False, the first line
         of the summary: which pair, when and by how much; ``feasible`` is the limits' verdict).  ``ClearanceSettings.off()``: reported only (000's
         way; ``paper_qf`` is 000's configuration and is only reported).
+    wheels
+        Beyond 000 (issue 28): what the spacecraft's attitude control can absorb
+        (:class:`~jointlock.analysis.attitude_control.WheelCapacity`: torque [N m], stored
+        momentum [N m s]); the halt's peak base moment and the momentum it hands the wheels are
+        judged against them (:meth:`HaltPlan.attitude_control`; over capacity: the summary's
+        first line).  Default: reported, not judged.
 
     Raises
     ------
@@ -389,6 +398,7 @@ def plan_halt(
         margin=margin,
         notes=notes,
         clearance_settings=clearance,
+        wheels=wheels if wheels is not None else WheelCapacity(),
     )
 
 
@@ -462,6 +472,8 @@ def halt_from_scenario(
         names=("state.q0_deg", "state.dq0_deg", "state.ddq0_deg"),
     )
     names = dict(SCENARIO_NAMES)
+    from_task = task_given(data) and data["failure"]["time_s"] is not None
+    state_source = f"task at t = {data['failure']['time_s']:g} s" if from_task else None
     qf = None
     if t["qf_deg"] is not None:
         qf = joint_vector_deg(model, list(t["qf_deg"]), "halt.qf_deg")
@@ -491,5 +503,9 @@ def halt_from_scenario(
         objective=t["objective"],
         prefer_margin=float(t["prefer_margin"]),
         clearance=scenario_clearance(data),
+        wheels=WheelCapacity(
+            data["spacecraft"]["wheel_torque_max_Nm"], data["spacecraft"]["wheel_momentum_max_Nms"]
+        ),
+        state_source=state_source,
         _names=names,
     )

@@ -1,0 +1,106 @@
+"""The ``[task]`` table (issue 28): a planned joint motion, and the state at failure taken from
+it at ``[failure] time_s`` (the joint locks at the angle the task has it then)."""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from ..bounds import shown
+from ..errors import ScenarioError
+from ..io.files import check_path_text
+from ..planning.task import Task, load_task_file
+
+
+def task_given(out: Mapping[str, Any]) -> bool:
+    """Whether the scenario has a planned motion."""
+    t = out.get("task") or {}
+    return t.get("file") is not None or t.get("waypoints_deg") is not None
+
+
+def resolve_task_file(out: dict[str, Any], source: str, base_dir: Path) -> None:
+    """``task.file`` as an absolute path (relative to the scenario's folder), checked to exist."""
+    name = (out.get("task") or {}).get("file")
+    if name is None:
+        return
+    check_path_text(name, f"{source}: task.file", ScenarioError)
+    path = Path(name)
+    if not path.is_absolute():
+        path = (base_dir / path).resolve()
+    if not path.is_file():
+        raise ScenarioError(f"{source}: task.file {shown(name)} not found (looked for {path})")
+    out["task"]["file"] = str(path)
+
+
+def scenario_task(out: dict[str, Any], source: str = "scenario") -> Task | None:
+    """The :class:`~jointlock.planning.task.Task` of a resolved scenario, or None."""
+    t = out.get("task") or {}
+    if t.get("file") is not None:
+        if t.get("waypoints_deg") is not None or t.get("durations_s") is not None:
+            raise ScenarioError(f"{source}: task.file and task.waypoints_deg exclude each other; give one")
+        return load_task_file(t["file"])
+    if t.get("waypoints_deg") is None:
+        if t.get("durations_s") is not None:
+            raise ScenarioError(f"{source}: task.durations_s needs task.waypoints_deg")
+        return None
+    if t.get("durations_s") is None:
+        raise ScenarioError(f"{source}: task.waypoints_deg needs task.durations_s (one per segment)")
+    return Task.from_waypoints(t["waypoints_deg"], t["durations_s"], t["scaling"], source=f"{source}: [task]")
+
+
+def state_from_task(out: dict[str, Any], jobs: tuple[str, ...], source: str, model: Any) -> None:
+    """With a ``[task]``: check it against the arm, and with ``failure.time_s`` fill the state at
+    failure (the healthy joints' angles, rates and accelerations of the task then) and the locked
+    angle (the task's), in place.  A ``[state]`` given too, an angle that disagrees with the
+    task's, a time past the task's end: one line each."""
+    task = scenario_task(out, source)
+    if task is None:
+        return
+    task.check(model)
+    fail = out["failure"]
+    time_s = fail["time_s"]
+    if "jump" in jobs:
+        raise ScenarioError(
+            f"{source}: [task] is a planned joint motion; the jump study follows its own Cartesian task ([jump]): "
+            "run them in separate scenarios"
+        )
+    if time_s is None:
+        raise ScenarioError(f"{source}: [task] needs failure.time_s (the instant the joint locks, in [0, {task.duration:g}] s)")
+    if not time_s <= task.duration:
+        raise ScenarioError(f"{source}: failure.time_s = {time_s:g} s is after the task's end ({task.duration:g} s)")
+    given = [k for k in ("q0_deg", "dq0_deg", "ddq0_deg") if out["state"][k] is not None]
+    if given:
+        raise ScenarioError(
+            f"{source}: state.{given[0]} and [task] with failure.time_s both give the state at failure; give one "
+            "(the task's state at that instant, or [state] without a task)"
+        )
+    q, dq, ddq = (np.degrees(v) for v in task.state(float(time_s)))
+    locks = {int(j): float(a) for j, a in (fail.get("also_locked_deg") or {}).items()}
+    if fail["joint"] is not None:
+        j = int(fail["joint"])
+        if not 1 <= j <= model.dof:
+            return  # the joint number's own check names it
+        if fail["angle_deg"] is None:
+            fail["angle_deg"] = float(q[j - 1])
+        elif not math.isclose(fail["angle_deg"], q[j - 1], abs_tol=1e-6):
+            raise ScenarioError(
+                f"{source}: failure.angle_deg = {fail['angle_deg']:g} but the task has joint {j} at {q[j - 1]:.6g} deg "
+                f"at t = {time_s:g} s; drop failure.angle_deg (the joint locks where the task has it)"
+            )
+        locks[j] = float(fail["angle_deg"])
+    for j, angle in locks.items():
+        if 1 <= j <= model.dof and not math.isclose(q[j - 1], angle, abs_tol=1e-6):
+            raise ScenarioError(
+                f"{source}: failure.also_locked_deg.{j} = {angle:g} but the task has joint {j} at {q[j - 1]:.6g} deg at "
+                f"t = {time_s:g} s: a joint locked before the failure cannot move in the task"
+            )
+    healthy = [k for k in range(model.dof) if k + 1 not in locks]
+    out["state"]["q0_deg"] = [float(q[k]) for k in healthy]
+    out["state"]["dq0_deg"] = [float(dq[k]) for k in healthy]
+    out["state"]["ddq0_deg"] = [float(ddq[k]) for k in healthy]
+    if "replan" in jobs and out["replan"]["from_deg"] is None:
+        out["replan"]["from_deg"] = [float(v) for v in q]
