@@ -56,7 +56,11 @@ def test_in_process_run_records_every_case_and_the_failures(serial):
     assert all("already breaks a limit" in f["error_message"] for f in status.failures)
     assert all(f["params"]["limits.vmax_deg_s"] == 30.0 for f in status.failures)
     lines = "\n".join(status.summary())
-    assert "failed cases (4)" in lines and "InfeasibleError" in lines
+    # infeasible is an answer, counted apart from errors (issue 28)
+    assert status.infeasible == 4 and status.to_dict()["errors"] == 0 and result.infeasible == 4
+    assert "4 infeasible (an answer), 0 failed" in lines and "infeasible cases (nothing keeps the limits" in lines
+    assert "failed cases" not in lines and "InfeasibleError" in lines
+    assert "(0 ok, 4 infeasible, 0 failed)" in "\n".join(result.summary()) or "4 infeasible, 0 failed" in "\n".join(result.summary())
 
 
 def test_the_ledger_holds_each_jobs_result_and_the_columns(serial):

@@ -122,6 +122,9 @@ class CampaignReport:
             robot = Path(str(data.get("robot", "")))
             if robot.suffix.lower() in (".toml", ".urdf") and not robot.is_absolute():
                 data["robot"] = str((spec.scenario_dir / robot).resolve())
+            task_file = (data.get("task") or {}).get("file")
+            if task_file and not Path(task_file).is_absolute():  # relative to the base scenario's folder
+                data["task"] = {**data["task"], "file": str((spec.scenario_dir / task_file).resolve())}
             header = (
                 f"# Case {row['index']} of the campaign {spec.source} (key {row['key']}), as a plain scenario:\n"
                 f"#   jointlock run {self._case_file(row)}\n# gives the same numbers as the campaign (same seed).\n"
@@ -134,7 +137,7 @@ class CampaignReport:
     def html(self, folder: Path | None = None) -> str:
         """The report page (links to the worst cases' files relative to ``folder``)."""
         s, t = self.status, self.table
-        sections: list[rp.Section | None] = [_overview(s, self.spec), _varied(self.spec)]
+        sections: list[rp.Section | None] = [_audit_section(Path(s.out)), _overview(s, self.spec), _varied(self.spec)]
         ok_rows = [r for r in t.rows if r["status"] == "ok"]
         numeric = [m for m in t.metrics if is_numeric([r.get(m) for r in ok_rows])]
         sections.append(_headline(ok_rows, numeric))
@@ -150,7 +153,9 @@ class CampaignReport:
             f"jointlock campaign: {s.title}",
             [sec for sec in sections if sec is not None],
             intro=(
-                f"Campaign <code>{html.escape(s.source)}</code>: {s.planned} cases, {s.ok} ok, {s.failed} failed"
+                f"Campaign <code>{html.escape(s.source)}</code>: {s.planned} cases, {s.ok} ok, "
+                + (f"{s.infeasible} infeasible (an answer: nothing keeps the limits), {s.failed - s.infeasible} failed"
+                   if s.infeasible else f"{s.failed} failed")
                 + (f", <b>{s.remaining} not run yet</b>" if s.remaining else "")
                 + f". Every number is in <code>{html.escape(str(Path(s.out) / 'ledger.sqlite'))}</code> "
                 "(<code>jointlock campaign export</code> writes it as CSV or Parquet)."
@@ -420,3 +425,42 @@ def write_campaign_report(out: str | Path, path: str | Path | None = None, **opt
     """Write the report of the campaign in ``out`` (:func:`campaign_report`'s ``options``);
     returns the files written (``report.html`` first)."""
     return campaign_report(out, **options).write(path)
+
+
+def _audit_section(out: Path) -> rp.Section | None:
+    """An audit's answer first (``audit.json``, :func:`~jointlock.campaign.run_audit`): the safe
+    windows, and the risk timeline: each joint's lock at each instant, safe or not."""
+    path = out / "audit.json"
+    if not path.is_file():
+        return None
+    import json
+
+    data = json.loads(path.read_text())
+    times, unsafe = data["times_s"], [set(j) for j in data["unsafe_joints"]]
+    windows = data["windows_s"]
+    sec = rp.Section("Audit: safe windows")
+    if windows:
+        text = ", ".join(f"[{a:g}, {b:g}] s" if b > a else f"{a:g} s" for a, b in windows)
+        sec.paragraphs.append(f"<b>Safe windows</b> (every audited lock leaves a feasible, clear halt within the "
+                              f"attitude control's capacity): {html.escape(text)}.")  # fmt: skip
+    else:
+        sec.paragraphs.append("<b>NO SAFE WINDOW</b>: at every audited instant some lock leaves no safe halt.")
+    joints = sorted({j for js in data["unsafe_joints"] for j in js} | set(data.get("joints", [])))
+    rows = [[f"{t:g}", ", ".join(map(str, sorted(js))) or "none", "" if w is None else str(w)]
+            for t, js, w in zip(times, unsafe, data["worst_joint"])]  # fmt: skip
+    sec.tables.append((["t [s]", "locks with no safe halt", "worst joint"], rows, "risk timeline"))
+    if joints and len(times) > 1:
+        fig = offscreen_figure((min(3.0 + 0.5 * len(times), 12.0), 1.5 + 0.35 * max(len(joints), 1)))
+        ax = fig.add_subplot()
+        for t, js in zip(times, unsafe):
+            for j in joints:
+                ax.plot(t, j, "s", color="#b00020" if j in js else "#176f2c", markersize=9)
+        for a, b in windows:
+            ax.axvspan(a, b if b > a else a + 1e-9, color="#176f2c", alpha=0.12)
+        ax.set_xlabel("failure instant t [s]")
+        ax.set_ylabel("locked joint")
+        ax.set_yticks(joints)
+        ax.set_title("risk timeline: red, the lock leaves no safe halt; shaded, the safe windows", fontsize=9)
+        fig.tight_layout()
+        sec.images.append(("risk timeline", figure_png(fig)))
+    return sec

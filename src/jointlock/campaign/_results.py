@@ -60,6 +60,12 @@ class CampaignStatus:
     def complete(self) -> bool:
         return self.remaining == 0
 
+    @property
+    def infeasible(self) -> int:
+        """Of ``failed``, the cases whose answer is that nothing keeps the limits
+        (``InfeasibleError``, its binding limit in the message): an answer, not an error."""
+        return sum(1 for f in self.failures if f["error_type"] == "InfeasibleError")
+
     def to_dict(self) -> dict[str, Any]:
         return {
             "title": self.title,
@@ -68,6 +74,8 @@ class CampaignStatus:
             "planned": self.planned,
             "ok": self.ok,
             "failed": self.failed,
+            "infeasible": self.infeasible,
+            "errors": self.failed - self.infeasible,
             "remaining": self.remaining,
             "outside": self.outside,
             "complete": self.complete,
@@ -85,7 +93,10 @@ class CampaignStatus:
             state += f"; a run is in progress (pid {self.running_pid})"
         lines = [
             f"{self.title} ({self.source})",
-            f"cases: {self.planned} planned, {self.ok} ok, {self.failed} failed, {state}"
+            f"cases: {self.planned} planned, {self.ok} ok, "
+            + (f"{self.infeasible} infeasible (an answer), {self.failed - self.infeasible} failed" if self.infeasible
+               else f"{self.failed} failed")
+            + f", {state}"
             + (f"; {self.outside} older case(s) no longer in the file" if self.outside else ""),
             f"work: {self.case_seconds:.1f} s over {len(self.runs)} run(s)"
             + (f"; {self.warned} case(s) raised warnings" if self.warned else ""),
@@ -98,13 +109,18 @@ class CampaignStatus:
                 f"  run {r['id']} {r['started_at']}{source}: {r['engine']}; {r['ok']} ok, {r['failed']} failed "
                 f"of {r['to_run']} sent; {how}"
             )
-        if self.failures:
-            lines.append(f"failed cases ({len(self.failures)}):")
-            for f in self.failures[:MAX_FAILURES_SHOWN]:
+        for title, group in (
+            ("infeasible cases (nothing keeps the limits: why, for each)", [f for f in self.failures if f["error_type"] == "InfeasibleError"]),
+            ("failed cases", [f for f in self.failures if f["error_type"] != "InfeasibleError"]),
+        ):  # fmt: skip
+            if not group:
+                continue
+            lines.append(f"{title} ({len(group)}):")
+            for f in group[:MAX_FAILURES_SHOWN]:
                 message = _one_line(_without_prefix(f["error_message"] or ""), limit=240)
                 lines.append(f"  #{f['index']} ({params_text(f['params'], limit=80)}): {f['error_type']}: {message}")
-            if len(self.failures) > MAX_FAILURES_SHOWN:
-                lines.append(f"  ... and {len(self.failures) - MAX_FAILURES_SHOWN} more (export lists them all)")
+            if len(group) > MAX_FAILURES_SHOWN:
+                lines.append(f"  ... and {len(group) - MAX_FAILURES_SHOWN} more (export lists them all)")
         if not self.complete and self.running_pid is None:
             lines.append(f"resume: {shlex.join(['jointlock', 'campaign', 'run', self.source, '--out', self.out])}")
         return lines

@@ -64,6 +64,9 @@ class CampaignRun:
         Cases of the campaign file, finished before this run, and sent in this run.
     ok, failed
         Cases of this run that finished, and that raised (recorded with their error).
+    infeasible
+        Of ``failed``, the cases whose answer is that nothing keeps the limits
+        (``InfeasibleError``: an answer, with its binding limit in the message, not an error).
     remaining
         Cases of the plan still not finished (after an interruption).
     seconds, case_seconds
@@ -94,6 +97,12 @@ class CampaignRun:
     columns: tuple[str, ...] = field(default_factory=tuple)
     unknown_columns: tuple[str, ...] = field(default_factory=tuple)
     other_campaign: str | None = None
+    infeasible: int = 0
+
+    @property
+    def errors(self) -> int:
+        """Cases that raised anything but ``InfeasibleError``."""
+        return self.failed - self.infeasible
 
     @property
     def interrupted(self) -> bool:
@@ -116,6 +125,8 @@ class CampaignRun:
             "to_run": self.to_run,
             "ok": self.ok,
             "failed": self.failed,
+            "infeasible": self.infeasible,
+            "errors": self.errors,
             "remaining": self.remaining,
             "seconds": self.seconds,
             "case_seconds": self.case_seconds,
@@ -133,13 +144,16 @@ class CampaignRun:
     def summary(self) -> list[str]:
         lines = [
             f"{self.title}: {self.planned} cases planned, {self.done_before} finished before, "
-            f"{self.ok + self.failed} run now ({self.ok} ok, {self.failed} failed) in {self.seconds:.1f} s "
+            f"{self.ok + self.failed} run now ({self.ok} ok, {_failed_text(self.failed, self.infeasible)}) in {self.seconds:.1f} s "
             f"with {self.engine} ({self.rate:.3g} cases/s)",
         ]
         if self.lost_batches:
             lines.append(f"  {self.lost_batches} batch(es) lost with a worker and sent again; pool restarts: {self.restarts}")
         if self.failed:
-            lines.append(f"  failed cases are recorded with their error: jointlock campaign status {shlex.quote(self.out)}")
+            lines.append(
+                f"  {'infeasible and failed' if self.infeasible and self.errors else 'infeasible' if self.infeasible else 'failed'} "
+                f"cases are recorded with their reason: jointlock campaign status {shlex.quote(self.out)}"
+            )
         if self.other_campaign:
             lines.append(
                 f"  note: this folder held another campaign ({self.other_campaign}); its cases stay in the "
@@ -280,7 +294,7 @@ class _Coordinator:
         self.queue: deque[Case] = deque(todo)
         self.retry: deque[_Batch] = deque()
         self.in_flight: dict[cf.Future, _Batch] = {}
-        self.counts = {"ok": 0, "failed": 0, "lost": 0, "restarts": 0}
+        self.counts = {"ok": 0, "failed": 0, "infeasible": 0, "lost": 0, "restarts": 0}
         self.case_seconds = 0.0
         self.breaks = 0  # pool breaks since a batch last came back
         self.unknown_columns: tuple[str, ...] | None = None
@@ -390,6 +404,7 @@ class _Coordinator:
         self.breaks = 0 if any(o.error_type != WORKER_LOST for o in outcomes) else self.breaks
         for o in outcomes:
             self.counts["ok" if o.ok else "failed"] += 1
+            self.counts["infeasible"] += int(not o.ok and o.error_type == INFEASIBLE)
             self.case_seconds += o.seconds
         if self.unknown_columns is None:
             first = next((o.result for o in outcomes if o.ok and o.result is not None), None)
@@ -447,6 +462,7 @@ def _coordinate(
         to_run=len(todo),
         ok=loop.counts["ok"],
         failed=loop.counts["failed"],
+        infeasible=loop.counts["infeasible"],
         remaining=ledger.counts()["remaining"],
         seconds=time.perf_counter() - start,
         case_seconds=loop.case_seconds,
@@ -458,3 +474,12 @@ def _coordinate(
         columns=tuple(columns),
         unknown_columns=loop.unknown_columns or (),
     )
+
+
+#: The error class of a case whose answer is "nothing keeps the limits" (counted apart).
+INFEASIBLE = "InfeasibleError"
+
+
+def _failed_text(failed: int, infeasible: int) -> str:
+    """``"3 failed"``, or ``"4 infeasible, 0 failed"`` when some failures are answers."""
+    return f"{infeasible} infeasible, {failed - infeasible} failed" if infeasible else f"{failed} failed"

@@ -40,6 +40,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "export-mjcf": ("export_mjcf", "write the (locked) arm and its spacecraft as a MuJoCo model (MJCF)"),
     "run": ("run", "run every job of a scenario file; results.json, CSV, plots and report.html in one folder"),
     "campaign": ("campaign", "sweep thousands of failure cases (process pool or Dask), resumable"),
+    "audit": ("audit", "audit a planned motion: every joint locking at every instant of the scenario's [task]"),
     "reproduce": ("reproduce", "re-run each seed paper's published experiment and compare with its printed numbers"),
     "demo": ("demo", "run the main job on the built-in arms and write a report"),
 }  # fmt: skip

@@ -15,6 +15,9 @@ from ..errors import ScenarioError
 from ..io.files import check_path_text
 from ..planning.task import Task, load_task_file
 
+#: Decimal places [deg, deg/s, deg/s^2] the state taken from a task is rounded to.
+ROUND_DEG = 9
+
 
 def task_given(out: Mapping[str, Any]) -> bool:
     """Whether the scenario has a planned motion."""
@@ -78,7 +81,9 @@ def state_from_task(out: dict[str, Any], jobs: tuple[str, ...], source: str, mod
             f"{source}: state.{given[0]} and [task] with failure.time_s both give the state at failure; give one "
             "(the task's state at that instant, or [state] without a task)"
         )
-    q, dq, ddq = (np.degrees(v) for v in task.state(float(time_s)))
+    # to 1e-9 deg: the spline reproduces its samples to round-off (a rate sampled at exactly a
+    # limit, 000's 40 deg/s, must not come back 1e-13 above it)
+    q, dq, ddq = (np.round(np.degrees(v), ROUND_DEG) for v in task.state(float(time_s)))
     locks = {int(j): float(a) for j, a in (fail.get("also_locked_deg") or {}).items()}
     if fail["joint"] is not None:
         j = int(fail["joint"])

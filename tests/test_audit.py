@@ -1,0 +1,154 @@
+"""Auditing a planned motion (issue 28): every chosen joint locking at every chosen instant of a
+scenario's [task], on the campaign engine.  A cell is exactly the standalone run with the cell's
+seed; the halt7 example's cell of joint 4 at t = 0 is 000's halt; infeasible cells are answers,
+counted apart from errors; the safe windows are read back."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import jointlock as jl
+from jointlock.campaign import (
+    audit_campaign,
+    audit_windows,
+    campaign_status,
+    in_process,
+    open_ledger,
+    run_audit,
+)
+from jointlock.cli import main
+from jointlock.errors import CampaignError
+
+PUMA = """
+title = "puma6 moves a payload"
+robot = "puma6"
+seed = 0
+[failure]
+joint = 2
+time_s = 0.0
+[task]
+waypoints_deg = [[0, 30, 0, 0, 0, 0], [20, 40, 20, 10, -40, 30], [30, 50, 30, 20, -80, 60]]
+durations_s = [3.0, 3.0]
+[limits]
+vmax_deg_s = 40.0
+amax_deg_s2 = 40.0
+[halt_config]
+samples = 600
+[halt]
+T = 4.0
+samples = 600
+minimum_T = true
+"""
+
+
+@pytest.fixture(scope="module")
+def audited(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("audit")
+    scenario = folder / "plan.toml"
+    scenario.write_text(PUMA)
+    result = run_audit(scenario, folder / "out", joints=[2, 3], times=3, engine=in_process())
+    return scenario, folder / "out", result
+
+
+def test_every_cell_runs_once_and_the_windows_are_read_back(audited):
+    scenario, out, result = audited
+    assert result.run.planned == 6 and result.run.remaining == 0 and result.windows is not None
+    assert result.windows.times == (0.0, 3.0, 6.0) and result.windows.joints == (2, 3)
+    assert json.loads((out / "audit.json").read_text()) == result.windows.to_dict()
+    page = (out / "report.html").read_text()
+    assert "Audit: safe windows" in page and "risk timeline" in page
+    worst = sorted((out / "worst").glob("*.toml"))
+    assert worst and jl.load_scenario(worst[0]).data["task"]["waypoints_deg"] is not None  # re-runs as it is
+    again = run_audit(scenario, out, joints=[2, 3], times=3, engine=in_process())  # resumes: nothing left
+    assert again.run.to_run == 0 and again.run.done_before == 6
+
+
+def test_a_cell_is_the_standalone_run_with_its_seed(audited):
+    scenario, out, _ = audited
+    with open_ledger(out) as ledger:
+        rows = [r for r in ledger.rows() if r["status"] == "ok"]
+        row = rows[-1]
+        recorded = ledger.result(row["key"])
+    overrides = {f"failure.{k.split('.')[1]}": v for k, v in row["params"].items()} | {"seed": row["seed"]}
+    alone = jl.run_scenario(jl.load_scenario(scenario, overrides))
+    mine = json.loads(json.dumps(alone["halt"].to_dict(), default=lambda a: np.asarray(a).tolist()))
+    for key in ("k", "global_torque_Nm", "minimum_T_s", "q_final_deg", "dq_initial_deg_s"):
+        assert recorded["halt"][key] == pytest.approx(mine[key], rel=1e-12, abs=1e-12), key
+    assert recorded["halt"]["state_source"] == f"task at t = {row['params']['failure.time_s']:g} s"
+
+
+def test_audit_windows_on_hand_made_cells():
+    def cell(j, t, feasible=True, clear=True, wheels=True, status="ok"):
+        return {"failure.joint": j, "failure.time_s": t, "status": status, "halt.feasible": feasible,
+                "halt.collision_free": clear, "halt.attitude_control.within": wheels, "halt.minimum_T_s": 5.0 + j}  # fmt: skip
+
+    rows = [cell(1, 0.0), cell(2, 0.0), cell(1, 1.0), cell(2, 1.0, wheels=False), cell(1, 2.0), cell(2, 2.0),
+            cell(1, 3.0, status="error"), cell(2, 3.0), cell(1, 4.0), cell(2, 4.0)]  # fmt: skip
+    w = audit_windows(rows)
+    assert w.windows == ((0.0, 0.0), (2.0, 2.0), (4.0, 4.0))
+    assert w.unsafe_joints[1] == (2,) and w.unsafe_joints[3] == (1,) and w.worst_joint[0] == 2
+    assert audit_windows([cell(1, 0.0, feasible=False)]).summary()[0].startswith("NO SAFE WINDOW")
+
+
+def test_bad_audits_are_one_line(tmp_path):
+    plain = tmp_path / "plain.toml"
+    plain.write_text('robot = "puma6"\n[failure]\njoint = 2\nangle_deg = 10.0\n[state]\nq0_deg = [0, 0, 0, 0, 0]\n'
+                     'dq0_deg = [0, 0, 0, 0, 0]\nddq0_deg = [0, 0, 0, 0, 0]\n[halt]\nT = 3.0\n')  # fmt: skip
+    with pytest.raises(CampaignError, match="has no \\[task\\]"):
+        audit_campaign(plain)
+    planned = tmp_path / "plan.toml"
+    planned.write_text(PUMA)
+    with pytest.raises(CampaignError, match="joints must be distinct joint numbers 1..6"):
+        audit_campaign(planned, joints=[2, 9])
+    with pytest.raises(CampaignError, match="give --times or --dt, not both"):
+        audit_campaign(planned, times=3, dt=1.0)
+    spec = audit_campaign(planned, dt=1.5)
+    assert list(spec.grid["failure.time_s"]) == [0.0, 1.5, 3.0, 4.5, 6.0]
+
+
+def test_cli_audit_and_infeasible_cells_counted_apart(tmp_path, capsys):
+    """With a 10 deg/s speed limit the task's own rates are over it at 3 s: those cells are
+    infeasible (an answer), counted apart from errors in the run and the status."""
+    scenario = tmp_path / "plan.toml"
+    scenario.write_text(PUMA.replace("vmax_deg_s = 40.0", "vmax_deg_s = 10.0"))
+    out = tmp_path / "out"
+    assert main(["audit", str(scenario), "--joints", "2", "--times", "2", "--in-process", "--out", str(out), "--json"]) == 0
+    data = json.loads(capsys.readouterr().out)
+    assert data["planned"] == 2 and data["infeasible"] >= 1 and data["errors"] == 0
+    status = campaign_status(out)
+    assert status.infeasible == data["infeasible"] and "infeasible (an answer)" in "\n".join(status.summary())
+
+
+@pytest.mark.paper
+def test_the_halt7_example_at_000s_instant_is_000s_halt(tmp_path, capsys):
+    """examples/audit_halt7.toml starts its task at 000 §5.2's state: the scenario as it is (joint 4
+    at t = 0, seed 0) gives `jointlock halt halt7`'s k* and base torque."""
+    run = jl.run_scenario(jl.load_scenario("examples/audit_halt7.toml"))
+    plan = run["halt"]
+    assert plan.state_source == "task at t = 0 s"
+    assert main(["halt", "halt7", "--json", "--quiet"]) == 0
+    reference = json.loads(capsys.readouterr().out)
+    assert float(np.ravel(plan.to_dict()["k"])[0]) == pytest.approx(float(np.ravel(reference["k"])[0]), rel=1e-9)
+    assert plan.motion.global_torque == pytest.approx(reference["global_torque_Nm"], rel=1e-9)
+    np.testing.assert_allclose(np.degrees(plan.problem.dq0), [20, 30, 15, 25, 40, 35], atol=1e-9)
+
+
+def test_a_worst_cell_with_a_task_file_runs_from_its_own_folder(tmp_path):
+    """The worst cells are written under DIR/worst/: a task file relative to the audited scenario
+    is written as an absolute path there, so that `jointlock run` finds it."""
+    (tmp_path / "motion.csv").write_text(
+        "t_s, q1, q2, q3, q4, q5, q6\n0, 0, 30, 0, 0, 0, 0\n3, 20, 40, 20, 10, -40, 30\n6, 30, 50, 30, 20, -80, 60\n"
+    )
+    text = PUMA.replace(
+        "waypoints_deg = [[0, 30, 0, 0, 0, 0], [20, 40, 20, 10, -40, 30], [30, 50, 30, 20, -80, 60]]\ndurations_s = [3.0, 3.0]",
+        'file = "motion.csv"',
+    )
+    scenario = tmp_path / "plan.toml"
+    scenario.write_text(text)
+    result = run_audit(scenario, tmp_path / "out", joints=[3], times=2, engine=in_process())
+    worst = sorted((tmp_path / "out" / "worst").glob("*.toml"))
+    assert result.windows is not None and worst
+    assert jl.load_scenario(worst[0]).data["task"]["file"] == str((tmp_path / "motion.csv").resolve())
