@@ -152,3 +152,25 @@ def test_a_worst_cell_with_a_task_file_runs_from_its_own_folder(tmp_path):
     worst = sorted((tmp_path / "out" / "worst").glob("*.toml"))
     assert result.windows is not None and worst
     assert jl.load_scenario(worst[0]).data["task"]["file"] == str((tmp_path / "motion.csv").resolve())
+
+
+def test_an_audited_scenario_needs_no_joint_nor_instant_and_a_damaged_audit_json_is_said(tmp_path):
+    """The audit sets each cell's joint and instant: the file need not name them (it must not
+    name an angle: the task's is used); a damaged audit.json is a note in the report, not a
+    traceback."""
+    text = PUMA.replace("joint = 2\ntime_s = 0.0\n", "")
+    scenario = tmp_path / "plan.toml"
+    scenario.write_text(text)
+    spec = audit_campaign(scenario, joints=[3], times=2)
+    assert list(spec.grid["failure.joint"]) == [3]
+    scenario.write_text(PUMA.replace("time_s = 0.0", "time_s = 0.0\nangle_deg = 30.0"))
+    with pytest.raises(CampaignError, match="failure.angle_deg is the task's"):
+        audit_campaign(scenario)
+    scenario.write_text(PUMA)
+    out = tmp_path / "out"
+    run_audit(scenario, out, joints=[3], times=2, engine=in_process())
+    (out / "audit.json").write_text("{not json")
+    from jointlock.campaign import write_campaign_report
+
+    page = write_campaign_report(out)[0].read_text()
+    assert "audit.json could not be read" in page

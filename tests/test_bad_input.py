@@ -424,8 +424,10 @@ def test_the_error_line_net_cuts_long_words():
     from jointlock.cli import LONGEST_WORD, _short_words
 
     assert _short_words("ok: short words stay") == "ok: short words stay"
-    cut = _short_words("name 'x" + "y" * 5000 + "' is bad")
-    assert cut.startswith("name 'xyy") and cut.endswith("... is bad") and len(cut) < 100
+    cut = _short_words("name 'x" + "y" * 5000 + "z' is bad")
+    assert cut.startswith("name 'xyy") and "...yyy" in cut and cut.endswith("z' is bad") and len(cut) < 150
+    path = "/tmp/" + "/".join(["deep_folder_name"] * 20) + "/model.urdf"
+    assert _short_words(f"looked for {path}").endswith("/model.urdf")  # the file name stays
     assert _short_words("p" * LONGEST_WORD) == "p" * LONGEST_WORD
 
 

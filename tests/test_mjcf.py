@@ -145,14 +145,39 @@ def test_quaternion_from_matrix_round_trip(rng):
         assert quat[0] >= 0
 
 
-def test_contacts_exclude_mounted_pairs():
-    """canadarm7's joint 1 stands on the bus (a pair in contact at the zero pose): the file
-    excludes that body pair from MuJoCo's contacts, so that the arm at rest does not push on it."""
-    arm = jl.load_robot("canadarm7", base="floating")
-    mm, data = _load(mjcf_text(arm))
-    data.qpos[3] = 1.0
-    mujoco.mj_forward(mm, data)
-    assert data.ncon == 0
+@pytest.mark.parametrize("name", ROBOT_NAMES)
+def test_no_contact_at_the_zero_pose(name):
+    """Every body and its parent, and the pairs in contact at the zero pose (canadarm7's joint 1
+    on its bus), are excluded from MuJoCo's contacts: none at the zero pose, fixed base (where
+    MuJoCo does not filter a body welded to the world and its child) and floating, locked and
+    not, folded and with brakes (the review found base-link1 contacts on fixed bases)."""
+    for base in ("fixed", "floating"):
+        arm = jl.load_robot(name, base=base)
+        for model in (arm, jl.lock(arm, 1, 0.0), jl.lock(arm, 2, 0.0)):
+            for brakes in (False, True) if model.locked else (False,):
+                mm, data = _load(mjcf_text(model, brakes=brakes))
+                if base == "floating":
+                    data.qpos[3] = 1.0
+                if brakes:
+                    free = 7 if base == "floating" else 0
+                    for lj in model.locked:
+                        data.qpos[free + lj.number - 1] = lj.angle
+                mujoco.mj_forward(mm, data)
+                assert data.ncon == 0, (base, [lj.number for lj in model.locked], brakes)
+
+
+def test_a_point_mass_and_a_massless_link_load():
+    """MuJoCo refuses zero mass or a zero principal inertia on a moving body: the file asks for
+    its floors (1e-9 kg, 1e-12 kg m^2), and its inverse dynamics still equal jointlock's to 1e-9."""
+    point = jl.Body(10.0, [2.0, 0.0, 0.0], np.zeros((3, 3)))
+    arm = jl.from_dh("two", a=[0.0, 1.0], alpha=[0.0, 0.0], d=[0.0, 0.0], convention="standard",
+                     bodies=[point, jl.Body(0.0)])  # fmt: skip
+    mm, data = _load(mjcf_text(arm), constraints=False)
+    q, dq, ddq = np.array([0.3, -0.2]), np.array([0.5, 1.0]), np.array([-1.0, 2.0])
+    data.qpos[:], data.qvel[:], data.qacc[:] = q, dq, ddq
+    mujoco.mj_inverse(mm, data)
+    tau = jl.rnea(arm, q, dq, ddq).torques
+    assert np.abs(data.qfrc_inverse - tau).max() <= 1e-9 * np.abs(tau).max()
 
 
 def test_cli_export_mjcf(tmp_path, capsys):

@@ -216,3 +216,18 @@ def test_replan_replayed(tmp_path):
     assert np.abs(replay.brake).max() == pytest.approx(np.abs(replay.brake_ref).max(), rel=1e-4)
     fixed = jl.run_scenario(jl.load_scenario("examples/replan_002.toml", {"jobs": ["replan"], "check_in": "mujoco"}))
     assert set(fixed.checks) == {"replan"} and fixed.checks["replan"].spacecraft == "held"
+
+
+def test_the_replay_ends_at_the_motions_end_and_a_refused_model_is_one_line(plan_000):
+    """A step that does not divide T: the replay takes the next smaller one that does (the review:
+    1.5 ms ran to 10.0005 s, past the halt polynomial); a massless arm loads (MuJoCo's floors)."""
+    replay = replay_halt(plan_000, timestep=0.0015)
+    assert replay.t[-1] == pytest.approx(plan_000.problem.T, abs=1e-12) and replay.timestep <= 0.0015
+    assert replay.attitude_difference_deg < ATTITUDE_TOL_DEG
+    with pytest.raises(ConfigurationError, match="timestep"):
+        replay_halt(plan_000, timestep=True)
+    # a massless arm (MuJoCo's floors: 1e-9 kg) replays, its brake holding nothing
+    massless = jl.lock(jl.from_dh("m", a=[0.0, 1.0], alpha=[0.0, 0.0], d=[0.0, 0.0], convention="standard",
+                                  bodies=[jl.Body(0.0), jl.Body(0.0)]), 1, 0.0)  # fmt: skip
+    still = replay_motion(massless, lambda t: (np.zeros((t.size, 1)),) * 3, 1.0)
+    assert np.abs(still.brake).max() < 1e-6

@@ -154,7 +154,7 @@ def test_the_halt_starts_from_the_tasks_state_at_the_failure(tmp_path):
     "edit, words",
     [
         (lambda t: t + "[state]\nq0_deg = [0, 0, 0, 0, 0, 0]\n", "state.q0_deg and [task] with failure.time_s both give"),
-        (lambda t: t.replace("time_s = 3.0", "time_s = 13.0"), "failure.time_s = 13 s is after the task's end (12 s)"),
+        (lambda t: t.replace("time_s = 3.0", "time_s = 13.0"), "failure.time_s = 13 s is outside the task, [0, 12] s"),
         (lambda t: t.replace("time_s = 3.0", "time_s = 3.0\nangle_deg = 5.0"), "the task has joint 4 at 0 deg"),
         (lambda t: t.replace("durations_s = [6.0, 6.0]", "durations_s = [6.0]"), "durations_s needs one duration per segment"),
         (lambda t: t.replace("[-120, -100, -60, 0, 90, 70, 30]]", "[-120, -100, -60, 0, 90, 70, 300]]"), "waypoint 3: joint 7 at 300 deg is outside"),
@@ -176,3 +176,30 @@ def test_a_task_file_relative_to_the_scenario(tmp_path):
     assert scenario.data["failure"]["angle_deg"] == pytest.approx(60.0)
     task = load_task_file(tmp_path / "motion.csv")
     np.testing.assert_allclose(scenario.data["replan"]["from_deg"], np.degrees(task.state(1.0)[0]), atol=1e-12)
+
+
+def test_review_fixes_file_times_header_continuous_joints_npz(tmp_path):
+    """A file's times are kept (6 s into a file from 5 s is 1 s in); a CSV without a header is
+    refused (it would lose its first row); a continuous joint takes any angle; a complex NPZ is
+    refused."""
+    csv = tmp_path / "late.csv"
+    csv.write_text("t_s, q1\n5, 0\n6, 10\n7, 30\n")
+    task = load_task_file(csv)
+    assert (task.start, task.end, task.duration) == (5.0, 7.0, 2.0)
+    assert math.degrees(task.state(6.0)[0][0]) == pytest.approx(10.0)
+    with pytest.raises(ScenarioError, match=r"runs over \[5, 7\] s"):
+        task.state(1.0)
+    bare = tmp_path / "bare.csv"
+    bare.write_text("0, 0\n1, 10\n2, 30\n")
+    with pytest.raises(ScenarioError, match="line 1 is numbers; a CSV task starts with a header row"):
+        load_task_file(bare)
+    body = jl.Body(1.0, [0.5, 0, 0], np.eye(3) * 0.01)
+    free = jl.from_dh("spin", a=[1.0], alpha=[0.0], d=[0.0], convention="standard", bodies=[body],
+                      lower=[-math.inf], upper=[math.inf])  # fmt: skip
+    Task.from_waypoints([[0.0], [270.0]], [2.0]).check(free)  # no limit: any angle
+    np.savez(tmp_path / "c.npz", t_s=[0.0, 1.0], q_deg=np.array([[0j], [1j]]))
+    with pytest.raises(ScenarioError, match="must be real numbers"):
+        load_task_file(tmp_path / "c.npz")
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    with pytest.raises(ScenarioError, match="not an NPZ file of numeric arrays"):
+        load_task_file(tmp_path / "junk.npz")

@@ -17,10 +17,12 @@ What the file holds:
 - one ``motor`` per healthy joint (gear 1: the control is the joint torque [N m]), its control
   range the joint's effort limit when the model has one;
 - the collision geometry (issue 27) as geoms: capsules (``fromto``), spheres and boxes, in the
-  body that carries them; pairs jointlock measures from their zero-pose contact ("mounted":
-  :mod:`jointlock.collision`) are excluded from MuJoCo's contacts, as MuJoCo itself excludes a
-  body and its parent.  Geoms carry no mass (``inertiafromgeom="false"``: the inertia is the
-  model's);
+  body that carries them; every body and its parent (adjacent links, never checked by jointlock;
+  MuJoCo would filter them itself except under a body welded to the world) and the pairs jointlock
+  measures from their zero-pose contact ("mounted": :mod:`jointlock.collision`) are excluded
+  from MuJoCo's contacts.  Geoms carry no mass (``inertiafromgeom="false"``: the inertia is the
+  model's); a massless body or a point mass gets MuJoCo's floors :data:`BOUND_MASS_KG`,
+  :data:`BOUND_INERTIA_KGM2` (MuJoCo refuses zero);
 - a site ``tool`` at the end effector;
 - with ``brakes=True`` and a locked model, the *unlocked* chain instead, each locked joint a
   hinge held at its lock angle by a joint equality (``brake<j>``) and given no motor: the
@@ -51,6 +53,11 @@ from .shapes import Box, Capsule, Shape, Sphere
 
 __all__ = ["mjcf_text", "quaternion_from_matrix", "write_mjcf"]
 
+#: MuJoCo refuses a moving body without mass or with a zero principal inertia (a point mass, a
+#: massless tool link): its compiler raises them to these floors [kg, kg m^2], which change the
+#: dynamics by as much (``boundmass``, ``boundinertia``).
+BOUND_MASS_KG = 1e-9
+BOUND_INERTIA_KGM2 = 1e-12
 #: Default simulation step written in ``<option>`` [s] and its integrator (fourth-order
 #: Runge-Kutta: the replay's attitude agrees with jointlock's to the step's fourth power).
 TIMESTEP_S = 0.001
@@ -194,7 +201,8 @@ def mjcf_text(
         f"<mujoco model={quoteattr(model.name)}>",
         f"  <!-- written by jointlock; locked: {locked_text or 'none'} ({how}); "
         f"base: {'floating' if floating else 'fixed'} -->",
-        '  <compiler angle="radian" autolimits="true" inertiafromgeom="false"/>',
+        f'  <compiler angle="radian" autolimits="true" inertiafromgeom="false" boundmass="{_num(BOUND_MASS_KG)}" '
+        f'boundinertia="{_num(BOUND_INERTIA_KGM2)}"/>',
         f'  <option gravity="{_vec(g)}" timestep="{_num(timestep)}" integrator="{INTEGRATOR}"/>',
         "  <worldbody>",
         f"    <body name={quoteattr(BASE_LINK)}>",
@@ -239,7 +247,11 @@ def mjcf_text(
     for k in range(len(chain.joints), -1, -1):
         lines.append(f"{'      ' + '  ' * (k - 1) if k else '    '}</body>")
     lines.append("  </worldbody>")
-    excluded = _mounted_body_pairs(model, body_of_link)
+    # a body and its parent never touch in jointlock (adjacent links); MuJoCo filters that pair
+    # itself except under a body welded to the world (a fixed base), so it is written out
+    chain_bodies = [BASE_LINK] + [f"link{joint.number}" for joint in chain.joints]
+    excluded = list(zip(chain_bodies[:-1], chain_bodies[1:]))
+    excluded += [pair for pair in _mounted_body_pairs(model, body_of_link) if pair not in excluded and pair[::-1] not in excluded]
     if excluded:
         lines += ["  <contact>"] + [
             f"    <exclude body1={quoteattr(a)} body2={quoteattr(b)}/>" for a, b in excluded

@@ -15,7 +15,7 @@ on every joint at once: ``M`` is the arm's inertia along the reference, the free
 ``H*`` when the spacecraft floats); the feed-forward is sampled at the
 middle of each step (second order in the step).  The spacecraft starts with the twist of zero
 momentum (what jointlock assumes), contacts are off (the clearance is jointlock's to report: a
-colliding motion should not bounce), control limits are off (a motion over a torque limit is
+colliding motion should not bounce), joint and control limits are off (a motion over a limit is
 still replayed; jointlock reports the limit).  MuJoCo integrates with fourth-order Runge-Kutta
 at ``timestep`` (default :data:`jointlock.mjcf.TIMESTEP_S`).
 
@@ -55,6 +55,7 @@ __all__ = [
     "replay_replan",
     "replay_steps",
     "replay_waypoints",
+    "require_mujoco",
 ]
 
 #: The one line a user without the extra sees.
@@ -73,6 +74,12 @@ def _mujoco() -> Any:
     except ImportError:
         raise ConfigurationError(MUJOCO_MISSING) from None
     return mujoco
+
+
+def require_mujoco() -> None:
+    """Raise :data:`MUJOCO_MISSING` now (before a long computation whose motions would be
+    replayed) when MuJoCo is not installed."""
+    _mujoco()
 
 
 @dataclass(frozen=True, eq=False)  # arrays inside
@@ -335,8 +342,13 @@ class _Player:
         assert chain is not None
         mode = "floating" if floating else "fixed"
         text = mjcf_text(model, brakes=True, timestep=timestep, base=mode, brakes_engaged=brakes_engaged)
-        self.mm = mujoco.MjModel.from_xml_string(text)
-        self.mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
+        try:
+            self.mm = mujoco.MjModel.from_xml_string(text)
+        except ValueError as exc:  # MuJoCo's compiler refused the model
+            raise ModelError(f"MuJoCo cannot load {model.name!r}: {' '.join(str(exc).split())}") from None
+        # contacts off (the clearance is jointlock's), and the joint limits: a motion that leaves
+        # them is jointlock's to report, not MuJoCo's to stop
+        self.mm.opt.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT | mujoco.mjtDisableBit.mjDSBL_LIMIT
         self.mm.actuator_ctrllimited[:] = 0
         self.data = mujoco.MjData(self.mm)
         self.floating, self.timestep = floating, timestep
@@ -457,12 +469,13 @@ def replay_motion(
     """
     if not (isinstance(duration, (int, float)) and math.isfinite(duration) and duration > 0):
         raise ConfigurationError(f"duration must be a positive number of seconds; got {duration!r}")
-    if not (isinstance(timestep, (int, float)) and 0 < timestep <= duration):
-        raise ConfigurationError(f"timestep must be in (0, duration] [s]; got {timestep!r}")
+    if isinstance(timestep, bool) or not (isinstance(timestep, (int, float)) and 0 < timestep <= min(duration, 1.0)):
+        raise ConfigurationError(f"timestep must be in (0, min(duration, 1 s)] [s]; got {timestep!r}")
     floating = _check_base(model, base)
     mode: BaseMode = "floating" if floating else "fixed"
-    steps = max(1, round(duration / timestep))
-    t = np.linspace(0.0, steps * timestep, steps + 1)
+    steps = max(1, math.ceil(duration / timestep - 1e-9))
+    timestep = duration / steps  # the replay ends at the motion's end, not past it
+    t = np.linspace(0.0, duration, steps + 1)
     q_ref, dq_ref, ddq_ref = trajectory(t)
     q_mid, dq_mid, ddq_mid = trajectory(t[:-1] + 0.5 * timestep)
     feed_now, brake_ref = actuator_torques(model, q_ref, dq_ref, ddq_ref, base=mode)
@@ -572,10 +585,11 @@ def replay_steps(
     mode: BaseMode = "floating" if floating else "fixed"
     zero = np.zeros_like(mid_q)
     feed = rnea(model, mid_q, qd[step_of], zero, base=mode).torques
-    loads = rnea(model, fine_q[:-1], qd[step_of], zero, base=mode).torques
+    # the last sample still has the last step's rates (MuJoCo's are not reset after the run)
+    loads = rnea(model, fine_q, np.vstack([qd[step_of], qd[-1:]]), np.zeros_like(fine_q), base=mode).torques
     brake_ref = np.zeros((fine_t.size, len(lock_steps)))
     for i, (j, k) in enumerate(lock_steps.items()):
-        brake_ref[k * sub : n_steps * sub, i] = loads[k * sub :, index[j]]
+        brake_ref[k * sub :, i] = loads[k * sub :, index[j]]
     inertia = generalized_inertia(model, fine_q[:-1]) if floating else mass_matrix(model, fine_q[:-1])
     kp, kd = tracking**2, 2.0 * tracking
 

@@ -14,6 +14,10 @@ rest, all of ``L_arm(0)`` has gone to the wheels).  The check compares the peak 
 peak stored momentum (Euclidean norms: a wheel assembly that can give that much about any
 axis) with the capacities ``wheel_torque_max_Nm`` and ``wheel_momentum_max_Nms`` of the
 scenario's ``[spacecraft]`` table.
+
+Assumption: the spacecraft is held in translation too (000's fixed-base reading).  Wheels hold
+the attitude only; the base force the arm exerts (``rnea``'s ``base_force``) would move a
+spacecraft held by wheels alone, or needs thrusters, and is not judged here.
 """
 
 from __future__ import annotations

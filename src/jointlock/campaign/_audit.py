@@ -25,6 +25,7 @@ from typing import Any
 import numpy as np
 
 from ..errors import CampaignError, JointlockError
+from ..io.files import read_toml_file
 from ..robots import UrdfChain, load_robot
 from ..scenario import load_scenario
 from ..scenario._task import scenario_task
@@ -75,7 +76,20 @@ def audit_campaign(
     """
     path = Path(scenario)
     try:
-        base = load_scenario(path)
+        raw = read_toml_file(path, "audit: scenario file", CampaignError)
+        if not isinstance(raw.get("task"), dict):
+            raise CampaignError(f"audit: {path} has no [task] (the planned motion to audit: waypoints or a file)")
+        fail: dict[str, Any] = raw["failure"] if isinstance(raw.get("failure"), dict) else {}
+        if fail.get("angle_deg") is not None:
+            raise CampaignError(
+                f"audit: {path}: failure.angle_deg is the task's at each instant; remove it (the joint locks where "
+                "the task has it)"
+            )
+        # the audit sets the joint and the instant of every cell: the file need not
+        first = {"failure.joint": fail.get("joint", 1), "failure.time_s": fail.get("time_s", 0.0)}
+        base = load_scenario(path, {k: v for k, v in first.items() if k.split(".")[1] not in fail})
+    except CampaignError:
+        raise
     except JointlockError as exc:
         raise CampaignError(f"audit: {exc}") from None
     task = scenario_task(base.data, str(path))
@@ -91,7 +105,7 @@ def audit_campaign(
         raise CampaignError(
             f"audit: joints must be distinct joint numbers 1..{dof}; got {chosen}" + (f" (not joints: {bad})" if bad else "")
         )
-    instants = _instants(task.duration, times, dt)
+    instants = [round(task.start + v, 9) for v in _instants(task.duration, times, dt)]
     data: dict[str, Any] = {
         "title": f"audit: {base.data.get('title') or path.stem}",
         "scenario": str(path.resolve()),
@@ -111,11 +125,12 @@ def _instants(duration: float, times: int | None, dt: float | None) -> list[floa
     if dt is not None:
         if not (isinstance(dt, (int, float)) and math.isfinite(dt) and 0 < dt <= duration):
             raise CampaignError(f"audit: dt must be a step in (0, {duration:g}] s (the task's length); got {dt!r}")
-        return [float(v) for v in np.arange(0.0, duration + 1e-9 * duration, dt)]
+        return [round(float(v), 9) for v in np.arange(0.0, duration + 1e-9 * duration, dt)]
     count = DEFAULT_AUDIT_TIMES if times is None else times
     if isinstance(count, bool) or not isinstance(count, int) or not 1 <= count <= 10_000:
         raise CampaignError(f"audit: times must be an integer in 1..10000; got {count!r}")
-    return [float(v) for v in np.linspace(0.0, duration, count)] if count > 1 else [0.0]
+    # to 1e-9 s: 7.2, not linspace's 7.199999999999999 (the cell's name and its --set value)
+    return [round(float(v), 9) for v in np.linspace(0.0, duration, count)] if count > 1 else [0.0]
 
 
 @dataclass(frozen=True)
@@ -131,8 +146,8 @@ class AuditWindows:
         (m,) every joint's cell at that instant finished with a feasible, collision-free halt
         within the attitude control's capacity.
     worst_joint
-        (m,) the joint with the longest smallest feasible halt time at that instant (an unsafe
-        cell first), or None when no cell finished.
+        (m,) the first unsafe joint at that instant, else the joint with the longest smallest
+        feasible halt time (None without ``halt.minimum_T_s`` values: ``halt.minimum_T = true``).
     unsafe_joints
         Per instant, the joints whose cell is unsafe (infeasible, colliding, over capacity,
         failed or not run).
@@ -153,7 +168,8 @@ class AuditWindows:
         lines = []
         if self.windows:
             text = ", ".join(f"[{a:g}, {b:g}] s" if b > a else f"{a:g} s" for a, b in self.windows)
-            lines.append(f"safe windows (every audited lock leaves a safe halt): {text}")
+            step = f", instants every {self.times[1] - self.times[0]:.3g} s" if len(self.times) > 1 else ""
+            lines.append(f"safe windows (every audited lock leaves a safe halt at every audited instant in them{step}): {text}")
         else:
             lines.append("NO SAFE WINDOW: at every audited instant some lock leaves no safe halt")
         risky = [(t, js) for t, js in zip(self.times, self.unsafe_joints) if js]

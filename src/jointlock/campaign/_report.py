@@ -435,19 +435,23 @@ def _audit_section(out: Path) -> rp.Section | None:
         return None
     import json
 
-    data = json.loads(path.read_text())
-    times, unsafe = data["times_s"], [set(j) for j in data["unsafe_joints"]]
-    windows = data["windows_s"]
+    try:
+        data = json.loads(path.read_text())
+        times, unsafe = [float(t) for t in data["times_s"]], [set(j) for j in data["unsafe_joints"]]
+        windows, worst = data["windows_s"], data["worst_joint"]
+    except (ValueError, KeyError, TypeError, OSError) as exc:  # a damaged file: said, not a traceback
+        return rp.Section("Audit: safe windows", notes=[f"audit.json could not be read ({exc!r}); run the audit again"])
     sec = rp.Section("Audit: safe windows")
     if windows:
         text = ", ".join(f"[{a:g}, {b:g}] s" if b > a else f"{a:g} s" for a, b in windows)
-        sec.paragraphs.append(f"<b>Safe windows</b> (every audited lock leaves a feasible, clear halt within the "
-                              f"attitude control's capacity): {html.escape(text)}.")  # fmt: skip
+        sec.paragraphs.append(f"<b>Safe windows</b> (at every audited instant in them, every audited lock leaves a "
+                              f"feasible, clear halt within the attitude control's capacity; only the audited "
+                              f"instants were checked): {html.escape(text)}.")  # fmt: skip
     else:
         sec.paragraphs.append("<b>NO SAFE WINDOW</b>: at every audited instant some lock leaves no safe halt.")
     joints = sorted({j for js in data["unsafe_joints"] for j in js} | set(data.get("joints", [])))
     rows = [[f"{t:g}", ", ".join(map(str, sorted(js))) or "none", "" if w is None else str(w)]
-            for t, js, w in zip(times, unsafe, data["worst_joint"])]  # fmt: skip
+            for t, js, w in zip(times, unsafe, worst)]  # fmt: skip
     sec.tables.append((["t [s]", "locks with no safe halt", "worst joint"], rows, "risk timeline"))
     if joints and len(times) > 1:
         fig = offscreen_figure((min(3.0 + 0.5 * len(times), 12.0), 1.5 + 0.35 * max(len(joints), 1)))

@@ -207,8 +207,9 @@ LONGEST_WORD = 200
 
 def _short_words(message: str) -> str:
     """``message`` with every run of more than :data:`LONGEST_WORD` non-space characters cut
-    to its first 77 and "..." (one error line stays one screen line or two)."""
-    return re.sub(rf"\S{{{LONGEST_WORD + 1},}}", lambda m: m.group(0)[:77] + "...", message)
+    to its first and last 60 around "..." (a path keeps its file name; one error line stays a
+    line or two)."""
+    return re.sub(rf"\S{{{LONGEST_WORD + 1},}}", lambda m: m.group(0)[:60] + "..." + m.group(0)[-60:], message)
 
 
 def _forgiving_streams() -> None:

@@ -315,10 +315,28 @@ def add_clearance_options(p: argparse.ArgumentParser) -> None:
         action="store_true",
         help="do not require the clearance (the papers' way); it is still reported",
     )
+    p.add_argument(
+        "--keep-out",
+        metavar="FILE",
+        help="a TOML file of [[keep_out]] volumes (boxes, spheres, capsules in the root frame: a docked vehicle, "
+        "a solar array) kept clear like the bus (format: docs/scenarios.md)",
+    )
 
 
 def clearance_from_args(args: argparse.Namespace) -> Any:
-    """The :class:`~jointlock.collision.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``."""
-    from ..jobs._common import clearance_settings
+    """The :class:`~jointlock.collision.ClearanceSettings` of ``--clearance-min-m`` / ``--no-clearance``
+    and ``--keep-out FILE``."""
+    import dataclasses
 
-    return clearance_settings(args.clearance_min_m, not args.no_clearance)
+    from ..io.files import read_toml_file
+    from ..jobs._common import clearance_settings
+    from ..scenario._keep_out import check_keep_out, shape_of
+
+    settings = clearance_settings(args.clearance_min_m, not args.no_clearance)
+    if args.keep_out is None:
+        return settings
+    data = read_toml_file(args.keep_out, "--keep-out file", ScenarioError)
+    if "keep_out" not in data:
+        raise ScenarioError(f"--keep-out {args.keep_out}: no [[keep_out]] entries in the file")
+    shapes = tuple(shape_of(e) for e in check_keep_out(data["keep_out"], f"--keep-out {args.keep_out}"))
+    return dataclasses.replace(settings, keep_out=shapes)

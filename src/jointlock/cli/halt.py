@@ -360,13 +360,17 @@ def plan_from_args(args: argparse.Namespace, progress: bool) -> HaltPlan:
 
 def run(args: argparse.Namespace) -> int:
     check_out_dir(args.out)
+    if args.check_in == "mujoco":  # before the halt is computed: a missing extra is said at once
+        from ..sim import require_mujoco
+
+        require_mujoco()
     plan = plan_from_args(args, not args.quiet and sys.stderr.isatty())
+    written = plan.write(Path(args.out)) if args.out else []  # the plan first, whatever the replay does
     replays = {}
     if args.check_in == "mujoco":
         from ..sim import replay_jobs
 
         replays = replay_jobs({"halt": plan})  # free, and held when the torques hold the spacecraft
-    written = plan.write(Path(args.out)) if args.out else []
     if args.out:
         for key, replay in replays.items():
             written += replay.write(Path(args.out), "mujoco" + key[len("halt") :])

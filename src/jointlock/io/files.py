@@ -178,13 +178,15 @@ _FLOAT_MAX_INT = int(sys.float_info.max)
 
 
 def toml_value(value: Any) -> str:
-    """One TOML value: a string, boolean, integer, float or a list of them."""
+    """One TOML value: a string, boolean, integer, float, a list of them or an inline table."""
     if isinstance(value, (bool, np.bool_)):
         return "true" if value else "false"
     if isinstance(value, str):
         return json.dumps(value)  # a JSON string is a TOML basic string
     if isinstance(value, (list, tuple, np.ndarray)):
         return "[" + ", ".join(toml_value(x) for x in value) + "]"
+    if isinstance(value, Mapping):  # an inline table (a list of them: an array of tables)
+        return "{" + ", ".join(f"{_toml_key(k)} = {toml_value(v)}" for k, v in value.items() if v is not None) + "}"
     if isinstance(value, (int, np.integer)):
         return str(int(value))
     return repr(float(value))

@@ -16,6 +16,7 @@ and plots through :mod:`jointlock.plots`.
 from __future__ import annotations
 
 import base64
+import dataclasses
 import functools
 import html
 import math
@@ -170,9 +171,13 @@ def clearance_settings(minimum_m: float | None, check: bool = True) -> Clearance
 
 def scenario_clearance(data: Mapping[str, Any]) -> ClearanceSettings:
     """The clearance a resolved scenario requires (``[limits] clearance_min_m`` and
-    ``check_clearance``, :func:`clearance_settings`)."""
+    ``check_clearance``, :func:`clearance_settings`) and its keep-out volumes (``[[keep_out]]``)."""
+    from ..scenario._keep_out import keep_out_shapes
+
     lim = data.get("limits") or {}
-    return clearance_settings(lim.get("clearance_min_m"), lim.get("check_clearance") is not False)
+    settings = clearance_settings(lim.get("clearance_min_m"), lim.get("check_clearance") is not False)
+    shapes = keep_out_shapes(data)
+    return dataclasses.replace(settings, keep_out=shapes) if shapes else settings
 
 
 def locked_deg(model: ArmModel) -> dict[str, float]:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import io
 import math
+import zipfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -66,7 +67,8 @@ class Task:
     Attributes
     ----------
     t
-        (K,) knot times [s] from 0: the waypoints' arrival times, or the samples' times.
+        (K,) knot times [s]: the waypoints' arrival times from 0, or the samples' own times (a
+        file's times are kept: a failure at ``t = 6 s`` of a file starting at 5 s is 1 s in).
     q
         (K, n) joint angles at those times [rad], every joint of the arm.
     kind
@@ -97,7 +99,6 @@ class Task:
         allowed = TIME_SCALINGS if self.kind == "waypoints" else ("spline",)
         if self.scaling not in allowed:
             raise ScenarioError(f"{where}: scaling must be one of {', '.join(map(repr, allowed))}; got {shown(self.scaling)}")
-        t = t - t[0]
         for name, value in (("t", t), ("q", q)):
             value.setflags(write=False)
             object.__setattr__(self, name, value)
@@ -134,9 +135,19 @@ class Task:
         return cls(t, np.radians(q), "samples", "spline", source)
 
     @property
+    def start(self) -> float:
+        """First time of the task [s] (0 for waypoints)."""
+        return float(self.t[0])
+
+    @property
+    def end(self) -> float:
+        """Last time of the task [s]."""
+        return float(self.t[-1])
+
+    @property
     def duration(self) -> float:
         """Length of the task [s]."""
-        return float(self.t[-1])
+        return self.end - self.start
 
     @property
     def dof(self) -> int:
@@ -144,15 +155,18 @@ class Task:
         return int(self.q.shape[1])
 
     def state(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
-        """``q`` [rad], ``dq`` [rad/s], ``ddq`` [rad/s^2] at times ``t`` [s] in ``[0, duration]``,
+        """``q`` [rad], ``dq`` [rad/s], ``ddq`` [rad/s^2] at times ``t`` [s] in ``[start, end]``,
         each of shape ``t.shape + (n,)``."""
         times = np.asarray(t, dtype=float)
-        if not np.all(np.isfinite(times)) or np.any(times < 0) or np.any(times > self.duration * (1 + 1e-12)):
-            bad = times[~((times >= 0) & (times <= self.duration * (1 + 1e-12)))]
+        slack = 1e-12 * max(1.0, abs(self.end))
+        inside = np.isfinite(times) & (times >= self.start - slack) & (times <= self.end + slack)
+        if not np.all(inside):
+            bad = times[~inside]
             raise ScenarioError(
-                f"{self.source}: the task runs over [0, {self.duration:g}] s; asked at t = {shown(bad.ravel()[:3].tolist())} s"
+                f"{self.source}: the task runs over [{self.start:g}, {self.end:g}] s; asked at t = "
+                f"{shown([float(v) for v in bad.ravel()[:3]])} s"
             )
-        flat = np.clip(times.ravel(), 0.0, self.duration)
+        flat = np.clip(times.ravel(), self.start, self.end)
         if self.kind == "samples":
             spline: Any = self._spline  # type: ignore[attr-defined]
             out = spline(flat), spline(flat, 1), spline(flat, 2)
@@ -177,7 +191,9 @@ class Task:
             raise ScenarioError(
                 f"{self.source}: {self.dof} joint angles per row; {model.name} has {model.dof} joints"
             )
-        lo, hi = model.angle_range()
+        # the joints' own limits: a continuous joint (no limit) takes any angle
+        lo = np.array([j.lower for j in model.joints])
+        hi = np.array([j.upper for j in model.joints])
         word = "row" if self.kind == "samples" else "waypoint"
         outside = (self.q < lo - 1e-12) | (self.q > hi + 1e-12)
         if np.any(outside):
@@ -192,6 +208,7 @@ class Task:
         return {
             "kind": self.kind,
             "scaling": self.scaling,
+            "start_s": self.start,
             "duration_s": self.duration,
             "t_s": self.t.tolist(),
             "q_deg": np.degrees(self.q).tolist(),
@@ -225,8 +242,10 @@ def _finite_rows(values: ArrayLike, source: str, field: str, word: str) -> Float
 def _check_rows(t: FloatArray, q: FloatArray, where: str, word: str) -> None:
     """Times finite, within bounds and increasing; angles finite (one line naming the row)."""
     for k in range(t.size):
-        if not math.isfinite(t[k]) or not 0 <= t[k] - t[0] <= MAX_TIME_S:
-            raise ScenarioError(f"{where}: {word} {k + 1}: time {t[k]!r} s is not a finite time within {MAX_TIME_S:g} s")
+        if not math.isfinite(t[k]) or not 0 <= t[k] - t[0] <= MAX_TIME_S or abs(t[k]) > MAX_TIME_S:
+            raise ScenarioError(
+                f"{where}: {word} {k + 1}: time {float(t[k])!r} s is not a finite time within {MAX_TIME_S:g} s"
+            )
         if k and not t[k] > t[k - 1]:
             raise ScenarioError(
                 f"{where}: {word} {k + 1}: t = {t[k]:g} s is not after {word} {k}'s {t[k - 1]:g} s (times must increase)"
@@ -252,14 +271,18 @@ def load_task_file(path: str | Path) -> Task:
     if path.suffix.lower() == ".npz":
         try:
             with np.load(io.BytesIO(data), allow_pickle=False) as npz:
-                missing = [k for k in ("t_s", "q_deg") if k not in npz.files]
-                if missing:
-                    raise ScenarioError(f"{label}: an NPZ task needs arrays t_s and q_deg; missing {', '.join(missing)}")
-                t, q = np.asarray(npz["t_s"], dtype=float), np.asarray(npz["q_deg"], dtype=float)
-        except (ValueError, OSError, EOFError) as exc:
-            raise ScenarioError(f"{label}: not a readable NPZ file ({exc})") from None
-        if q.ndim != 2 or t.ndim != 1 or q.shape[0] != t.size:
-            raise ScenarioError(f"{label}: t_s must be (m,) and q_deg (m, n); got {t.shape} and {q.shape}")
+                files = list(npz.files)
+                arrays = {k: np.asarray(npz[k]) for k in ("t_s", "q_deg") if k in files}
+        except (ValueError, OSError, EOFError, zipfile.BadZipFile):
+            raise ScenarioError(f"{label}: not an NPZ file of numeric arrays (numpy.savez, no pickled objects)") from None
+        missing = [k for k in ("t_s", "q_deg") if k not in arrays]
+        if missing:
+            raise ScenarioError(f"{label}: an NPZ task needs arrays t_s and q_deg; missing {', '.join(missing)}")
+        if any(a.dtype.kind not in "iuf" for a in arrays.values()):
+            raise ScenarioError(f"{label}: t_s and q_deg must be real numbers; got {arrays['t_s'].dtype} and {arrays['q_deg'].dtype}")
+        t, q = arrays["t_s"].astype(float), arrays["q_deg"].astype(float)
+        if q.ndim != 2 or t.ndim != 1 or q.shape[0] != t.size or q.shape[1] == 0:
+            raise ScenarioError(f"{label}: t_s must be (m,) and q_deg (m, n), n >= 1; got {t.shape} and {q.shape}")
         return Task.from_samples(t, q, source=label)
     if path.suffix.lower() != ".csv":
         raise ScenarioError(f"{label}: a task file is .csv or .npz; got {shown(path.suffix or 'no suffix')}")
@@ -271,6 +294,10 @@ def load_task_file(path: str | Path) -> Task:
     if len(lines) < 3:
         raise ScenarioError(f"{label}: a CSV task needs a header row and 2 or more rows of t_s and angles [deg]")
     header = [c.strip() for c in lines[0][1].split(",")]
+    if all(_is_float(c) for c in header):
+        raise ScenarioError(
+            f"{label}: line {lines[0][0]} is numbers; a CSV task starts with a header row (t_s, q1_deg, ...)"
+        )
     if len(header) < 2:
         raise ScenarioError(f"{label}: line {lines[0][0]}: the header needs t_s and one column per joint; got {shown(lines[0][1])}")
     times: list[float] = []

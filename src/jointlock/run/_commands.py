@@ -54,10 +54,22 @@ def _chain_args(data: Mapping[str, Any]) -> list[str]:
     return argv
 
 
-def _clearance_args(lim: Mapping[str, Any]) -> list[str]:
-    """``--clearance-min-m`` / ``--no-clearance`` of ``[limits]`` (none when at the defaults)."""
+def _clearance_args(lim: Mapping[str, Any], keep_out: Any = None, out: Path | None = None) -> list[str]:
+    """``--clearance-min-m`` / ``--no-clearance`` of ``[limits]`` (none when at the defaults), and
+    ``--keep-out OUT/keep_out.toml`` when the scenario has ``[[keep_out]]`` (written with the run:
+    :func:`keep_out_toml`)."""
     argv = ["--clearance-min-m", _num(lim["clearance_min_m"])] if lim.get("clearance_min_m") is not None else []
+    argv += ["--keep-out", str(out / KEEP_OUT_FILE)] if keep_out and out is not None else []
     return argv + (["--no-clearance"] if lim.get("check_clearance") is False else [])
+
+
+#: The file of a run's keep-out volumes, for its equivalent commands.
+KEEP_OUT_FILE = "keep_out.toml"
+
+
+def keep_out_toml(scenario: Scenario) -> str:
+    """The scenario's ``[[keep_out]]`` entries as a TOML file ``--keep-out`` reads."""
+    return toml_document({"keep_out": list(scenario.data.get("keep_out") or [])})
 
 
 def job_argv(
@@ -88,7 +100,7 @@ def job_argv(
         for key in ("vmax_deg", "amax_deg"):
             if lim[key] is not None:
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
-        argv += _clearance_args(lim)
+        argv += _clearance_args(lim, d.get("keep_out"), out)
         argv += ["--json", "--out", job_out] + (["--quiet"] if quiet else [])
     elif job == "halt":
         argv += job_lock_args(scenario) + ["--base", t["base"] or d["base"]]
@@ -107,7 +119,7 @@ def job_argv(
                 argv += [f"--{key.replace('_', '-')}", _num(lim[key])]
         for key, option in (("torque_max_Nm", "--torque-max-Nm"), ("brake_max_Nm", "--brake-max-Nm")):
             argv += [option, _num(lim[key])] if lim.get(key) is not None else []
-        argv += _clearance_args(lim)
+        argv += _clearance_args(lim, d.get("keep_out"), out)
         for key, option in (("wheel_torque_max_Nm", "--wheel-torque-max-Nm"), ("wheel_momentum_max_Nms", "--wheel-momentum-max-Nms")):
             argv += [option, _num(d["spacecraft"][key])] if d["spacecraft"].get(key) is not None else []
         argv += ["--solver", t["solver"], "--seed", str(seed), "--samples", str(t["samples"])]

@@ -27,7 +27,7 @@ from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
 from ..scenario import JOB_PAPER, Scenario, load_scenario
-from ._commands import job_command, jump_task_toml
+from ._commands import KEEP_OUT_FILE, job_command, jump_task_toml, keep_out_toml
 from ._summary import summarize, summary_lines
 
 #: The library call of each job: (module, function) taking ``(data, previous, *, progress)``.
@@ -128,15 +128,19 @@ def run_scenario(
             f"run_scenario needs a Scenario (jointlock.load_scenario(path)) or a scenario file's path; "
             f"got {type(scenario).__name__}"
         )
+    simulator = check_in if check_in is not None else scenario.data.get("check_in", "none")
+    if simulator not in CHECK_IN:
+        raise ScenarioError(f"check_in must be one of {', '.join(map(repr, CHECK_IN))}; got {simulator!r}")
+    if simulator == "mujoco":  # before the jobs run: a missing extra is said at once
+        from ..sim import require_mujoco
+
+        require_mujoco()
     results: dict[str, JobResult] = {}
     for job in scenario.jobs:
         try:
             results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
         except JointlockError as exc:
             raise _with_context(exc, f"{scenario.source}: job [{job}]") from exc
-    simulator = check_in if check_in is not None else scenario.data.get("check_in", "none")
-    if simulator not in CHECK_IN:
-        raise ScenarioError(f"check_in must be one of {', '.join(map(repr, CHECK_IN))}; got {simulator!r}")
     checks: dict[str, Any] = {}
     if simulator == "mujoco":
         from ..sim import replay_jobs
@@ -255,6 +259,8 @@ class RunResult:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         results = self.to_dict(out)
+        if self.scenario.data.get("keep_out"):  # the keep-outs the equivalent commands read
+            atomic_write_text(out / KEEP_OUT_FILE, keep_out_toml(self.scenario))
         for job, result in self.jobs.items():
             if job == "jump":  # the task file its equivalent command reads
                 atomic_write_text(out / "jump" / "task.toml", jump_task_toml(self.scenario))

@@ -130,12 +130,14 @@ def summary_lines(results: dict[str, Any]) -> list[str]:
     """Human-readable summary of a run (a few lines per job)."""
     s = results["summary"]
     lines = [f"{results['title']}  ({results['scenario_file']}, seed {results['seed']})"]
+    first = []
     verdict = ((s.get("halt") or {}).get("clearance") or {}).get("verdict")
     if verdict:  # a halt that comes too close says so first
-        lines.insert(0, verdict)
+        first.append(verdict)
     wheels = (s.get("halt") or {}).get("attitude_control") or {}
-    if wheels.get("within") is False:  # ... and one that needs more than the wheels can give
-        lines.insert(0, wheels["verdict"])
+    if wheels.get("within") is False:  # ... then one that needs more than the wheels can give
+        first.append(wheels["verdict"])
+    lines[:0] = first
     if "halt_config" in s:
         h = s["halt_config"]
         q = ", ".join(f"{v:.2f}" for v in h["q_best_deg"])

@@ -29,6 +29,7 @@ from ._fields import (
     _hint,
     _spellings,
 )
+from ._keep_out import check_keep_out
 from ._scenario import Scenario
 from ._task import resolve_task_file
 
@@ -278,10 +279,12 @@ def scenario_from_dict(
     if not isinstance(data, Mapping):
         raise ScenarioError(f"{source}: a scenario must be a TOML table; got {type(data).__name__}")
     base_dir = Path.cwd() if base_dir is None else Path(base_dir)
-    allowed = list(TOP_FIELDS) + list(ALL_TABLES)
+    allowed = list(TOP_FIELDS) + list(ALL_TABLES) + ["keep_out"]
     out: dict[str, Any] = {}
     for key, value in data.items():
-        if key in TOP_FIELDS:
+        if key == "keep_out":  # [[keep_out]]: an array of tables, each a shape
+            out[key] = check_keep_out(value, source)
+        elif key in TOP_FIELDS:
             out[key] = check_value(value, TOP_FIELDS[key], f"{source}: {key}")
         elif key in ALL_TABLES:
             out[key] = _table(value, key, ALL_TABLES[key], source)
@@ -291,6 +294,7 @@ def scenario_from_dict(
             )
     for key, spec in TOP_FIELDS.items():
         out.setdefault(key, spec.default)
+    out.setdefault("keep_out", [])
     for name, fields in SHARED_TABLES.items():
         out.setdefault(name, _table({}, name, fields, source))
     if out["robot"] is None:

@@ -72,9 +72,13 @@ def state_from_task(out: dict[str, Any], jobs: tuple[str, ...], source: str, mod
             "run them in separate scenarios"
         )
     if time_s is None:
-        raise ScenarioError(f"{source}: [task] needs failure.time_s (the instant the joint locks, in [0, {task.duration:g}] s)")
-    if not time_s <= task.duration:
-        raise ScenarioError(f"{source}: failure.time_s = {time_s:g} s is after the task's end ({task.duration:g} s)")
+        raise ScenarioError(
+            f"{source}: [task] needs failure.time_s (the instant the joint locks, in [{task.start:g}, {task.end:g}] s)"
+        )
+    if not task.start <= time_s <= task.end:
+        raise ScenarioError(
+            f"{source}: failure.time_s = {time_s:g} s is outside the task, [{task.start:g}, {task.end:g}] s"
+        )
     given = [k for k in ("q0_deg", "dq0_deg", "ddq0_deg") if out["state"][k] is not None]
     if given:
         raise ScenarioError(
