@@ -231,3 +231,19 @@ def test_the_replay_ends_at_the_motions_end_and_a_refused_model_is_one_line(plan
                                   bodies=[jl.Body(0.0), jl.Body(0.0)]), 1, 0.0)  # fmt: skip
     still = replay_motion(massless, lambda t: (np.zeros((t.size, 1)),) * 3, 1.0)
     assert np.abs(still.brake).max() < 1e-6
+
+
+def test_the_attitude_plot_carries_mujocos_trace(plan_000, tmp_path):
+    """Issue 30: the halt's attitude figure with MuJoCo's attitude and rate dashed on top."""
+    from jointlock.plots._common import offscreen_figure
+    from jointlock.plots.halt import plot_spacecraft_response
+    from jointlock.sim import write_attitude_with_replay
+
+    replay = replay_halt(plan_000)
+    fig = plot_spacecraft_response(plan_000.spacecraft_response(), fig=offscreen_figure(), simulated=replay.simulated_response())
+    labels = [line.get_label() for ax in fig.axes for line in ax.get_lines()]
+    assert "MuJoCo: attitude change" in labels and "MuJoCo: rate" in labels
+    write_attitude_with_replay(plan_000, replay, tmp_path)
+    assert (tmp_path / "spacecraft_attitude.png").is_file() and (tmp_path / "spacecraft_attitude.svg").is_file()
+    held = replay_halt(plan_000, base="fixed")
+    assert held.simulated_response() is None

@@ -203,3 +203,31 @@ def test_review_fixes_file_times_header_continuous_joints_npz(tmp_path):
     (tmp_path / "junk.npz").write_bytes(b"not a zip")
     with pytest.raises(ScenarioError, match="not an NPZ file of numeric arrays"):
         load_task_file(tmp_path / "junk.npz")
+
+
+# -- can the task still be finished (issue 28, item 3) -----------------------------------------------
+
+
+def test_task_completion_after_a_lock():
+    """A joint the plan does not move after the failure: every remaining pose is reachable (the
+    plan's own configurations are solutions); puma6 (6 joints, no redundancy) with a joint the plan
+    keeps moving: the next waypoint is out of reach, by a stated distance; canadarm7 (7 joints)
+    keeps 001's line with joint 2 locked halfway."""
+    from jointlock.planning.completion import task_completion
+
+    puma = jl.load_robot("puma6")
+    steady = Task.from_waypoints([[0, 30, 0, 0, 0, 15], [20, 40, 20, 10, -40, 15], [30, 50, 30, 20, -80, 15]], [3.0, 3.0])
+    done = task_completion(puma, steady, 6, 1.0)
+    assert done.completable and done.first_unreachable_s is None and list(done.times) == [3.0, 6.0]
+    moving = Task.from_waypoints([[0, 30, 0, 0, 0, 0], [20, 40, 20, 10, -40, 30], [30, 50, 30, 20, -80, 60]], [3.0, 3.0])
+    stuck = task_completion(puma, moving, 2, 1.0)
+    assert not stuck.completable and stuck.first_unreachable_s == 3.0
+    assert stuck.position_error[0] > 1e-3 and "NOT COMPLETABLE" in stuck.summary()[0]
+    assert math.degrees(stuck.angle) == pytest.approx(math.degrees(moving.state(1.0)[0][1]))
+    c7 = jl.load_robot("canadarm7")
+    line = load_task_file("examples/audit_canadarm7_motion.csv")
+    assert task_completion(c7, line, 2, 6.0, samples=4).completable
+    with pytest.raises(jl.ConfigurationError, match="joint must be a joint number 1..6"):
+        task_completion(puma, moving, 7, 1.0)
+    with pytest.raises(jl.ConfigurationError, match=r"t_fail must lie in the task, \[0, 6\] s"):
+        task_completion(puma, moving, 2, 9.0)

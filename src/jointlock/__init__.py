@@ -90,6 +90,8 @@ _LAZY = {
     "adaptive_ga": "jointlock.planning.ga",
     "Task": "jointlock.planning.task",
     "load_task_file": "jointlock.planning.task",
+    "task_completion": "jointlock.planning.completion",
+    "TaskCompletion": "jointlock.planning.completion",
     "WheelCapacity": "jointlock.analysis.attitude_control",
     "attitude_control_check": "jointlock.analysis.attitude_control",
     "JumpScenario": "jointlock.planning.jump",
@@ -141,6 +143,8 @@ __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals()
 __all__ = [
     "Task",
     "load_task_file",
+    "task_completion",
+    "TaskCompletion",
     "WheelCapacity",
     "attitude_control_check",
     "mjcf_text",

@@ -56,6 +56,7 @@ __all__ = [
     "replay_steps",
     "replay_waypoints",
     "require_mujoco",
+    "write_attitude_with_replay",
 ]
 
 #: The one line a user without the extra sees.
@@ -165,6 +166,13 @@ class Replay:
         vector = a[0] * b[1:] - b[0] * a[1:] - np.cross(a[1:], b[1:])
         scalar = float(np.dot(a, b))
         return float(np.degrees(2.0 * math.atan2(float(np.linalg.norm(vector)), abs(scalar))))
+
+    def simulated_response(self) -> SpacecraftResponse | None:
+        """MuJoCo's spacecraft as a :class:`~jointlock.analysis.spacecraft.SpacecraftResponse`
+        (attitude, rate, drift on :attr:`t`); None with the spacecraft held."""
+        if self.attitude is None or self.angular_velocity is None or self.com_displacement is None:
+            return None
+        return SpacecraftResponse(self.t, self.attitude, self.angular_velocity, self.com_displacement)
 
     def rows(self) -> list[dict[str, Any]]:
         """The comparison: ``{"quantity", "short", "unit", "jointlock", "mujoco", "difference"}``
@@ -690,3 +698,19 @@ def replay_halt(
         tracking=tracking,
         base=base,
     )
+
+
+def write_attitude_with_replay(plan: Any, replay: Replay, folder: str | Path) -> None:
+    """Write a :class:`~jointlock.jobs.HaltPlan`'s ``spacecraft_attitude.png`` (and .svg) into
+    ``folder`` again, with the replay's spacecraft (MuJoCo's) dashed on top (issue 30); nothing
+    for a held spacecraft."""
+    if replay.simulated_response() is None:
+        return
+    response = plan.spacecraft_response()
+    if response is None:
+        return
+    from .plots._common import offscreen_figure
+    from .plots.halt import plot_spacecraft_response
+
+    fig = plot_spacecraft_response(response, fig=offscreen_figure((7, 4)), simulated=replay.simulated_response())
+    write_figure(fig, Path(folder), "spacecraft_attitude.png")

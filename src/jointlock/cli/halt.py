@@ -374,6 +374,10 @@ def run(args: argparse.Namespace) -> int:
     if args.out:
         for key, replay in replays.items():
             written += replay.write(Path(args.out), "mujoco" + key[len("halt") :])
+        if "halt" in replays:  # the attitude plot with MuJoCo's trace on top
+            from ..sim import write_attitude_with_replay
+
+            write_attitude_with_replay(plan, replays["halt"], Path(args.out))
     if args.json:
         data = plan.to_dict()
         if replays:

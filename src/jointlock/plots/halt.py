@@ -158,10 +158,15 @@ def plot_base_torque_vs_time(res: HaltMotion, *, ax: Any | None = None) -> Any:
     return ax
 
 
-def plot_spacecraft_response(response: Any, *, fig: Any | None = None) -> Any:
+def plot_spacecraft_response(
+    response: Any, *, fig: Any | None = None, simulated: Any | None = None, simulator: str = "MuJoCo"
+) -> Any:
     """The spacecraft during a free-floating motion
     (:class:`~jointlock.analysis.spacecraft.SpacecraftResponse`): attitude change [deg] and
-    angular rate [deg/s] over time (left axis, right axis).  Returns the figure."""
+    angular rate [deg/s] over time (left axis, right axis).  ``simulated``: the same motion
+    replayed in a simulator (a response with ``t``, ``attitude_change_deg``,
+    ``angular_velocity``: :meth:`jointlock.sim.Replay.simulated_response`), drawn dashed on top.
+    Returns the figure."""
     fig = new_figure(fig, (7, 4))
     ax = fig.add_subplot()
     t = response.t
@@ -172,6 +177,11 @@ def plot_spacecraft_response(response: Any, *, fig: Any | None = None) -> Any:
     rate.plot(
         t, np.degrees(np.linalg.norm(response.angular_velocity, axis=-1)), color="C1", label="rate [deg/s]"
     )
+    if simulated is not None:
+        ax.plot(simulated.t, simulated.attitude_change_deg, "k--", lw=1, label=f"{simulator}: attitude change")
+        rate.plot(simulated.t, np.degrees(np.linalg.norm(simulated.angular_velocity, axis=-1)), "k:", lw=1,
+                  label=f"{simulator}: rate")  # fmt: skip
+        ax.legend(fontsize=7, loc="upper left")
     rate.set_ylabel("angular rate [deg/s]", color="C1")
     ax.set_title(
         f"spacecraft: attitude change {response.final_attitude_change_deg:.3g} deg, peak {response.peak_rate_deg_s:.3g} deg/s, "

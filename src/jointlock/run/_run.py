@@ -268,6 +268,10 @@ class RunResult:
                 atomic_write_json(out / job / "result.json", results["jobs"][job]["result"])
         for job, replay in self.checks.items():
             replay.write(out / "checks", f"mujoco_{job}")
+        if "halt" in self.checks:  # the halt's attitude plot with MuJoCo's trace on top
+            from ..sim import write_attitude_with_replay
+
+            write_attitude_with_replay(self.jobs["halt"], self.checks["halt"], out / "halt")
         results.update(to_plain(dict(extra or {})))
         sections = report_sections(self.scenario, results, dict(self.jobs), out) + list(extra_sections)
         files = {str(p.relative_to(out)) for p in out.rglob("*") if p.is_file() and not p.name.startswith(".")}
@@ -285,3 +289,4 @@ class RunResult:
         atomic_write_text(out / "report.html", page)
         atomic_write_json(out / "results.json", results)
         return results
+
