@@ -174,3 +174,13 @@ def test_an_audited_scenario_needs_no_joint_nor_instant_and_a_damaged_audit_json
 
     page = write_campaign_report(out)[0].read_text()
     assert "audit.json could not be read" in page
+
+
+def test_a_per_joint_table_reduces_to_one_column():
+    """The audit records the locked joints' peak brake torque: a table per joint reduced by |max."""
+    from jointlock.campaign import AUDIT_COLUMNS, column_value
+
+    assert "halt.actuators.peak_brake_torque_Nm|max" in AUDIT_COLUMNS
+    results = {"halt": {"actuators": {"peak_brake_torque_Nm": {"4": 2220.5, "2": 10.0}}}}
+    assert column_value(results, "halt.actuators.peak_brake_torque_Nm|max") == 2220.5
+    assert column_value(results, "halt.actuators.peak_brake_torque_Nm|len") == 2

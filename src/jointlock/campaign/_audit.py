@@ -49,6 +49,7 @@ AUDIT_COLUMNS = (
     "halt.spacecraft.attitude_change_deg",
     "halt.attitude_control.peak_torque_Nm",
     "halt.attitude_control.peak_momentum_Nms",
+    "halt.actuators.peak_brake_torque_Nm|max",
     "halt.clearance.motion_min_m",
     "halt.state_source",
 )

@@ -104,6 +104,8 @@ def column_value(results: Mapping[str, Any], column: str) -> Any:
 
 
 def _reduce(value: Any, reducer: str) -> Any:
+    if isinstance(value, Mapping):  # a value per joint ({"4": 2220.5}): reduced over the joints
+        value = list(value.values())
     if not isinstance(value, list):
         return value
     if reducer == "len":
