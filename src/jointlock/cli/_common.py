@@ -340,3 +340,26 @@ def clearance_from_args(args: argparse.Namespace) -> Any:
         raise ScenarioError(f"--keep-out {args.keep_out}: no [[keep_out]] entries in the file")
     shapes = tuple(shape_of(e) for e in check_keep_out(data["keep_out"], f"--keep-out {args.keep_out}"))
     return dataclasses.replace(settings, keep_out=shapes)
+
+
+def export_facts(model: Any, path: Any) -> dict[str, Any]:
+    """What ``export-urdf`` and ``export-mjcf`` print about the file written: the file, the arm,
+    its base, its healthy joints and its locks [deg]."""
+    import math
+
+    return {
+        "file": str(path),
+        "robot": model.name,
+        "base": "floating" if model.floating else "fixed",
+        "joint_numbers": list(model.joint_numbers),
+        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
+    }
+
+
+def export_line(facts: dict[str, Any]) -> str:
+    """The one line an export prints: ``wrote FILE: ROBOT, BASE base, healthy joints [...], locked: ...``."""
+    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked"].items()) or "none"
+    return (
+        f"wrote {facts['file']}: {facts['robot']}, {facts['base']} base, healthy joints {facts['joint_numbers']}, "
+        f"locked: {locked}"
+    )

@@ -5,11 +5,9 @@ its locked joints folded in and their bodies merged, or held by brakes (a thin s
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
-from typing import Any
 
-from ._common import add_robot_arguments, model_from_args, print_json
+from ._common import add_robot_arguments, export_facts, export_line, model_from_args, print_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -42,22 +40,10 @@ def run(args: argparse.Namespace) -> int:
     from ..mjcf import write_mjcf
 
     model = model_from_args(args)
-    path = write_mjcf(model, args.out, brakes=args.brakes)
-    facts: dict[str, Any] = {
-        "file": str(path),
-        "robot": model.name,
-        "base": "floating" if model.floating else "fixed",
-        "joint_numbers": list(model.joint_numbers),
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
-        "brakes": bool(args.brakes and model.locked),
-    }
+    facts = export_facts(model, write_mjcf(model, args.out, brakes=args.brakes))
+    facts["brakes"] = bool(args.brakes and model.locked)
     if args.json:
         print_json(facts)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked"].items()) or "none"
-    held = " (held by brakes)" if facts["brakes"] else ""
-    print(
-        f"wrote {path}: {model.name}, {facts['base']} base, healthy joints {facts['joint_numbers']}, "
-        f"locked: {locked}{held}"
-    )
+    print(export_line(facts) + (" (held by brakes)" if facts["brakes"] else ""))
     return 0

@@ -5,11 +5,9 @@ their bodies merged, for simulating the crippled arm elsewhere (a thin shell ove
 from __future__ import annotations
 
 import argparse
-import math
 from pathlib import Path
-from typing import Any
 
-from ._common import add_robot_arguments, model_from_args, print_json
+from ._common import add_robot_arguments, export_facts, export_line, model_from_args, print_json
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -36,17 +34,9 @@ def run(args: argparse.Namespace) -> int:
     from ..io.urdf_export import write_urdf
 
     model = model_from_args(args)
-    path = write_urdf(model, args.out)
-    facts: dict[str, Any] = {
-        "file": str(path),
-        "robot": model.name,
-        "base": "floating" if model.floating else "fixed",
-        "joint_numbers": list(model.joint_numbers),
-        "locked": {str(lj.number): math.degrees(lj.angle) for lj in model.locked},
-    }
+    facts = export_facts(model, write_urdf(model, args.out))
     if args.json:
         print_json(facts)
         return 0
-    locked = ", ".join(f"joint {k} at {v:g} deg" for k, v in facts["locked"].items()) or "none"
-    print(f"wrote {path}: {model.name}, {facts['base']} base, healthy joints {facts['joint_numbers']}, locked: {locked}")
+    print(export_line(facts))
     return 0
