@@ -184,3 +184,16 @@ def test_a_per_joint_table_reduces_to_one_column():
     results = {"halt": {"actuators": {"peak_brake_torque_Nm": {"4": 2220.5, "2": 10.0}}}}
     assert column_value(results, "halt.actuators.peak_brake_torque_Nm|max") == 2220.5
     assert column_value(results, "halt.actuators.peak_brake_torque_Nm|len") == 2
+
+
+def test_sigma_min_at_failure_is_recorded():
+    """Issue 28's cell content: how close to a singularity the arm is when the joint locks (the
+    locked arm's generalized Jacobian at the state at failure for a free-floating model)."""
+    from jointlock.campaign import AUDIT_COLUMNS
+
+    plan = jl.plan_halt("halt7", progress=False)
+    p = plan.problem
+    expected = np.linalg.svd(jl.generalized_jacobian(p.model, p.q0), compute_uv=False).min()
+    assert plan.sigma_min_at_failure() == pytest.approx(expected, rel=1e-12)
+    assert plan.to_dict()["sigma_min_at_failure"] == pytest.approx(expected, rel=1e-12)
+    assert "halt.sigma_min_at_failure" in AUDIT_COLUMNS

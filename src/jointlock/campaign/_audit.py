@@ -50,6 +50,7 @@ AUDIT_COLUMNS = (
     "halt.attitude_control.peak_torque_Nm",
     "halt.attitude_control.peak_momentum_Nms",
     "halt.actuators.peak_brake_torque_Nm|max",
+    "halt.sigma_min_at_failure",
     "halt.clearance.motion_min_m",
     "halt.state_source",
 )

@@ -24,6 +24,7 @@ from ...io.files import (
     npz_bytes,
     write_figure,
 )
+from ...kinematics import generalized_jacobian, jacobian
 from ...model import ArmModel
 from ...papers import p000
 from ...planning.halt_config import HaltConfiguration
@@ -226,6 +227,7 @@ class HaltPlan(JobResult):
             if (clear := self._clearance_dict()) is None
             else {**clear, "verdict": next(iter(self._collision_line()), None)},
             "attitude_control": self.attitude_control().to_dict(),
+            "sigma_min_at_failure": self.sigma_min_at_failure(),
             "torque_limit_Nm": _none_for_inf(self.limits.torque),
             "brake_limit_Nm": _none_for_inf(self.limits.brake),
             "torque_limit_source": list(self.limits.torque_source),
@@ -333,6 +335,15 @@ class HaltPlan(JobResult):
             text += "the halt comes no closer"
         text += f"; the halt configuration keeps {data['halt_configuration_m']:+.3f} m ({data['halt_configuration_pair']})"
         return [text]
+
+    def sigma_min_at_failure(self) -> float:
+        """Smallest singular value of the locked arm's Jacobian at the state at failure (how
+        close to a singularity the arm is when the joint locks; issue 28's audit records it):
+        the generalized Jacobian J_F for a free-floating model, else the fixed-base one (000's
+        CP basis), linear rows in m/s, angular in rad/s."""
+        p = self.problem
+        jac = generalized_jacobian(p.model, p.q0) if p.model.floating else jacobian(p.model, p.q0)
+        return float(np.linalg.svd(jac, compute_uv=False).min())
 
     def attitude_control(self) -> AttitudeControlCheck:
         """What the attitude control must absorb to hold the spacecraft during the halt
