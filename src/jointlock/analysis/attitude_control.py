@@ -22,13 +22,13 @@ spacecraft held by wheels alone, or needs thrusters, and is not judged here.
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..bounds import MAX_TORQUE_NM, as_real
 from ..dynamics import rnea
 from ..errors import ConfigurationError
 from ..model import ArmModel, FloatArray
@@ -45,15 +45,13 @@ class WheelCapacity:
     momentum_max_Nms: float | None = None
 
     def __post_init__(self) -> None:
-        for name in ("torque_max_Nm", "momentum_max_Nms"):
+        for name, unit in (("torque_max_Nm", "N m"), ("momentum_max_Nms", "N m s")):
             value = getattr(self, name)
-            if value is None:
-                continue
-            if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-                raise ConfigurationError(f"wheel {name} must be a positive number or None; got {value!r}")
-            if not (math.isfinite(float(value)) and float(value) > 0):
-                raise ConfigurationError(f"wheel {name} must be a positive finite number; got {value!r}")
-            object.__setattr__(self, name, float(value))
+            if value is not None:
+                checked = as_real(value, f"wheel {name}", lo=0.0, hi=MAX_TORQUE_NM, unit=unit, error=ConfigurationError)
+                if checked <= 0:
+                    raise ConfigurationError(f"wheel {name} must be > 0 [{unit}]; got {value!r}")
+                object.__setattr__(self, name, checked)
 
     @property
     def given(self) -> bool:

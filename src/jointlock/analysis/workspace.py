@@ -30,6 +30,7 @@ from numpy.typing import ArrayLike, NDArray
 from .._random import resolve_rng
 from ..bounds import MAX_LENGTH_M, MIN_LENGTH_M, as_real
 from ..errors import ConfigurationError
+from ..io.files import to_plain
 from ..kinematics import DEFAULT_CHUNK, ee_positions
 from ..locking import lock
 from ..model import ArmModel, FloatArray
@@ -184,16 +185,16 @@ class Workspace:
         """Plain JSON values: the volume, its error and the samples per voxel as numbers, ``None``
         where there is no estimate, and ``volume_text`` saying so in words ("no estimate (too
         few samples)")."""
-        return {
+        return to_plain({
             "voxel_m": self.voxel,
-            "volume_full_m3": _number(self.volume),
-            "volume_full_error_m3": _number(self.volume_error),
+            "volume_full_m3": self.volume,
+            "volume_full_error_m3": self.volume_error,
             "occupancy_full_m3": self.occupancy,
             "extent_full_m": projection_extent(self.points),
-            "samples_per_voxel": _number(self.samples_per_voxel),
+            "samples_per_voxel": self.samples_per_voxel,
             "volume_full_text": volume_text(self.volume, self.volume_error),
             "warnings": self.warnings(),
-        }
+        })
 
     def summary(self, name: str = "full arm") -> list[str]:
         """The volume line, indented (``name``: how the arm is called)."""
@@ -354,29 +355,29 @@ class WorkspaceComparison:
         """Plain JSON values: every figure as a number, ``None`` where there is no estimate
         (too few samples, or a full volume of 0), and the ``*_text`` entries saying so in words
         ("no estimate (too few samples)", "no estimate") next to the numbers."""
-        return {
+        return to_plain({
             "lock": {"joint": self.joint, "angle_deg": math.degrees(self.angle)},
             "voxel_m": self.voxel,
-            "volume_full_m3": _number(self.volume_full),
-            "volume_full_error_m3": _number(self.volume_full_error),
-            "volume_locked_m3": _number(self.volume_locked),
-            "volume_locked_error_m3": _number(self.volume_locked_error),
-            "share_kept": _number(self.share_kept),
-            "share_kept_error": _number(self.share_kept_error),
+            "volume_full_m3": self.volume_full,
+            "volume_full_error_m3": self.volume_full_error,
+            "volume_locked_m3": self.volume_locked,
+            "volume_locked_error_m3": self.volume_locked_error,
+            "share_kept": self.share_kept,
+            "share_kept_error": self.share_kept_error,
             "occupancy_full_m3": self.occupancy_full,
             "occupancy_locked_m3": self.occupancy_locked,
-            "share_kept_occupancy": _number(self.share_kept_occupancy),
-            "share_kept_half_samples": _number(self.share_kept_half),
+            "share_kept_occupancy": self.share_kept_occupancy,
+            "share_kept_half_samples": self.share_kept_half,
             "voxel_half_samples_m": self.voxel_half,
-            "locked_voxels_outside_full": _number(self.outside),
+            "locked_voxels_outside_full": self.outside,
             "extent_full_m": projection_extent(self.full),
             "extent_locked_m": projection_extent(self.locked),
-            "samples_per_voxel": _number(self.samples_per_voxel),
+            "samples_per_voxel": self.samples_per_voxel,
             "volume_full_text": volume_text(self.volume_full, self.volume_full_error),
             "volume_locked_text": volume_text(self.volume_locked, self.volume_locked_error),
             "share_kept_text": share_text(self.share_kept, self.share_kept_error),
             "warnings": self.warnings(),
-        }
+        })
 
     def summary(self, before: str = "full arm") -> list[str]:
         """The volume, share-kept and sampling lines, indented (``before``: how the arm before
@@ -397,11 +398,6 @@ class WorkspaceComparison:
 def _ratio(num: float, den: float) -> float:
     """``num / den``, NaN for a zero or non-finite denominator (no ZeroDivisionError)."""
     return num / den if math.isfinite(den) and den != 0 else math.nan
-
-
-def _number(x: float) -> float | None:
-    """``x`` as a JSON number, None for NaN or an infinity (no estimate)."""
-    return float(x) if math.isfinite(x) else None
 
 
 def _percent(share: float, places: int = 0) -> str:

@@ -26,7 +26,7 @@ import numpy as np
 from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
-from ..scenario import JOB_PAPER, Scenario, load_scenario
+from ..scenario import JOB_PAPER, TOP_FIELDS, Scenario, load_scenario
 from ._commands import KEEP_OUT_FILE, job_command, jump_task_toml, keep_out_toml
 from ._summary import summarize, summary_lines
 
@@ -152,8 +152,8 @@ def run_scenario(
     return RunResult(scenario, results, versions(), checks)
 
 
-#: The simulators a run can replay its motions in (``check_in``).
-CHECK_IN = ("none", "mujoco")
+#: The simulators a run can replay its motions in (the scenario's ``check_in`` choices).
+CHECK_IN = TOP_FIELDS["check_in"].choices
 
 
 #: Keys before which a command's JSON lists its ``files`` (else they come last).
