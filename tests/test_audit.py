@@ -72,7 +72,10 @@ def test_a_cell_is_the_standalone_run_with_its_seed(audited):
         rows = [r for r in ledger.rows() if r["status"] == "ok"]
         row = rows[-1]
         recorded = ledger.result(row["key"])
+        mode = ledger.meta("compiled")
+    assert mode == "always"  # a campaign's workers run every batch compiled (jointlock.compiled)
     overrides = {f"failure.{k.split('.')[1]}": v for k, v in row["params"].items()} | {"seed": row["seed"]}
+    overrides["compiled"] = mode  # the run in the campaign's mode: the same numbers, bit for bit
     alone = jl.run_scenario(jl.load_scenario(scenario, overrides))
     mine = json.loads(json.dumps(alone["halt"].to_dict(), default=lambda a: np.asarray(a).tolist()))
     for key in ("k", "global_torque_Nm", "minimum_T_s", "q_final_deg", "dq_initial_deg_s"):

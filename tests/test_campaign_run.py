@@ -82,6 +82,8 @@ def test_a_case_rerun_as_a_plain_scenario_gives_the_same_numbers(serial, tmp_pat
     files = report.write(tmp_path / "report.html")
     scenario_file = files[1]
     assert scenario_file.suffix == ".toml" and "jointlock run" in scenario_file.read_text()
+    # the mode the workers ran in (jointlock.compiled), so that the numbers are the same bit for bit
+    assert report.compiled == "always" and jl.load_scenario(scenario_file).data["compiled"] == "always"
     rerun = jl.run_scenario(jl.load_scenario(scenario_file))
     row = report.worst[0]
     assert rerun["halt"].to_dict()["global_torque_Nm"] == row["halt.global_torque_Nm"]

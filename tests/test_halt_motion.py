@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -735,3 +736,103 @@ def test_compiled_objective_finds_the_same_halt(base, monkeypatch):
     np.testing.assert_allclose(halt_objective(peak, k), halt_objective(ref_peak, k), rtol=1e-12)
     with pytest.raises(jl.ScenarioError, match="compiled must be True, False or None"):
         _problem(compiled="yes")
+
+
+# -- the fast paths of issue 29 give the exact scan's answers, bit for bit ---------------------
+
+
+def _reference_least_violating_k(problem):
+    """least_violating_k before issue 29: every limit at every check time."""
+    from scipy.optimize import minimize_scalar
+
+    from jointlock.planning.halt_motion import relative_violation
+
+    per = feasible_k_intervals(problem)
+    ends = per[np.isfinite(per)]
+    span = max(float(np.abs(ends).max()) if ends.size else 0.0, 1e-12)
+    grid = np.linspace(-2 * span, 2 * span, 801)
+    viol = np.concatenate([relative_violation(problem, grid[i : i + 100]) for i in range(0, grid.size, 100)])
+    i = int(np.argmin(viol))
+    a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
+    res = minimize_scalar(lambda x: float(relative_violation(problem, x)), bounds=(a, b), method="bounded",
+                          options={"xatol": 1e-12 * span + 1e-15})  # fmt: skip
+    return float(res.x) if res.fun <= viol[i] else float(grid[i])
+
+
+def _reference_minimum_halt_time(problem, t_min=0.5, tol=1e-3):
+    """minimum_halt_time before issue 29: every T of the grid checked exactly."""
+    from jointlock._search1d import bisect_boundary
+
+    def ok(T):
+        lo, hi = shared_k_interval(problem.with_time(T))
+        return lo <= hi
+
+    prev = None
+    for T in np.arange(t_min, max(10 * problem.T, 120.0) + 1e-9, 0.25):
+        if ok(float(T)):
+            if prev is None:
+                return float(T)
+            return float(bisect_boundary(lambda x: ok(float(x)), prev, float(T), xtol=tol).true_end)
+        prev = float(T)
+    return None
+
+
+def _varied_problems(rng, count):
+    """000's scenario with other halt configurations, halt times, limits and check grids."""
+    base = _problem()
+    for _ in range(count):
+        yield dataclasses.replace(
+            base, qf=QF_PAPER + rng.normal(0, 0.3, QF_PAPER.size), T=float(rng.uniform(3.0, 14.0)),
+            dq_max=VMAX * rng.uniform(0.8, 2.0), ddq_max=AMAX * rng.uniform(0.8, 2.0),
+            n_check=int(rng.integers(201, 2001)),
+        )  # fmt: skip
+
+
+def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
+    from jointlock.planning.halt_motion import relative_violation
+    from jointlock.planning.halt_motion._feasibility import _Limits, least_violating_k
+
+    checked = 0
+    for p in [_problem(), *_varied_problems(rng, 12)]:
+        lo, hi = shared_k_interval(p)
+        if lo <= hi:
+            continue  # feasible: the least-violating k is not asked for
+        checked += 1
+        grid = np.linspace(-3e-4, 3e-4, 57)
+        limits = _Limits(p)
+        assert np.array_equal(limits.within(grid[0], grid[-1]).relative_violation(grid), relative_violation(p, grid))
+        narrow = limits.within(grid[10], grid[12])
+        assert narrow.count < limits.count / 20  # most limits cannot bind there
+        assert np.array_equal(narrow.relative_violation(grid[10:13]), relative_violation(p, grid[10:13]))
+        assert least_violating_k(p) == _reference_least_violating_k(p)
+    assert checked >= 3
+
+
+def test_minimum_halt_time_is_the_full_scans_bit_for_bit(rng):
+    from jointlock.planning.halt_motion._feasibility import _surely_infeasible
+
+    for p in [_problem(), *_varied_problems(rng, 8)]:
+        assert minimum_halt_time(p) == _reference_minimum_halt_time(p)
+        # the screen never calls infeasible a halt time that is feasible
+        times = np.linspace(0.5, 30.0, 237)
+        surely_not = _surely_infeasible(p, times)
+        feasible = np.array([np.subtract(*shared_k_interval(p.with_time(float(T)))) <= 0 for T in times])
+        assert not np.any(surely_not & feasible) and surely_not.any()
+
+
+def test_the_clearance_screen_gives_the_full_checks_answer():
+    """000's halt to the clearance-keeping configuration: some k of the limits' interval keep
+    the clearance, others do not (tests/test_clearance.py); the screened check says which,
+    exactly as the check of every sample does."""
+    from jointlock.planning.halt_motion import clearance_shortfall
+    from jointlock.planning.halt_motion._clearance_limits import keeps_clearance
+
+    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    p = kept.problem
+    lo, hi = (float(v) for v in kept.motion.k_interval)
+    k = np.linspace(lo, hi, 61)
+    for margin in (0.0, 0.05, 0.3):
+        full = clearance_shortfall(p, k, margin) <= 0
+        assert np.array_equal(keeps_clearance(p, k, margin), full)
+        if margin == 0.05:
+            assert full.any() and not full.all()

@@ -74,6 +74,9 @@ _CORE = {
     "Clearance": "jointlock.collision",
     "clearance": "jointlock.collision",
     "ClearanceSettings": "jointlock.collision",
+    "compiled_kernels": "jointlock.compiled",
+    "compiled_mode": "jointlock.compiled",
+    "set_compiled_mode": "jointlock.compiled",
 }
 
 #: Capability entry points, imported on first use (they pull in scipy.optimize and friends).
@@ -141,6 +144,9 @@ __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals()
 
 
 __all__ = [
+    "compiled_kernels",
+    "compiled_mode",
+    "set_compiled_mode",
     "Task",
     "load_task_file",
     "task_completion",

@@ -25,6 +25,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from ._cache import cached_on
 from ._rows import add, add3, cmv, cross_cv, lc, nz, rz
 from .model import ArmModel, FloatArray
 
@@ -320,7 +321,12 @@ def kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray,
     """The chain as the compiled kernels (:mod:`jointlock._kernels`) take it: ``E_i`` (n, 3, 3),
     ``p_i`` (n, 3) [m], the tool point in the last ``z``-joint frame (3,) [m] (the numbers of
     :func:`position_program`), and (n,) bool: joint ``i`` cannot move the tool point (the
-    joints :func:`ee_position_rows` skips)."""
+    joints :func:`ee_position_rows` skips).  Computed once per model and shared: the kernels
+    only read these arrays (writable, so that numba keeps one specialisation per kernel)."""
+    return cached_on(model, "kernel_program", lambda: _kernel_program(model))
+
+
+def _kernel_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     steps, tool_rows = position_program(model)
     rot = np.ascontiguousarray([mat for mat, _ in steps], dtype=float)
     pos = np.array([[0.0 if x is None else x for x in off] for _, off in steps], dtype=float)
@@ -346,9 +352,14 @@ def kernel_input(x: FloatArray) -> FloatArray:
 def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
     """The masses for :func:`jointlock._kernels.generalized_jacobian`: per link mass (n,),
     centre of mass (n, 3) [m] and inertia about it (n, 3, 3) [kg m^2] in its ``z``-joint
-    frame, and the spacecraft's mass, centre of mass and inertia (root frame) packed (13,)."""
-    _rot, _pos, mass, com, inertia = kernel_link_arrays(model, np.zeros(3))
-    return mass, com, inertia, kernel_root(model)
+    frame, and the spacecraft's mass, centre of mass and inertia (root frame) packed (13,).
+    Computed once per model and shared, as :func:`kernel_program`."""
+
+    def compute() -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+        _rot, _pos, mass, com, inertia = kernel_link_arrays(model, np.zeros(3))
+        return mass, com, inertia, kernel_root(model)
+
+    return cached_on(model, "kernel_mass_program", compute)
 
 
 def kernel_link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:

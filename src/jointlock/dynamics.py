@@ -23,6 +23,7 @@ from . import forward as _fk
 from ._chain import SYM, composite, kernel_input, kernel_link_arrays, kernel_root, link_constants
 from ._rows import add, add3, cmv, cross, cross_cv, cross_vc, lc, mul, nz, rz, sub
 from .bounds import check_overflow
+from .compiled import use_compiled
 from .errors import ConfigurationError, ModelError
 from .kinematics import ChainState, _world_inertias, com_jacobians, com_positions, state_at
 from .model import ArmModel, FloatArray, as_joint_array
@@ -434,7 +435,7 @@ def rnea(
 
     n_samples = int(np.prod(batch, dtype=np.int64))
     if compiled is None:
-        compiled = n_samples >= _fk.COMPILED_MIN_BATCH
+        compiled = use_compiled(n_samples, _fk.COMPILED_MIN_BATCH)
     elif not isinstance(compiled, (bool, np.bool_)):
         raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
     if compiled:

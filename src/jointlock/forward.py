@@ -19,6 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._chain import ee_position_rows, kernel_input, kernel_program, position_program
+from .compiled import use_compiled
 from .errors import ConfigurationError
 from .model import ArmModel, FloatArray, as_joint_array
 from .spatial import pose, skew
@@ -278,7 +279,7 @@ def ee_positions(
     flat = kernel_input(q.reshape(-1, model.dof))
     out = np.empty((flat.shape[0], 3))
     if compiled is None:
-        compiled = flat.shape[0] >= COMPILED_MIN_POSITIONS
+        compiled = use_compiled(flat.shape[0], COMPILED_MIN_POSITIONS)
     elif not isinstance(compiled, (bool, np.bool_)):
         raise ConfigurationError(f"compiled must be True, False or None; got {compiled!r}")
     if compiled:

@@ -35,6 +35,7 @@ from numpy.typing import ArrayLike
 from . import forward as _fk
 from ._chain import kernel_input, kernel_mass_program, kernel_program, momentum_matrix_soa
 from .bounds import check_overflow
+from .compiled import use_compiled
 from .errors import ConfigurationError, ModelError
 from .forward import DEFAULT_CHUNK, ChainState, chain_state, ee_pose, ee_positions, link_poses, state_at
 from .model import ArmModel, FloatArray, as_joint_array
@@ -90,7 +91,7 @@ def _use_kernel(q: ArrayLike | None, frame: str, state: ChainState | None, compi
             shape = np.shape(q)  # validated afterwards, by whichever path runs
         except ValueError:  # ragged: as_joint_array says so
             return False
-        return len(shape) > 1 and math.prod(shape[:-1]) >= _fk.COMPILED_MIN_BATCH
+        return len(shape) >= 1 and use_compiled(math.prod(shape[:-1]), _fk.COMPILED_MIN_BATCH)
     return True
 
 

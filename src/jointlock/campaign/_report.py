@@ -65,6 +65,10 @@ class CampaignReport:
         The result the worst cases are ranked by and which way is worse.
     worst
         The worst cases' table rows, worst first.
+    compiled
+        The mode the cases ran in (:mod:`jointlock.compiled`; None for a campaign run before
+        it was recorded): the worst cases' scenario files say it, so that ``jointlock run``
+        gives their numbers bit for bit.
     """
 
     status: CampaignStatus
@@ -75,6 +79,7 @@ class CampaignReport:
     worst_column: str | None
     worse: str
     worst: tuple[dict[str, Any], ...]
+    compiled: str | None = None
 
     def to_dict(self) -> dict[str, Any]:
         return {
@@ -122,6 +127,8 @@ class CampaignReport:
             robot = Path(str(data.get("robot", "")))
             if robot.suffix.lower() in (".toml", ".urdf") and not robot.is_absolute():
                 data["robot"] = str((spec.scenario_dir / robot).resolve())
+            if self.compiled is not None:  # the mode the case ran in: the same numbers, bit for bit
+                data.setdefault("compiled", self.compiled)
             task_file = (data.get("task") or {}).get("file")
             if task_file and not Path(task_file).is_absolute():  # relative to the base scenario's folder
                 data["task"] = {**data["task"], "file": str((spec.scenario_dir / task_file).resolve())}
@@ -386,6 +393,7 @@ def campaign_report(
     table = campaign_table(out)
     with open_ledger(out) as ledger:
         spec = ledger.meta("spec") or {}
+        compiled = ledger.meta("compiled")
     conf = spec.get("report", {})
     x, y = x or conf.get("x"), y or conf.get("y")
     for axis, name in (("x", x), ("y", y)):
@@ -418,7 +426,7 @@ def campaign_report(
     if worst is not None:
         scored = [r for r in ok_rows if r.get(worst) is not None]
         ranked = sorted(scored, key=lambda r: float(r[worst]), reverse=worse == "higher")[: max(int(top), 0)]
-    return CampaignReport(status, table, spec, x, y, worst, worse, tuple(ranked))
+    return CampaignReport(status, table, spec, x, y, worst, worse, tuple(ranked), compiled)
 
 
 def write_campaign_report(out: str | Path, path: str | Path | None = None, **options: Any) -> list[Path]:

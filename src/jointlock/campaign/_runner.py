@@ -34,7 +34,7 @@ from ._guard import Stop, exclusive
 from ._ledger import LEDGER_NAME, Ledger, open_ledger
 from ._read import as_spec
 from ._spec import CONFIRM_CASES, CampaignSpec
-from ._worker import WORKER_LOST, CaseOutcome, decode_result, make_task, run_batch
+from ._worker import WORKER_LOST, CaseOutcome, campaign_compiled_mode, decode_result, make_task, run_batch
 
 #: Times a batch may be lost while alone in flight before it is split (a single case is then
 #: recorded as ``WorkerLost``, and runs again on resume).
@@ -255,7 +255,9 @@ def _remember(ledger: Ledger, spec: CampaignSpec, columns: Sequence[str]) -> Non
     if ledger.meta("columns") not in (None, list(columns)):
         keys = ledger.finished_keys(status="ok")
         ledger.update_records({key: record(res, columns) for key, res in ledger.results(keys)})
-    ledger.set_meta(spec=spec.to_dict(), columns=list(columns), jointlock=__version__)
+    ledger.set_meta(
+        spec=spec.to_dict(), columns=list(columns), jointlock=__version__, compiled=campaign_compiled_mode()
+    )
 
 
 @dataclass

@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from .._version import __version__
+from ..compiled import CompiledMode, chosen_compiled_mode, compiled_kernels
 from ..io.files import json_text
 from ..run import run_scenario
 from ._cases import Case, case_key, case_overrides, resolve_case
@@ -60,6 +61,11 @@ class BatchTask:
         Columns to record.
     version
         The coordinator's jointlock version (a worker with another one refuses the batch).
+    compiled
+        The mode the cases run in (:mod:`jointlock.compiled`): the coordinator's
+        ``JOINTLOCK_COMPILED`` when set, else ``"always"`` (a worker runs many cases, so it
+        pays numba's load once and runs every batch compiled); the same on every engine and
+        worker, so that a case gives the same numbers wherever it runs.
     """
 
     scenario: Mapping[str, Any]
@@ -69,6 +75,7 @@ class BatchTask:
     cases: tuple[tuple[str, Mapping[str, Any], int], ...]
     columns: tuple[str, ...]
     version: str = __version__
+    compiled: CompiledMode = "always"
 
 
 @dataclass(frozen=True)
@@ -125,7 +132,14 @@ def make_task(spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str])
         campaign_seed=spec.seed,
         cases=tuple((c.key, case_overrides(spec, c.params), c.seed) for c in cases),
         columns=tuple(columns),
+        compiled=campaign_compiled_mode(),
     )
+
+
+def campaign_compiled_mode() -> CompiledMode:
+    """The mode a campaign's cases run in: ``JOINTLOCK_COMPILED`` when set (or a mode set in
+    the program), else ``"always"``."""
+    return chosen_compiled_mode() or "always"
 
 
 def run_batch(task: BatchTask) -> list[CaseOutcome]:
@@ -153,7 +167,7 @@ def run_batch(task: BatchTask) -> list[CaseOutcome]:
         seed=task.campaign_seed,
     )
     worker = f"{socket.gethostname()}:{os.getpid()}"
-    with _BATCH_LOCK, threadpool_limits(limits=1):
+    with _BATCH_LOCK, threadpool_limits(limits=1), compiled_kernels(task.compiled):
         return [_run_case(spec, key, overrides, seed, task.columns, worker) for key, overrides, seed in task.cases]
 
 

@@ -17,12 +17,14 @@ from __future__ import annotations
 import importlib
 import platform
 from collections.abc import Callable, Mapping, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from ..compiled import compiled_kernels
 from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
@@ -136,11 +138,13 @@ def run_scenario(
 
         require_mujoco()
     results: dict[str, JobResult] = {}
-    for job in scenario.jobs:
-        try:
-            results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
-        except JointlockError as exc:
-            raise _with_context(exc, f"{scenario.source}: job [{job}]") from exc
+    mode = scenario.data.get("compiled")
+    with compiled_kernels(mode) if mode is not None else nullcontext():
+        for job in scenario.jobs:
+            try:
+                results[job] = job_runner(job)(scenario.data, dict(results), progress=progress)
+            except JointlockError as exc:
+                raise _with_context(exc, f"{scenario.source}: job [{job}]") from exc
     checks: dict[str, Any] = {}
     if simulator == "mujoco":
         from ..sim import replay_jobs

@@ -160,6 +160,14 @@ TOP_FIELDS: dict[str, Field] = {
         help="replay the halt, the jump runs and the re-plan in this simulator and compare the spacecraft's attitude, "
         "drift and the brake torque with jointlock's ('mujoco': the optional extra jointlock[mujoco]; docs/simulators.md)",
     ),
+    "compiled": Field(
+        "choice",
+        None,
+        choices=("auto", "always", "never"),
+        help="when the jobs run on the compiled kernels: 'always' (every batch: a campaign's workers), 'auto' (large "
+        "batches only) or 'never'; the same numbers to round-off (default: the environment's JOINTLOCK_COMPILED, "
+        "else 'auto'; docs/performance.md)",
+    ),
 }
 
 #: Tables shared by the jobs.

@@ -12,6 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._chain import kernel_input, kernel_mass_program, kernel_program
+from ...compiled import use_compiled
 from ...errors import ConfigurationError
 from ...model import ArmModel, FloatArray
 from ...progress import Progress
@@ -352,7 +353,7 @@ def configuration_indices(
     if method is None:
         from ...forward import COMPILED_MIN_BATCH
 
-        method = "jacobi" if flat.shape[0] >= COMPILED_MIN_BATCH else "svd"
+        method = "jacobi" if use_compiled(flat.shape[0], COMPILED_MIN_BATCH) else "svd"
     fused = method == "jacobi"
     if fused:  # the compiled kernel builds each block's Jacobian and its singular values at once
         from ... import _kernels  # numba is imported on first use, not with the package

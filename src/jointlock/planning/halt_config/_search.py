@@ -23,6 +23,7 @@ from ...analysis.ability import (
     fit_ability_model,
 )
 from ...collision import check_clearance_m, clearance, collision_pairs
+from ...compiled import use_compiled
 from ...errors import ConfigurationError, InfeasibleError
 from ...forward import COMPILED_MIN_BATCH
 from ...model import ArmModel, FloatArray, as_joint_array
@@ -199,7 +200,7 @@ def optimal_halt_configuration(
         model_locked,
         q,
         # compiled one-sided Jacobi (as exact as LAPACK) where the batch pays numba's start-up
-        method="jacobi" if k >= COMPILED_MIN_BATCH else "gram",
+        method="jacobi" if use_compiled(k, COMPILED_MIN_BATCH) else "gram",
         batch_size=batch_size,
         progress=progress,
         jacobian=jacobian,
@@ -212,7 +213,13 @@ def optimal_halt_configuration(
 
     def exact(qs: FloatArray) -> tuple[FloatArray, KinematicIndices]:
         i = configuration_indices(
-            model_locked, qs, method="svd", jacobian=jacobian, characteristic_length=characteristic_length
+            model_locked,
+            qs,
+            # LAPACK's SVD (the reference) on the refinement's small batches, unless the
+            # process runs every batch compiled (jointlock.compiled)
+            method="jacobi" if use_compiled(np.size(qs) // n, COMPILED_MIN_BATCH) else "svd",
+            jacobian=jacobian,
+            characteristic_length=characteristic_length,
         )
         return ability(i), i
 
