@@ -1,4 +1,13 @@
-"""Benchmark: failure campaigns on each engine, in the same run.
+"""Benchmark: what a failure case costs, and failure campaigns on each engine, in the same run.
+
+Per-case cost (issue 29): cases of the three example campaigns (``examples/campaigns/``: the
+halt7 halts, the canadarm7 jump runs, the puma6 tolerance angles), each run as a worker runs
+it (:func:`jointlock.campaign.run_batch`: resolve, run, record, compress) in one warm process
+(one case first, untimed: numba's load and the models' building), by this checkout in the
+compiled mode ``always`` (what workers use) and ``auto``, and by the revision ``--before REV``
+(default ``HEAD~1``; a temporary git worktree) in the same run.  Printed: median and min-max
+seconds per case, the speed-up of the medians, and how far the recorded figures (k*, the
+global torque, the smallest T, the verdicts, ...) moved against the revision before.
 
 A halt campaign (halt7, 000's strategy: 7 joints x 4 locked angles x 2 halt times = 56 cases)
 and a jump campaign (canadarm7, 001's task: 7 joints x 4 failure times = 28 cases), each run
@@ -10,11 +19,16 @@ ledger, workers' start-up, idle tails), also as a share of the work.  Then the l
 rate (one transaction per batch of 100 outcomes).  Aim: >= 1.8x serial with 2 workers, overhead
 < 5 % of the work.
 
-    python benchmarks/bench_campaign.py [WORKERS]
+    python benchmarks/bench_campaign.py [WORKERS] [--before REV] [--cases N] [--costs-only]
 """
 
 from __future__ import annotations
 
+import argparse
+import json
+import os
+import statistics
+import subprocess
 import sys
 import tempfile
 import time
@@ -83,6 +97,86 @@ def run_engines(name: str, text: str, workers: int, folder: Path) -> None:
               f"{over_pct:8.1f}%{start:>15}")  # fmt: skip
 
 
+#: Run in a fresh interpreter on one source tree: cases of a campaign file as a worker runs them;
+#: prints one JSON list of [key, seconds, record, error type] per case.
+_CASES_SCRIPT = """
+import json, sys
+from jointlock import campaign
+from jointlock.campaign._cases import plan_cases
+from jointlock.campaign._columns import check_columns
+spec = campaign.load_campaign(sys.argv[1])
+plan = plan_cases(spec)
+step = max(1, len(plan.cases) // int(sys.argv[2]))
+cases = list(plan.cases[::step])[: int(sys.argv[2])]
+columns = check_columns(spec, plan)
+campaign.run_batch(campaign.make_task(spec, cases[:1], columns))  # warm: numba, models
+outs = campaign.run_batch(campaign.make_task(spec, cases, columns))
+print(json.dumps([[o.key, o.seconds, o.record, o.error_type] for o in outs]))
+"""
+
+CAMPAIGNS = ("halt7.toml", "jump_canadarm7.toml", "tolerance_puma6.toml")
+
+
+def _run_cases(src: Path, campaign_file: Path, n: int, mode: str | None) -> list:
+    env = {k: v for k, v in os.environ.items() if k not in ("JOINTLOCK_COMPILED", "PYTHONPATH")}
+    env["PYTHONPATH"] = str(src)
+    env["OMP_NUM_THREADS"] = env["OPENBLAS_NUM_THREADS"] = "1"
+    if mode is not None:
+        env["JOINTLOCK_COMPILED"] = mode
+    out = subprocess.run(
+        [sys.executable, "-c", _CASES_SCRIPT, str(campaign_file), str(n)],
+        capture_output=True, text=True, env=env, check=True,
+    )  # fmt: skip
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def _moved(before: list, after: list) -> str:
+    """The largest relative change of each recorded number, and the verdicts that changed."""
+    rel: dict[str, float] = {}
+    changed = 0
+    for (_, _, a, ea), (_, _, b, eb) in zip(before, after):
+        if ea != eb or (a is None) != (b is None):
+            changed += 1
+            continue
+        for col, x in (a or {}).items():
+            y = b.get(col)
+            if isinstance(x, bool) or isinstance(y, bool) or x is None or y is None:
+                changed += x != y
+            elif isinstance(x, (int, float)) and isinstance(y, (int, float)):
+                rel[col] = max(rel.get(col, 0.0), abs(x - y) / max(abs(x), abs(y), 1e-300))
+    worst = sorted(rel.items(), key=lambda kv: -kv[1])[:4]
+    text = ", ".join(f"{c.split('.', 1)[-1]} {v:.1e}" for c, v in worst) or "no numbers"
+    return f"{changed} verdicts/errors changed; largest relative change: {text}"
+
+
+def case_costs(before: str, n: int) -> None:
+    """Seconds per case of the example campaigns: this checkout (always, auto) and ``before``."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tree = Path(tmp) / "before"
+        subprocess.run(["git", "-C", str(ROOT), "worktree", "add", "-q", "--detach", str(tree), before], check=True)
+        try:
+            rev = subprocess.run(["git", "-C", str(tree), "log", "-1", "--format=%h %s"], capture_output=True,
+                                 text=True, check=True).stdout.strip()[:70]  # fmt: skip
+            print(f"\nper-case cost, warm worker (run_batch), {n} cases of each campaign; before = {rev}")
+            print(f"{'campaign':<22}{'code':<24}{'median [s]':>11}{'min-max [s]':>17}{'speed-up':>10}")
+            for name in CAMPAIGNS:
+                path = ROOT / "examples" / "campaigns" / name
+                runs = {
+                    "before": _run_cases(tree / "src", path, n, None),
+                    "this, always (workers)": _run_cases(ROOT / "src", path, n, None),
+                    "this, auto": _run_cases(ROOT / "src", path, n, "auto"),
+                }
+                base = statistics.median(r[1] for r in runs["before"])
+                for label, rows in runs.items():
+                    secs = [r[1] for r in rows]
+                    med = statistics.median(secs)
+                    print(f"{name:<22}{label:<24}{med:11.3f}{min(secs):8.3f}-{max(secs):<8.3f}{base / med:9.1f}x")
+                print(f"{'':<22}always vs before: {_moved(runs['before'], runs['this, always (workers)'])}")
+                print(f"{'':<22}auto vs before:   {_moved(runs['before'], runs['this, auto'])}")
+        finally:
+            subprocess.run(["git", "-C", str(ROOT), "worktree", "remove", "--force", str(tree)], check=False)
+
+
 def ledger_rate(folder: Path, n: int = 20000, batch: int = 100) -> None:
     """Outcomes of the size a halt case gives (a 2 kB compressed result), written as the
     coordinator writes them."""
@@ -105,12 +199,20 @@ def ledger_rate(folder: Path, n: int = 20000, batch: int = 100) -> None:
 
 
 def main(argv: list[str]) -> int:
-    workers = int(argv[1]) if len(argv) > 1 else 2
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("workers", nargs="?", type=int, default=2)
+    parser.add_argument("--before", default="HEAD~1", help="the revision the per-case cost is compared with")
+    parser.add_argument("--cases", type=int, default=15, help="cases of each campaign in the per-case cost")
+    parser.add_argument("--costs-only", action="store_true", help="the per-case cost only, no engines")
+    args = parser.parse_args(argv[1:])
     print(machine_info())
+    case_costs(args.before, args.cases)
+    if args.costs_only:
+        return 0
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
-        run_engines("halt", HALT, workers, folder)
-        run_engines("jump", JUMP, workers, folder)
+        run_engines("halt", HALT, args.workers, folder)
+        run_engines("jump", JUMP, args.workers, folder)
         ledger_rate(folder)
     return 0
 

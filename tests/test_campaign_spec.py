@@ -263,3 +263,14 @@ def test_the_default_output_folder_is_beside_the_campaign_file(tmp_path, monkeyp
     assert load_campaign(path).default_out() == tmp_path / "mine-campaign"
     other = write_campaign(tmp_path, 'out = "results/here"\n[grid]\n"halt.T" = [9.0]\n', name="o.toml")
     assert load_campaign(other).default_out() == tmp_path / "results" / "here"
+
+
+def test_keys_do_not_move_with_fields_added_later(tmp_path):
+    """A field added to scenarios after the key format was set (``compiled``) leaves the keys of
+    cases that do not set it as they were (so their seeds, and resume, stay); set, it counts."""
+    plain = load_campaign(write_campaign(tmp_path, '[grid]\n"halt.T" = [8.0, 10.0]\n'))
+    keys = [c.key for c in plan_cases(plain).cases]
+    assert keys == ["35a7bb766881cdd35ef3a310", "0af85a422d5bc3122bafcf36"]  # the keys before the field
+    told = load_campaign(write_campaign(tmp_path, '[grid]\n"halt.T" = [8.0, 10.0]\n"compiled" = ["always"]\n',
+                                        name="told.toml"))  # fmt: skip
+    assert not set(keys) & {c.key for c in plan_cases(told).cases}

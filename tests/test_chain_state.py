@@ -183,9 +183,9 @@ def _imported_modules(path: Path) -> set[str]:
 LOW_MODULES = {
     "_rows": set(),
     "spatial": set(),
-    "_chain": {"_rows", "model"},
-    "forward": {"_chain", "errors", "model", "spatial", "_kernels"},
-    "kinematics": {"_chain", "bounds", "errors", "forward", "model", "_kernels"},
+    "_chain": {"_rows", "model", "_cache"},
+    "forward": {"_chain", "errors", "model", "spatial", "_kernels", "compiled"},
+    "kinematics": {"_chain", "bounds", "errors", "forward", "model", "_kernels", "compiled"},
 }
 
 

@@ -139,13 +139,22 @@ def resolve_case(spec: CampaignSpec, overrides: Mapping[str, Any]) -> Scenario:
     return scenario_from_dict(data, source=spec.scenario_source, base_dir=spec.scenario_dir)
 
 
+#: Top-level fields added after :data:`KEY_FORMAT` was set, left out of a key while unset, so that
+#: the cases of earlier campaigns keep their keys and seeds (and resume).
+UNKEYED_WHEN_UNSET = ("compiled",)
+
+
 def case_key(scenario: Scenario, campaign_seed: int) -> str:
     """Hash (24 hex digits of SHA-256) of a case's fully resolved inputs: the resolved
-    scenario without its title, description and output folder, a model file by its name and
-    content, the campaign seed and :data:`KEY_FORMAT`."""
+    scenario without its title, description and output folder (nor the fields of
+    :data:`UNKEYED_WHEN_UNSET` while unset), a model file by its name and content, the campaign
+    seed and :data:`KEY_FORMAT`."""
     data = scenario.to_dict()
     for key in ("title", "description", "out"):
         data.pop(key, None)
+    for key in UNKEYED_WHEN_UNSET:
+        if data.get(key) is None:
+            data.pop(key, None)
     robot = Path(str(data["robot"]))
     if robot.suffix.lower() in (".toml", ".urdf"):
         data["robot"] = {"file": robot.name, "sha256": _file_digest(str(robot))}
