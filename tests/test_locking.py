@@ -130,3 +130,21 @@ def test_massless_bodies_keep_their_rotational_inertia_when_merged(rng):
         locked, q_full, keep = _frozen_comparison(arm, locks, random_q(arm, rng, (5,))[:, : arm.dof - len(locks)])
         m_full = jl.mass_matrix(arm, q_full)
         np.testing.assert_allclose(jl.mass_matrix(locked, locked.healthy(q_full)), m_full[:, keep][:, :, keep], atol=1e-12)
+
+
+def test_check_lock_refuses_what_lock_refuses():
+    """A scenario's validation checks each lock without building the locked arm (issue 29: one
+    validation per campaign case): the same errors as lock itself."""
+    from jointlock.errors import ModelError
+    from jointlock.locking import check_lock
+
+    arm = jl.load_robot("puma6")
+    one = jl.lock_joints(arm, {1: 0.0, 2: 0.0, 3: 0.0, 4: 0.0, 5: 0.0})
+    for model, joint, angle in ((arm, 0, 0.0), (arm, 7, 0.0), (arm, True, 0.0), (arm, 2, float("nan")),
+                                (arm, 2, 10.0), (one, 6, 0.0), (one, 3, 0.0)):  # fmt: skip
+        with pytest.raises(ModelError) as built:
+            jl.lock(model, joint, angle)
+        with pytest.raises(ModelError) as checked:
+            check_lock(model, joint, angle)
+        assert str(checked.value) == str(built.value)
+    assert check_lock(arm, 3, 0.5) == (2, 0.5)

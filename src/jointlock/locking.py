@@ -50,19 +50,8 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
         ``model.dof - 1`` movable joints; ``locked`` gains ``LockedJoint(joint, angle)``;
         ``unlocked`` is the arm before its first lock.
     """
-    if isinstance(joint, bool) or not isinstance(joint, (int, np.integer)):
-        raise ModelError(f"joint must be an integer joint number (1-based); got {joint!r}")
-    index = model.index_of(int(joint))
-    angle = as_real(angle, f"lock angle of joint {joint}", unit="rad", error=ModelError)
+    index, angle = check_lock(model, joint, angle, check_limits=check_limits)
     jnt = model.joints[index]
-    if check_limits and not (jnt.lower - LOCK_LIMIT_SLACK <= angle <= jnt.upper + LOCK_LIMIT_SLACK):
-        raise ModelError(
-            f"lock angle of joint {joint} must lie within its limits "
-            f"[{math.degrees(jnt.lower):.10g}, {math.degrees(jnt.upper):.10g}] deg; "
-            f"got {math.degrees(angle):.10g} deg"
-        )
-    if model.dof == 1:
-        raise ModelError(f"cannot lock joint {joint}: it is the only movable joint of {model.name!r}")
 
     # Pose of the locked joint's frame in its parent's frame, now constant.
     frozen = jnt.placement @ pose(axis_angle_rotation(jnt.axis, angle), np.zeros(3))
@@ -91,6 +80,32 @@ def lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True
         locked=model.locked + (LockedJoint(int(joint), angle),),
         unlocked=model.unlocked if model.locked else model,
     )
+
+
+def check_lock(model: ArmModel, joint: int, angle: float, *, check_limits: bool = True) -> tuple[int, float]:
+    """What :func:`lock` checks, without building the locked model (a scenario's validation,
+    once per case of a campaign): ``(index of the joint among the movable ones, angle [rad])``.
+
+    Raises
+    ------
+    ModelError
+        As :func:`lock`: not a joint number of ``model`` (or already locked), the angle not a
+        real number or outside the joint's limits, or the joint the only movable one.
+    """
+    if isinstance(joint, bool) or not isinstance(joint, (int, np.integer)):
+        raise ModelError(f"joint must be an integer joint number (1-based); got {joint!r}")
+    index = model.index_of(int(joint))
+    angle = as_real(angle, f"lock angle of joint {joint}", unit="rad", error=ModelError)
+    jnt = model.joints[index]
+    if check_limits and not (jnt.lower - LOCK_LIMIT_SLACK <= angle <= jnt.upper + LOCK_LIMIT_SLACK):
+        raise ModelError(
+            f"lock angle of joint {joint} must lie within its limits "
+            f"[{math.degrees(jnt.lower):.10g}, {math.degrees(jnt.upper):.10g}] deg; "
+            f"got {math.degrees(angle):.10g} deg"
+        )
+    if model.dof == 1:
+        raise ModelError(f"cannot lock joint {joint}: it is the only movable joint of {model.name!r}")
+    return index, angle
 
 
 def lock_joints(model: ArmModel, locks: Mapping[int, float], *, check_limits: bool = True) -> ArmModel:

@@ -149,12 +149,13 @@ def case_key(scenario: Scenario, campaign_seed: int) -> str:
     scenario without its title, description and output folder (nor the fields of
     :data:`UNKEYED_WHEN_UNSET` while unset), a model file by its name and content, the campaign
     seed and :data:`KEY_FORMAT`."""
-    data = scenario.to_dict()
-    for key in ("title", "description", "out"):
-        data.pop(key, None)
-    for key in UNKEYED_WHEN_UNSET:
-        if data.get(key) is None:
-            data.pop(key, None)
+    # the resolved data as Scenario.to_dict gives it, without copying it: only serialised here
+    data = {
+        key: value
+        for key, value in scenario.data.items()
+        if key not in ("title", "description", "out") and not (key in UNKEYED_WHEN_UNSET and value is None)
+    }
+    data["jobs"] = list(scenario.jobs)
     robot = Path(str(data["robot"]))
     if robot.suffix.lower() in (".toml", ".urdf"):
         data["robot"] = {"file": robot.name, "sha256": _file_digest(str(robot))}

@@ -126,7 +126,7 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
     Over 100 lines: one flat list of independent rules, each a few lines, in the order the
     tables appear; splitting it would scatter the rules without making any of them simpler.
     """
-    from ..locking import lock
+    from ..locking import check_lock
 
     cache: dict = {}
     model = _load(out, out["base"], source, cache)
@@ -159,13 +159,15 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
     locks_deg: dict[int, float] = {}
     if fail["joint"] is not None and fail["angle_deg"] is not None:
         locks_deg = {**earlier, int(fail["joint"]): float(fail["angle_deg"])}
-    locked = None
     for j, a in locks_deg.items():
+        # lock()'s checks without building the locked arm (distinct joints and at least one
+        # left movable are checked above, so checking each on the arm as loaded is the same)
         try:
-            locked = lock(locked or model, j, math.radians(a))
+            check_lock(model, j, math.radians(a))
         except JointlockError as exc:
             where = "failure.angle_deg" if j == fail["joint"] else f"failure.also_locked_deg.{j}"
             raise ScenarioError(f"{source}: {where}: {exc}") from None
+    locked_dof = n - len(locks_deg) if locks_deg else None
     _defaults_000(out, jobs, model)
 
     def vector(
@@ -176,16 +178,16 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
         accelerations, as a locked joint does not move)."""
         if values is None:
             return
-        sizes = {n} if full_only or locked is None else {locked.dof, n}
+        sizes = {n} if full_only or locked_dof is None else {locked_dof, n}
         if len(values) not in sizes:
             want = " or ".join(str(s) for s in sorted(sizes))
             what = (
-                "every joint of the arm" if full_only or locked is None else "healthy joints, or every joint"
+                "every joint of the arm" if full_only or locked_dof is None else "healthy joints, or every joint"
             )
             raise ScenarioError(
                 f"{source}: {where} needs {want} values ({what} of {model.name}); got {len(values)}"
             )
-        if locked is not None and not full_only and len(values) == n:
+        if locked_dof is not None and not full_only and len(values) == n:
             for number, angle in locks_deg.items():
                 j = number - 1
                 if rates:
@@ -257,7 +259,7 @@ def _check_semantics(out: dict[str, Any], jobs: tuple[str, ...], source: str) ->
             raise ScenarioError(
                 f"{source}: singular.verify_conditions needs base 'virtual' or 'fixed'; got 'floating'"
             )
-        if s["verify_conditions"] and locked is not None:
+        if s["verify_conditions"] and locked_dof is not None:
             raise ScenarioError(
                 f"{source}: singular.verify_conditions analyses the whole 7-joint arm; remove [failure] "
                 "or set verify_conditions = false"
