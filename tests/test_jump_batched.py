@@ -163,3 +163,48 @@ def test_the_law_of_a_large_batch_equals_it_in_small_batches():
         small = law(frame.jac[..., part], healthy[:, part], xdot[:, part], kappa[part], axes=frame.axes[..., part])
         for got, ref in zip(whole, small):
             assert _close(got[..., part], ref)
+
+
+def test_the_compiled_step_equals_the_numpy_one():
+    """issue 29: in the compiled mode "always" the integrator's frame and law run as kernels
+    (jointlock._kernels._jump), with numpy's numbers to round-off; a run whose Gram matrix is
+    singular (two locked joints of a 3-joint reach) goes to numpy's SVD, as in numpy."""
+    for arm in (jl.load_robot("canadarm7"), jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")):
+        rng = np.random.default_rng(11)
+        q0 = tuple(rng.uniform(-1.0, 1.0, arm.dof))
+        p = _problem(arm, JumpScenario(q0=q0))
+        runs = 40
+        q = np.asarray(q0) + rng.uniform(-0.5, 0.5, (runs, arm.dof))
+        healthy = np.ones((arm.dof, runs), dtype=bool)
+        healthy[rng.integers(0, arm.dof, runs), np.arange(runs)] = False
+        healthy[:, -1] = False
+        healthy[:2, -1] = True  # two joints left: J_h J_h^T of rank 2, by the SVD
+        xdot, kappa = rng.normal(size=(3, runs)), rng.normal(size=runs)
+        frame = p.frame(q, None)
+        reference = law(frame.jac, healthy, xdot, kappa, axes=frame.axes)
+        with jl.compiled_kernels("always"):
+            compiled_frame = p.frame(q, None)
+            compiled = law(compiled_frame.jac, healthy, xdot, kappa, axes=compiled_frame.axes)
+        for got, ref in ((compiled_frame.x, frame.x), (compiled_frame.jac, frame.jac), (compiled_frame.axes, frame.axes)):
+            assert _close(got, ref)
+        for got, ref in zip(compiled, reference):
+            assert np.all(np.abs(got - ref) <= 1e-11 * np.abs(ref).max())
+        assert np.all(compiled[0][~healthy] == 0.0)
+
+
+def test_a_jump_in_either_mode_gives_the_same_numbers():
+    """001's jump at one failure time with the optimal kappa (the search, then the runs), in
+    the compiled mode "always" and in numpy: the same kappa, interval and jumps to round-off."""
+    import math
+
+    from jointlock.planning.jump import jump_at_time
+
+    arm = jl.load_robot("canadarm7")
+    task = JumpScenario(duration=2.0, blend=0.5, dx=(0.1, -0.12, 0.06), vmax=math.radians(10), amax=math.radians(10),
+                        eps=0.01)  # fmt: skip
+    reference = jump_at_time(arm, task, 1.0)
+    with jl.compiled_kernels("always"):
+        compiled = jump_at_time(arm, task, 1.0)
+    assert reference.jump_after < 0.5 * reference.jump_before  # the compensation works here
+    for name in ("kappa", "jump_before", "jump_after", "interval", "joint_jump_after"):
+        assert np.allclose(getattr(compiled, name), getattr(reference, name), rtol=1e-9, atol=1e-15), name

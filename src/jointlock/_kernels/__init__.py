@@ -59,6 +59,7 @@ from ._arm import (
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
 from ._dynamics import rnea_fixed, rnea_floating
+from ._jump import fixed_frame, rate_law
 from ._svd import singular_values
 
 __all__ = [
@@ -66,10 +67,12 @@ __all__ = [
     "MAX_SWEEPS",
     "TRIG_LIMIT",
     "ee_positions",
+    "fixed_frame",
     "fixed_singular_values",
     "generalized_jacobian",
     "generalized_singular_values",
     "jacobian",
+    "rate_law",
     "rnea_fixed",
     "rnea_floating",
     "sincos",

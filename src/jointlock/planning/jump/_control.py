@@ -12,6 +12,9 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._chain import kernel_input
+from ...compiled import use_compiled
+from ...forward import COMPILED_MIN_BATCH
 from ...model import FloatArray
 
 #: Gram matrices ``J_h J_h^T`` whose determinant is below this fraction of ``(tr/3)^3`` are
@@ -128,6 +131,21 @@ def law(
         (n, B) the null-space term ``(I - J_h^+ J_h) grad w_h`` [m^3/rad] (``qdot`` at
         ``xdot = 0``, ``kappa = 1``).
     """
+    if axes is not None and use_compiled(jac.shape[-1], COMPILED_MIN_BATCH):
+        return _compiled_law(jac, healthy, xdot, kappa, axes)
+    return _reference_law(jac, healthy, xdot, kappa, axes=axes, djac=djac)
+
+
+def _reference_law(
+    jac: FloatArray,
+    healthy: np.ndarray,
+    xdot: FloatArray,
+    kappa: FloatArray,
+    *,
+    axes: FloatArray | None = None,
+    djac: FloatArray | None = None,
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`law` in numpy, batch last (the reference of the compiled kernel)."""
     jac_h = jac * healthy
     gram = np.einsum("rkb,skb->rsb", jac_h, jac_h)
     m, det = _pinv_rows(jac_h, gram)  # m[:, k] = 0 where column k is locked
@@ -145,6 +163,35 @@ def law(
     grad = grad * healthy
     null = grad - np.einsum("rib,rb->ib", m, np.einsum("rkb,kb->rb", jac_h, grad))
     qdot = np.einsum("rib,rb->ib", m, xdot) + kappa * null
+    return qdot, w, null
+
+
+def _c(x: FloatArray) -> FloatArray:
+    """``x`` as the kernels take it (C-contiguous, writable float64): :func:`jointlock._chain.kernel_input`
+    with a quick exit for the arrays the integrator already makes so (once per step, it counts)."""
+    if x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable:
+        return x
+    return kernel_input(x)
+
+
+def _compiled_law(
+    jac: FloatArray, healthy: np.ndarray, xdot: FloatArray, kappa: FloatArray, axes: FloatArray
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """:func:`law` with ``axes`` by the compiled kernel (:func:`jointlock._kernels.rate_law`);
+    runs with a (nearly) singular Gram matrix by the reference, whose SVD handles them."""
+    from ... import _kernels
+
+    n, B = jac.shape[1], jac.shape[2]
+    qdot, w, null = np.empty((n, B)), np.empty(B), np.empty((n, B))
+    singular = np.zeros(B, dtype=np.bool_)
+    healthy_c = np.ascontiguousarray(healthy, dtype=np.bool_)
+    jac_c, axes_c, xdot_c = _c(jac), _c(axes), _c(xdot)
+    kappa_c = np.array(np.broadcast_to(kappa, (B,)), dtype=float)  # a column of the schedules: strided
+    _kernels.rate_law(jac_c, axes_c, healthy_c, xdot_c, kappa_c, SINGULAR_GRAM_RTOL, qdot, w, null, singular)
+    if singular.any():
+        q_s, w_s, n_s = _reference_law(jac_c[..., singular], healthy_c[:, singular], xdot_c[:, singular],
+                                       kappa_c[singular], axes=axes_c[..., singular])  # fmt: skip
+        qdot[:, singular], w[singular], null[:, singular] = q_s, w_s, n_s
     return qdot, w, null
 
 

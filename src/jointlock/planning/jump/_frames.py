@@ -14,7 +14,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from ..._chain import axis_frame
+from ..._chain import axis_frame, kernel_input
+from ...compiled import use_compiled
+from ...forward import COMPILED_MIN_BATCH
 from ...model import ArmModel, FloatArray
 from ._control import CYCLIC, cross_cyclic, law
 
@@ -75,6 +77,7 @@ class _FixedChain:
 
     link_t: tuple[FloatArray, ...]  # (n,) H_i^T (4, 4), for the batch-last product [R'|p] H
     tool: FloatArray  # (4,) homogeneous tool point in the last z-joint frame [m]
+    link_h: FloatArray  # (n, 4, 4) H_i, for the compiled frame (jointlock._kernels.fixed_frame)
 
     @classmethod
     def of(cls, model: ArmModel) -> _FixedChain:
@@ -88,11 +91,19 @@ class _FixedChain:
             h[:3, 3] = q_prev.T @ joint.placement[:3, 3]
             links.append(np.ascontiguousarray(h.T))
             q_prev = q_axis
-        return cls(tuple(links), np.append(q_prev.T @ model.tool[:3, 3], 1.0))
+        return cls(
+            tuple(links), np.append(q_prev.T @ model.tool[:3, 3], 1.0), np.ascontiguousarray([h.T for h in links])
+        )
 
     def frame(self, q: FloatArray) -> _Frame:
         """Tool point, joint axes and position Jacobian at ``q`` (B, n) [rad], batch last."""
         n, B = len(self.link_t), q.shape[0]
+        if use_compiled(B, COMPILED_MIN_BATCH):  # the same numbers to round-off, one call
+            from ... import _kernels
+
+            x, jac, axes = np.empty((3, B)), np.empty((3, n, B)), np.empty((3, n, B))
+            _kernels.fixed_frame(kernel_input(q), self.link_h, self.tool, x, jac, axes)
+            return _Frame(x, jac, axes=axes)
         qt = q.T
         cos = np.cos(qt)  # (n, B)
         sin_pm = np.sin(qt)[:, None, :] * _SIGNS  # (n, 2, B): s, -s
