@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import math
 from typing import Any
 
 import numpy as np
@@ -118,7 +119,7 @@ def summarize(jobs: dict[str, dict]) -> dict[str, Any]:
 
 
 def _pct(x: Any) -> str:
-    return "n/a" if x is None else f"{100 * float(x):.1f} %"
+    return "n/a" if x is None or not math.isfinite(float(x)) else f"{100 * float(x):.1f} %"
 
 
 def _pct0(x: Any) -> str:

@@ -21,6 +21,7 @@ from ...planning.jump import (
     LimitReport,
     Trajectory,
     Verification,
+    improved_share,
     simulate,
 )
 from ...plots._common import offscreen_figure
@@ -260,7 +261,7 @@ def _single_json(robot: str, sc: JumpScenario, r: JumpAtTime) -> dict:
         "jump_before": r.jump_before,
         "jump_after": r.jump_after,
         "mean_reduction": r.reduction,
-        "share_improved": float(r.jump_after < r.jump_before),
+        "share_improved": improved_share(r.jump_before, r.jump_after),
         "limits_ok": r.limits_after.ok,
         "joint_jump_before_rad_s": r.joint_jump_before,
         "joint_jump_after_rad_s": r.joint_jump_after,

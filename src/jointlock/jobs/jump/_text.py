@@ -12,6 +12,11 @@ import numpy as np
 from ...plots.jump import KAPPA_UNIT
 
 
+def _share(share: float | None) -> str:
+    """``"97.5 %"``; ``"n/a (no jump)"`` when no failure time has a jump to improve."""
+    return "n/a (no jump)" if share is None or not math.isfinite(share) else f"{100 * share:.1f} %"
+
+
 def _less(reduction: float | None) -> str:
     """``"12.3 % less"``; ``"34x larger"`` (or ``"5.0 % larger"``) when the compensation makes
     the jump larger; ``"reduction n/a"`` when it is undefined (no jump before)."""
@@ -106,7 +111,7 @@ def summary_lines(r: Mapping[str, Any], *, kappa_given: bool = False) -> list[st
         lines.append(
             f"{label}, failure at every step: mean jump {_deg(v['mean_jump_before']):.5g} -> "
             f"{_deg(v['mean_jump_after']):.5g} deg/s ({_less(v['mean_reduction'])}), improved at "
-            f"{100 * v['share_improved']:.1f} % of steps, limits kept: {v['limits_ok']}"
+            f"{_share(v['share_improved'])} of steps, limits kept: {v['limits_ok']}"
         )
         if not v["limits_ok"]:
             times = v["broken_failure_times_s"]

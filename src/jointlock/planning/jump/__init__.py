@@ -98,7 +98,16 @@ from ._search import KappaSearch, merge_searches, sample_failure_times, search_k
 from ._search import _contiguous as _contiguous
 from ._search import _probe as _probe
 from ._search import _refine as _refine
-from ._simulate import JumpTable, LimitReport, Trajectory, jump_reduction, jump_table, simulate
+from ._simulate import (
+    NO_JUMP_RAD_S,
+    JumpTable,
+    LimitReport,
+    Trajectory,
+    improved_share,
+    jump_reduction,
+    jump_table,
+    simulate,
+)
 from ._simulate import _limit_report as _limit_report
 from ._simulate import _table as _table
 from ._study import JumpAtTime, JumpStudy, jump_at_time, study_jump
@@ -134,6 +143,8 @@ __all__ = [
     "fit_pieces",
     "jump_at_time",
     "jump_reduction",
+    "improved_share",
+    "NO_JUMP_RAD_S",
     "jump_table",
     "load_jump_task",
     "merge_searches",

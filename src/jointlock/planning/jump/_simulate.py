@@ -255,19 +255,36 @@ def _table(prob: _Problem, krows: FloatArray, out: _RunOut) -> JumpTable:
 
 
 
-def jump_reduction(before: ArrayLike, after: ArrayLike) -> Any:
-    """Relative jump reduction ``1 - after / before``.
+#: A joint-rate jump at most this large is round-off, not a jump [rad/s]: the rates are below
+#: ~1 rad/s, so their round-off is ~1e-16 rad/s; the jumps 001 is about are 1e-4..1e-1 rad/s.
+#: (canadarm7's last joint, which does not move the tool point, "jumps" by 1e-18..1e-17 rad/s.)
+NO_JUMP_RAD_S = 1e-12
 
-    Undefined -- NaN, written ``null`` in JSON and ``n/a`` in text -- where ``before`` is 0:
-    without compensation there is no jump to reduce (e.g. a task that does not move,
-    ``dx_m = [0, 0, 0]``), and a ratio would be 0/0 or hide a jump the compensation made.
+
+def jump_reduction(before: ArrayLike, after: ArrayLike) -> Any:
+    """Relative jump reduction ``1 - after / before`` (jumps in rad/s).
+
+    Undefined -- NaN, written ``null`` in JSON and ``n/a`` in text -- where ``before`` is at
+    most :data:`NO_JUMP_RAD_S`: without compensation there is no jump to reduce (e.g. a task
+    that does not move, ``dx_m = [0, 0, 0]``, or a joint that cannot move the tool point), and
+    a ratio would be 0/0, a ratio of round-off, or hide a jump the compensation made.
     A float for scalar inputs, an array otherwise; never warns or raises.
     """
     b = np.asarray(before, dtype=float)
     a = np.asarray(after, dtype=float)
+    jump = b > NO_JUMP_RAD_S
     with np.errstate(divide="ignore", invalid="ignore"):
-        out = np.where(b != 0.0, 1.0 - a / np.where(b != 0.0, b, 1.0), np.nan)
+        out = np.where(jump, 1.0 - a / np.where(jump, b, 1.0), np.nan)
     return float(out) if out.ndim == 0 else out
+
+
+def improved_share(before: ArrayLike, after: ArrayLike) -> float:
+    """Share of the failure times with a jump (above :data:`NO_JUMP_RAD_S`) whose jump the
+    compensation made smaller; NaN when none has a jump (see :func:`jump_reduction`)."""
+    b = np.atleast_1d(np.asarray(before, dtype=float))
+    a = np.atleast_1d(np.asarray(after, dtype=float))
+    jump = b > NO_JUMP_RAD_S
+    return float(np.mean(a[jump] < b[jump])) if jump.any() else math.nan
 
 
 def uncompensated_violations(model: ArmModel, scenario: JumpScenario | None = None) -> list[str]:

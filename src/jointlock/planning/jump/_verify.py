@@ -15,7 +15,7 @@ from ...model import ArmModel, FloatArray
 from ._engine import LIMIT_RTOL, _branched_runs, _ok, _Problem, _problem, _RunOut
 from ._fit import KappaFit
 from ._search import KappaSearch
-from ._simulate import LimitReport, _limit_report, _table, jump_reduction
+from ._simulate import LimitReport, _limit_report, _table, improved_share, jump_reduction
 from ._task import JumpScenario
 
 #: The fixes of a fitted kappa(t) that :func:`verify_kappa` offers.
@@ -226,7 +226,7 @@ def _verify_fixes(
                 table.task_jump_noreplan[j],
                 float(max(table.task_jump_replan[0].max(), table.task_jump_replan[j].max())),
                 jump_reduction(before.mean(), after.mean()),
-                float(np.mean(after < before)),
+                improved_share(before, after),
                 _limit_report(prob, [healthy, post], [sel, post_sel]),
                 bool(table.healthy_limits_ok[j]),
                 ok_steps,
