@@ -9,8 +9,8 @@ compiled mode ``always`` (what workers use) and ``auto``, and by the revision ``
 seconds per case, the speed-up of the medians, and how far the recorded figures (k*, the
 global torque, the smallest T, the verdicts, ...) moved against the revision before.
 
-A halt campaign (halt7, 000's strategy: 7 joints x 4 locked angles x 2 halt times = 56 cases)
-and a jump campaign (canadarm7, 001's task: 7 joints x 4 failure times = 28 cases), each run
+A halt campaign (halt7, 000's strategy: 7 joints x 8 locked angles x 2 halt times = 112 cases)
+and a jump campaign (canadarm7, 001's task: 7 joints x 12 failure times = 84 cases), each run
 serially in-process, on a local process pool of ``W`` workers and on a Dask LocalCluster of
 ``W`` workers (default 2).  Printed per engine: wall time, cases/s, speed-up over the serial
 run and parallel efficiency (speed-up / W), and the engine's overhead per case:
@@ -49,12 +49,12 @@ scenario = "{ROOT / "examples" / "halt_000.toml"}"
 "halt.minimum_T" = true
 [grid]
 "failure.joint" = [1, 2, 3, 4, 5, 6, 7]
-"failure.angle_deg" = [-60.0, -20.0, 20.0, 60.0]
+"failure.angle_deg" = [-75.0, -50.0, -25.0, -5.0, 5.0, 25.0, 50.0, 75.0]
 "halt.T" = [10.0, 12.0]
 """
 
 JUMP = (ROOT / "examples" / "campaigns" / "jump_canadarm7.toml").read_text().replace(
-    '"failure.time_s" = [1.0, 3.0, 5.0, 7.0, 9.0, 11.0]', '"failure.time_s" = [2.0, 5.0, 8.0, 11.0]'
+    '"failure.time_s" = [1.0, 3.0, 5.0, 7.0, 9.0, 11.0]', f'"failure.time_s" = {[0.5 + i for i in range(12)]}'
 )
 
 
@@ -204,9 +204,11 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--before", default="HEAD~1", help="the revision the per-case cost is compared with")
     parser.add_argument("--cases", type=int, default=15, help="cases of each campaign in the per-case cost")
     parser.add_argument("--costs-only", action="store_true", help="the per-case cost only, no engines")
+    parser.add_argument("--engines-only", action="store_true", help="the engines only, no per-case cost")
     args = parser.parse_args(argv[1:])
     print(machine_info())
-    case_costs(args.before, args.cases)
+    if not args.engines_only:
+        case_costs(args.before, args.cases)
     if args.costs_only:
         return 0
     with tempfile.TemporaryDirectory() as tmp:

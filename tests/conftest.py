@@ -31,6 +31,14 @@ ORACLE_ATOL = 1e-10
 ROBOT_NAMES = tuple(jl.BUILTIN_ROBOTS)
 
 
+@pytest.fixture(autouse=True)
+def _no_compiled_mode_leaks():
+    """A test that sets the process's compiled mode (jl.set_compiled_mode) leaves it unset.
+    (JOINTLOCK_COMPILED=always in the environment runs the suite on the compiled paths.)"""
+    yield
+    jl.set_compiled_mode(None)
+
+
 @pytest.fixture
 def rng() -> np.random.Generator:
     return np.random.default_rng(20261121)

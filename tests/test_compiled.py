@@ -4,6 +4,8 @@ field, and a campaign's workers running every batch compiled."""
 
 from __future__ import annotations
 
+import sqlite3
+
 import numpy as np
 import pytest
 
@@ -43,6 +45,7 @@ def test_the_mode_comes_from_the_program_else_the_environment(monkeypatch):
 def test_every_batched_function_follows_the_mode(arm, monkeypatch, rng):
     """One configuration runs on the kernels in "always" and on numpy in "auto" (spied), with
     the same numbers to round-off."""
+    monkeypatch.delenv(ENVIRONMENT_VARIABLE, raising=False)
     calls = []
     for name in ("generalized_jacobian", "jacobian", "rnea_floating", "generalized_singular_values", "ee_positions"):
         real = getattr(_kernels, name)
@@ -72,6 +75,7 @@ def test_a_scenario_can_say_its_mode(monkeypatch):
     """The scenario's ``compiled`` field is the mode its jobs run in (then the process's again)."""
     import jointlock.run._run as run_module
 
+    monkeypatch.delenv(ENVIRONMENT_VARIABLE, raising=False)
     seen = []
     real = run_module.job_runner
 
@@ -104,3 +108,72 @@ def test_a_campaign_runs_its_cases_compiled_unless_told_otherwise(tmp_path, monk
     assert make_task(spec, [], ()).compiled == "never"
     with jl.compiled_kernels("auto"):
         assert make_task(spec, [], ()).compiled == "auto"
+
+
+def test_a_block_s_mode_is_its_thread_s():
+    """Blocks in two threads, ending in the other order than they began, leave each thread's
+    mode its own and the process's as it was."""
+    import threading
+
+    entered, first_done = threading.Barrier(2), threading.Event()
+    seen = {}
+
+    def worker(name, mode, wait):
+        with jl.compiled_kernels(mode):
+            entered.wait()
+            if wait:
+                first_done.wait()
+            seen[name] = compiled_mode()
+        if not wait:
+            first_done.set()
+        seen[name + " after"] = compiled_mode()
+
+    threads = [threading.Thread(target=worker, args=("a", "always", True)),
+               threading.Thread(target=worker, args=("b", "never", False))]  # fmt: skip
+    for t in threads:
+        t.start()
+    for t in threads:
+        t.join()
+    assert seen["a"] == "always" and seen["b"] == "never"
+    assert seen["a after"] == seen["b after"] == compiled_mode()
+
+
+TOLERANCE = """
+title = "two locks"
+[scenario]
+robot = "puma6"
+[scenario.failure]
+joint = 6
+angle_deg = 10.0
+[scenario.tolerance_angle]
+q_target_deg = [5.0, 60.0, 35.0, 10.0, -120.0, 90.0]
+[grid]
+"failure.angle_deg" = [10.0, 20.0]
+"""
+
+
+def test_a_campaign_keeps_the_mode_its_cases_ran_in(tmp_path, monkeypatch):
+    """Resumed, a campaign runs in the mode its finished cases ran in (recorded in the ledger,
+    "auto" for a ledger from before the mode existed); the environment asking for another is
+    one clear error, not a campaign computed two ways."""
+    from jointlock.campaign import in_process, open_ledger, run_campaign
+    from jointlock.errors import CampaignError
+
+    path = tmp_path / "c.toml"
+    path.write_text(TOLERANCE)
+    out = tmp_path / "out"
+    monkeypatch.setenv(ENVIRONMENT_VARIABLE, "never")
+    assert run_campaign(path, out, engine=in_process()).ok == 2
+    monkeypatch.delenv(ENVIRONMENT_VARIABLE)
+    run_campaign(path, out, engine=in_process(), retry_failed=True)
+    with open_ledger(out) as ledger:
+        assert ledger.meta("compiled") == "never"
+    monkeypatch.setenv(ENVIRONMENT_VARIABLE, "always")
+    with pytest.raises(CampaignError, match="ran in the compiled mode 'never'.*JOINTLOCK_COMPILED=never"):
+        run_campaign(path, out, engine=in_process())
+    monkeypatch.delenv(ENVIRONMENT_VARIABLE)
+    with sqlite3.connect(out / "ledger.sqlite") as db:  # a ledger from before issue 29
+        db.execute("DELETE FROM meta WHERE name = 'compiled'")
+    run_campaign(path, out, engine=in_process())
+    with open_ledger(out) as ledger:
+        assert ledger.meta("compiled") == "auto"

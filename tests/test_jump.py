@@ -366,6 +366,8 @@ def test_reduction_is_undefined_without_a_jump(arm):
     # "jumps" of 1e-18..1e-17 rad/s gave reductions of 0..99 % that moved with the last bits
     assert math.isnan(jump_reduction(1.2e-17, 2.0e-19)) and jump_reduction(1e-9, 5e-10) == 0.5
     assert math.isnan(improved_share([1e-17, 0.0], [1e-19, 0.0])) and improved_share([1.0, 1e-17], [0.5, 0.0]) == 1.0
+    # a jump the compensation made where there was none counts, as not improved
+    assert improved_share([1.0, 0.0], [0.5, 0.3]) == 0.5 and improved_share([0.0], [0.3]) == 0.0
     np.testing.assert_array_equal(jump_reduction([1.0, 0.0], [0.5, 0.0]), [0.5, np.nan])
 
 

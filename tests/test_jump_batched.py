@@ -165,10 +165,22 @@ def test_the_law_of_a_large_batch_equals_it_in_small_batches():
             assert _close(got[..., part], ref)
 
 
-def test_the_compiled_step_equals_the_numpy_one():
+def _spy_jump_kernels(monkeypatch) -> list[str]:
+    from jointlock import _kernels
+
+    calls: list[str] = []
+    for name in ("fixed_frame", "rate_law"):
+        real = getattr(_kernels, name)
+        monkeypatch.setattr(_kernels, name, lambda *a, _real=real, _name=name: (calls.append(_name), _real(*a))[1])
+    return calls
+
+
+def test_the_compiled_step_equals_the_numpy_one(monkeypatch):
     """issue 29: in the compiled mode "always" the integrator's frame and law run as kernels
     (jointlock._kernels._jump), with numpy's numbers to round-off; a run whose Gram matrix is
     singular (two locked joints of a 3-joint reach) goes to numpy's SVD, as in numpy."""
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    calls = _spy_jump_kernels(monkeypatch)
     for arm in (jl.load_robot("canadarm7"), jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")):
         rng = np.random.default_rng(11)
         q0 = tuple(rng.uniform(-1.0, 1.0, arm.dof))
@@ -190,9 +202,14 @@ def test_the_compiled_step_equals_the_numpy_one():
         for got, ref in zip(compiled, reference):
             assert np.all(np.abs(got - ref) <= 1e-11 * np.abs(ref).max())
         assert np.all(compiled[0][~healthy] == 0.0)
+    assert calls.count("fixed_frame") == 2 and calls.count("rate_law") == 2  # only in "always"
+    with jl.compiled_kernels("always"):  # a mask and a velocity of one run, broadcast as numpy does
+        one = law(frame.jac, healthy[:, :1], xdot[:, :1], kappa, axes=frame.axes)
+    np.testing.assert_allclose(one[0], law(frame.jac, healthy[:, :1], xdot[:, :1], kappa, axes=frame.axes)[0],
+                               rtol=0, atol=1e-11 * np.abs(one[0]).max())  # fmt: skip
 
 
-def test_a_jump_in_either_mode_gives_the_same_numbers():
+def test_a_jump_in_either_mode_gives_the_same_numbers(monkeypatch):
     """001's jump at one failure time with the optimal kappa (the search, then the runs), in
     the compiled mode "always" and in numpy: the same kappa, interval and jumps to round-off."""
     import math
@@ -202,9 +219,12 @@ def test_a_jump_in_either_mode_gives_the_same_numbers():
     arm = jl.load_robot("canadarm7")
     task = JumpScenario(duration=2.0, blend=0.5, dx=(0.1, -0.12, 0.06), vmax=math.radians(10), amax=math.radians(10),
                         eps=0.01)  # fmt: skip
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
     reference = jump_at_time(arm, task, 1.0)
+    calls = _spy_jump_kernels(monkeypatch)
     with jl.compiled_kernels("always"):
         compiled = jump_at_time(arm, task, 1.0)
+    assert {"fixed_frame", "rate_law"} <= set(calls)
     assert reference.jump_after < 0.5 * reference.jump_before  # the compensation works here
     for name in ("kappa", "jump_before", "jump_after", "interval", "joint_jump_after"):
         assert np.allclose(getattr(compiled, name), getattr(reference, name), rtol=1e-9, atol=1e-15), name

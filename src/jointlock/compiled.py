@@ -20,8 +20,9 @@ takes ``compiled=True/False`` per call; with ``compiled=None`` (the default) it 
     the numpy references at every size (to compare, or where numba is unwelcome).
 
 The mode is set by the environment variable ``JOINTLOCK_COMPILED`` (``auto``, ``always`` or
-``never``; read on each use), or in the program by :func:`compiled_kernels` (a context manager)
-or :func:`set_compiled_mode`, which take precedence over the environment.
+``never``; read on each use), or in the program by :func:`set_compiled_mode` (for the whole
+process) or :func:`compiled_kernels` (a context manager, for the enclosed code in its thread),
+which take precedence over the environment, the block over the process's setting.
 
 The two paths give the same numbers to round-off (``tests/test_kernels*.py``), so a result that
 is a smooth function of its inputs (a Jacobian, a torque, the halt's ``k`` for a given halt
@@ -38,6 +39,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterator
 from contextlib import contextmanager
+from contextvars import ContextVar
 from typing import Literal
 
 from .errors import ConfigurationError
@@ -48,7 +50,9 @@ COMPILED_MODES: tuple[CompiledMode, ...] = ("auto", "always", "never")
 #: The environment variable that sets the mode.
 ENVIRONMENT_VARIABLE = "JOINTLOCK_COMPILED"
 
-_set_mode: CompiledMode | None = None  # set in the program; None: the environment's
+_set_mode: CompiledMode | None = None  # set_compiled_mode: the process's; None: the environment's
+#: compiled_kernels: the mode of the enclosed code, in this thread (or asyncio task) only
+_context_mode: ContextVar[CompiledMode | None] = ContextVar("jointlock_compiled_mode", default=None)
 
 
 def _checked(mode: object, where: str) -> CompiledMode:
@@ -58,7 +62,8 @@ def _checked(mode: object, where: str) -> CompiledMode:
 
 
 def compiled_mode() -> CompiledMode:
-    """The mode now: set in the program, else ``JOINTLOCK_COMPILED``, else ``"auto"``.
+    """The mode now: :func:`compiled_kernels`' around this code, else :func:`set_compiled_mode`'s,
+    else ``JOINTLOCK_COMPILED``, else ``"auto"``.
 
     Raises
     ------
@@ -69,14 +74,18 @@ def compiled_mode() -> CompiledMode:
 
 
 def chosen_compiled_mode() -> CompiledMode | None:
-    """The mode set in the program, else by ``JOINTLOCK_COMPILED``; None when neither chose
-    one (a caller with another default, such as a campaign's ``"always"``, applies its own).
+    """The mode chosen in the program (:func:`compiled_kernels`, :func:`set_compiled_mode`), else
+    by ``JOINTLOCK_COMPILED``; None when none chose one (a caller with another default, such as a
+    campaign's ``"always"``, applies its own).
 
     Raises
     ------
     ConfigurationError
         ``JOINTLOCK_COMPILED`` holds something else than a mode.
     """
+    mode = _context_mode.get()
+    if mode is not None:
+        return mode
     if _set_mode is not None:
         return _set_mode
     value = os.environ.get(ENVIRONMENT_VARIABLE, "").strip().lower()
@@ -84,8 +93,9 @@ def chosen_compiled_mode() -> CompiledMode | None:
 
 
 def set_compiled_mode(mode: CompiledMode | None) -> CompiledMode | None:
-    """Set the process's mode (None: follow ``JOINTLOCK_COMPILED`` again); returns the mode set
-    before (None if there was none)."""
+    """Set the process's mode, for every thread (None: follow ``JOINTLOCK_COMPILED`` again);
+    returns the mode set before (None if there was none).  A :func:`compiled_kernels` block
+    takes precedence inside it."""
     global _set_mode
     checked = None if mode is None else _checked(mode, "the compiled mode")
     before, _set_mode = _set_mode, checked
@@ -96,12 +106,14 @@ def set_compiled_mode(mode: CompiledMode | None) -> CompiledMode | None:
 def compiled_kernels(mode: CompiledMode = "always") -> Iterator[None]:
     """Run the enclosed code in ``mode`` (default ``"always"``), then restore the mode before.
 
-    The mode is the process's: threads running at the same time share it."""
-    before = set_compiled_mode(mode)
+    The mode holds for this thread (a :class:`contextvars.ContextVar`): code running at the same
+    time in other threads keeps its own mode, and blocks in several threads may end in any
+    order.  A thread started inside the block starts without it (its mode is the process's)."""
+    token = _context_mode.set(_checked(mode, "the compiled mode"))
     try:
         yield
     finally:
-        set_compiled_mode(before)
+        _context_mode.reset(token)
 
 
 def use_compiled(batch: int, threshold: int) -> bool:

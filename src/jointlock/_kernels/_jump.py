@@ -100,7 +100,7 @@ def rate_law(jac, axes, healthy, xdot, kappa, rtol, qdot, w, null, singular):
                 adj[r, c] = g[c1, r1] * g[c2, r2] - g[c1, r2] * g[c2, r1]
         det = g[0, 0] * adj[0, 0] + g[0, 1] * adj[1, 0] + g[0, 2] * adj[2, 0]
         trace3 = (g[0, 0] + g[1, 1] + g[2, 2]) / 3.0
-        if not det > rtol * trace3**3:
+        if not det > rtol * (trace3 * trace3 * trace3):  # as the numpy reference
             singular[b] = True
             continue
         singular[b] = False

@@ -25,6 +25,7 @@ from pathlib import Path
 from typing import Any
 
 from .._version import __version__
+from ..compiled import ENVIRONMENT_VARIABLE, CompiledMode, chosen_compiled_mode
 from ..errors import CampaignError
 from ..progress import Progress
 from ._cases import Case, CasePlan, plan_cases
@@ -219,7 +220,7 @@ def run_campaign(
     with exclusive(out), open_ledger(out, create=True) as ledger:
         previous = (ledger.meta("spec") or {}).get("source")
         other = previous if previous is not None and not _same_file(previous, spec.source) else None
-        _remember(ledger, spec, columns)
+        compiled = _remember(ledger, spec, columns)
         ledger.set_plan(plan.cases)
         finished = ledger.finished_keys(status="ok")
         if not retry_failed:
@@ -235,7 +236,9 @@ def run_campaign(
         else:
             engine = engine()
         try:
-            result = _coordinate(spec, plan, todo, columns, ledger, engine, out, batch_seconds, progress, own)
+            result = _coordinate(
+                spec, plan, todo, columns, ledger, engine, out, batch_seconds, progress, own, compiled
+            )
             return dataclasses.replace(result, other_campaign=other)
         finally:
             if own:
@@ -249,15 +252,34 @@ def _same_file(a: str, b: str) -> bool:
         return a == b
 
 
-def _remember(ledger: Ledger, spec: CampaignSpec, columns: Sequence[str]) -> None:
+def _remember(ledger: Ledger, spec: CampaignSpec, columns: Sequence[str]) -> CompiledMode:
     """Store the campaign in the ledger; when the columns changed, recompute the finished
-    cases' records from their stored results (nothing runs again)."""
+    cases' records from their stored results (nothing runs again).  Returns the compiled mode
+    its cases run in (:mod:`jointlock.compiled`): the one its finished cases ran in (``"auto"``
+    for cases run before the mode was recorded), else the environment's, else ``"always"``.
+
+    Raises
+    ------
+    CampaignError
+        The environment asks for another mode than the finished cases ran in (the campaign's
+        cases would not all be computed the same way).
+    """
     if ledger.meta("columns") not in (None, list(columns)):
         keys = ledger.finished_keys(status="ok")
         ledger.update_records({key: record(res, columns) for key, res in ledger.results(keys)})
-    ledger.set_meta(
-        spec=spec.to_dict(), columns=list(columns), jointlock=__version__, compiled=campaign_compiled_mode()
-    )
+    recorded = ledger.meta("compiled")
+    if recorded is None and ledger.finished_keys():
+        recorded = "auto"  # finished before the mode was recorded: numpy below the thresholds, as auto
+    chosen = chosen_compiled_mode()
+    if recorded is not None and chosen is not None and chosen != recorded:
+        raise CampaignError(
+            f"the finished cases of this campaign ran in the compiled mode {recorded!r}, and {ENVIRONMENT_VARIABLE} "
+            f"(or the program) asks for {chosen!r}: run it with {ENVIRONMENT_VARIABLE}={recorded}, so that every case "
+            "is computed the same way, or into a new output folder"
+        )
+    mode: CompiledMode = recorded or chosen or campaign_compiled_mode()
+    ledger.set_meta(spec=spec.to_dict(), columns=list(columns), jointlock=__version__, compiled=mode)
+    return mode
 
 
 @dataclass
@@ -289,8 +311,10 @@ class _Coordinator:
         run_id: int,
         batch_seconds: float,
         bar: Progress,
+        compiled: CompiledMode,
     ) -> None:
         self.spec, self.columns, self.ledger, self.engine = spec, tuple(columns), ledger, engine
+        self.compiled = compiled
         self.run_id, self.batch_seconds, self.bar = run_id, batch_seconds, bar
         self.by_key = {c.key: c for c in todo}
         self.queue: deque[Case] = deque(todo)
@@ -329,7 +353,9 @@ class _Coordinator:
                 batch = self.retry.popleft()
             else:
                 batch = _Batch([self.queue.popleft() for _ in range(min(self._batch_size(limit), len(self.queue)))])
-            future = self.engine.executor.submit(run_batch, make_task(self.spec, batch.cases, self.columns))
+            future = self.engine.executor.submit(
+                run_batch, make_task(self.spec, batch.cases, self.columns, compiled=self.compiled)
+            )
             self.in_flight[future] = batch
 
     # -- receiving ---------------------------------------------------------------------------
@@ -435,13 +461,14 @@ def _coordinate(
     batch_seconds: float,
     progress: bool,
     own_engine: bool,
+    compiled: CompiledMode,
 ) -> CampaignRun:
     done_before = len(plan) - len(todo)
     run_id = ledger.start_run(engine.description, engine.workers, len(plan), len(todo), spec.source, __version__)
     start = time.perf_counter()
     bar = Progress(len(plan), "cases", enabled=None if progress else False, unit="cases", initial=done_before,
                    log_every_s=LOG_EVERY_S)  # fmt: skip
-    loop = _Coordinator(spec, todo, columns, ledger, engine, run_id, batch_seconds, bar)
+    loop = _Coordinator(spec, todo, columns, ledger, engine, run_id, batch_seconds, bar, compiled)
     stop = Stop()
     with stop:
         try:

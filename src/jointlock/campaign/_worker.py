@@ -123,8 +123,11 @@ def decode_result(blob: bytes) -> dict[str, Any]:
     return json.loads(zlib.decompress(blob))
 
 
-def make_task(spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str]) -> BatchTask:
-    """The task of running ``cases`` of ``spec`` and recording ``columns``."""
+def make_task(
+    spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str], *, compiled: CompiledMode | None = None
+) -> BatchTask:
+    """The task of running ``cases`` of ``spec`` and recording ``columns``, in the compiled mode
+    ``compiled`` (default :func:`campaign_compiled_mode`)."""
     return BatchTask(
         scenario=spec.scenario,
         scenario_source=spec.scenario_source,
@@ -132,7 +135,7 @@ def make_task(spec: CampaignSpec, cases: Sequence[Case], columns: Sequence[str])
         campaign_seed=spec.seed,
         cases=tuple((c.key, case_overrides(spec, c.params), c.seed) for c in cases),
         columns=tuple(columns),
-        compiled=campaign_compiled_mode(),
+        compiled=campaign_compiled_mode() if compiled is None else compiled,
     )
 
 

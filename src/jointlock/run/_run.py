@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from ..compiled import compiled_kernels
+from ..compiled import compiled_kernels, compiled_mode
 from ..errors import JointlockError, ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, to_plain
 from ..jobs._common import JobResult
@@ -139,6 +139,7 @@ def run_scenario(
         require_mujoco()
     results: dict[str, JobResult] = {}
     mode = scenario.data.get("compiled")
+    compiled_mode()  # a bad JOINTLOCK_COMPILED is said now, in one line, not deep in a job
     with compiled_kernels(mode) if mode is not None else nullcontext():
         for job in scenario.jobs:
             try:
@@ -150,7 +151,8 @@ def run_scenario(
         from ..sim import replay_jobs
 
         try:
-            checks = dict(replay_jobs(results))
+            with compiled_kernels(mode) if mode is not None else nullcontext():
+                checks = dict(replay_jobs(results))
         except JointlockError as exc:
             raise _with_context(exc, f"{scenario.source}: check in MuJoCo") from exc
     return RunResult(scenario, results, versions(), checks)

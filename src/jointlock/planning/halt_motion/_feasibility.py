@@ -214,8 +214,13 @@ class _Limits:
             floor = max(float(np.minimum(a, b).max(initial=-np.inf)) for a, b in zip(*ends))
         if not np.isfinite(floor):
             return self
-        margin = 1e-6 * (1.0 + abs(floor))
-        keep = (high[0] >= floor - margin) | (high[1] >= floor - margin)
+        # far above the round-off of each term (that of base + k * shape and of the limit, over
+        # the scale); a NaN term is kept (the full scan's maximum is NaN then too)
+        finite = [np.where(np.isfinite(x), np.abs(x), 0.0) for x in (self._lo, self._hi)]
+        k_big = max(abs(k_lo), abs(k_hi))
+        terms = np.abs(self._base) + k_big * np.abs(self._shape) + np.maximum(*finite)
+        margin = 1e-6 * (1.0 + abs(floor)) + 64 * np.finfo(float).eps * terms / self._scale
+        keep = ~((high[0] < floor - margin) & (high[1] < floor - margin))
         return _Limits(terms=tuple(x[keep] for x in (self._base, self._shape, self._lo, self._hi, self._scale)))
 
     def relative_violation(self, k: FloatArray) -> FloatArray:
@@ -292,9 +297,11 @@ def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarr
     round-off, so each bound is widened by :data:`SCREEN_RTOL` of the terms it comes from, and
     check times where ``phi`` or its derivative vanishes (no bound on ``k``) are left out."""
     n = problem.n_check
-    picked = np.unique(np.r_[np.arange(0, n, SCREEN_STRIDE), n - 1]) / (n - 1)
+    picked = np.unique(np.r_[np.arange(0, n, SCREEN_STRIDE), n - 1])
     T = np.asarray(halt_times, dtype=float)[:, None, None]  # (m, 1, 1)
-    t = T * picked[None, :, None]  # (m, s, 1)
+    # the check times exactly as problem.times (np.linspace) makes them: i * (T / (n - 1)), the
+    # last one T itself
+    t = np.where(picked[None, :, None] == n - 1, T, picked[None, :, None] * (T / (n - 1)))  # (m, s, 1)
     q0, dq0, ddq0, qf = problem.q0, problem.dq0, problem.ddq0, problem.qf
     h = qf - q0
     # 000 eq. 27 with k = 0 (halt_coefficients), every T at once: (m, 1, n) each

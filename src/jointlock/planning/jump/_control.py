@@ -55,7 +55,7 @@ def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatAr
     adj = products[:9] - products[9:]  # (9, B), row-major adj[r, c]
     det = np.einsum("cb,cb->b", g[:3], adj[::3])  # along the first row of g
     trace3 = g[::4].sum(axis=0) / 3.0
-    singular = ~(det > SINGULAR_GRAM_RTOL * trace3**3)
+    singular = ~(det > SINGULAR_GRAM_RTOL * (trace3 * trace3 * trace3))  # as the compiled kernel
     inv_det = 1.0 / np.where(singular, 1.0, det)
     m = np.einsum("rsb,skb->rkb", adj.reshape(gram.shape), jac_h) * inv_det
     if singular.any():
@@ -184,8 +184,9 @@ def _compiled_law(
     n, B = jac.shape[1], jac.shape[2]
     qdot, w, null = np.empty((n, B)), np.empty(B), np.empty((n, B))
     singular = np.zeros(B, dtype=np.bool_)
-    healthy_c = np.ascontiguousarray(healthy, dtype=np.bool_)
-    jac_c, axes_c, xdot_c = _c(jac), _c(axes), _c(xdot)
+    # broadcast as numpy would (the kernel indexes every run's column; numba checks no bounds)
+    healthy_c = np.ascontiguousarray(np.broadcast_to(healthy, (n, B)), dtype=np.bool_)
+    jac_c, axes_c, xdot_c = _c(jac), _c(np.broadcast_to(axes, jac.shape)), _c(np.broadcast_to(xdot, (3, B)))
     kappa_c = np.array(np.broadcast_to(kappa, (B,)), dtype=float)  # a column of the schedules: strided
     _kernels.rate_law(jac_c, axes_c, healthy_c, xdot_c, kappa_c, SINGULAR_GRAM_RTOL, qdot, w, null, singular)
     if singular.any():

@@ -279,11 +279,12 @@ def jump_reduction(before: ArrayLike, after: ArrayLike) -> Any:
 
 
 def improved_share(before: ArrayLike, after: ArrayLike) -> float:
-    """Share of the failure times with a jump (above :data:`NO_JUMP_RAD_S`) whose jump the
-    compensation made smaller; NaN when none has a jump (see :func:`jump_reduction`)."""
+    """Share of the failure times with a jump (above :data:`NO_JUMP_RAD_S`, without or with
+    compensation) whose jump the compensation made smaller: a jump it made where there was
+    none counts as not improved.  NaN when no failure time has a jump either way."""
     b = np.atleast_1d(np.asarray(before, dtype=float))
     a = np.atleast_1d(np.asarray(after, dtype=float))
-    jump = b > NO_JUMP_RAD_S
+    jump = (b > NO_JUMP_RAD_S) | (a > NO_JUMP_RAD_S)
     return float(np.mean(a[jump] < b[jump])) if jump.any() else math.nan
 
 

@@ -41,10 +41,11 @@ class Verification:
     task_jump_replan_max
         Largest ``||J dqdot||`` with re-planning [m/s] (round-off when ``J_r`` keeps full rank).
     mean_reduction
-        ``1 - mean(after) / mean(before)``; NaN (undefined) when every ``before`` is 0
-        (:func:`jump_reduction`).
+        ``1 - mean(after) / mean(before)``; NaN (undefined) when ``mean(before)`` is at most
+        :data:`~jointlock.planning.jump.NO_JUMP_RAD_S`, round-off (:func:`jump_reduction`).
     share_improved
-        Fraction of failure steps with ``after < before``.
+        Fraction of the failure steps with a jump (either way) where ``after < before``; NaN
+        when none has one (:func:`improved_share`).
     limits
         Limits over the no-failure run and every run with a failure, with the schedule.
     healthy_ok
