@@ -185,8 +185,11 @@ def _compiled_law(
     qdot, w, null = np.empty((n, B)), np.empty(B), np.empty((n, B))
     singular = np.zeros(B, dtype=np.bool_)
     # broadcast as numpy would (the kernel indexes every run's column; numba checks no bounds)
-    healthy_c = np.ascontiguousarray(np.broadcast_to(healthy, (n, B)), dtype=np.bool_)
-    jac_c, axes_c, xdot_c = _c(jac), _c(np.broadcast_to(axes, jac.shape)), _c(np.broadcast_to(xdot, (3, B)))
+    healthy_c = np.ascontiguousarray(healthy if healthy.shape == (n, B) else np.broadcast_to(healthy, (n, B)),
+                                     dtype=np.bool_)  # fmt: skip
+    jac_c = _c(jac)
+    axes_c = _c(axes if axes.shape == jac.shape else np.broadcast_to(axes, jac.shape))
+    xdot_c = _c(xdot if xdot.shape == (3, B) else np.broadcast_to(xdot, (3, B)))
     kappa_c = np.array(np.broadcast_to(kappa, (B,)), dtype=float)  # a column of the schedules: strided
     _kernels.rate_law(jac_c, axes_c, healthy_c, xdot_c, kappa_c, SINGULAR_GRAM_RTOL, qdot, w, null, singular)
     if singular.any():
