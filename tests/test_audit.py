@@ -83,6 +83,29 @@ def test_a_cell_is_the_standalone_run_with_its_seed(audited):
     for key in ("k", "global_torque_Nm", "minimum_T_s", "q_final_deg", "dq_initial_deg_s"):
         assert recorded["halt"][key] == pytest.approx(mine[key], rel=1e-12, abs=1e-12), key
     assert recorded["halt"]["state_source"] == f"task at t = {row['params']['failure.time_s']:g} s"
+    assert recorded["halt"]["task_completion"] == mine["task_completion"] is not None
+
+
+def test_a_cell_says_whether_the_task_could_be_finished_instead(audited):
+    """Each cell records jl.task_completion of the scenario's task with the cell's joint locked
+    at its instant: whether every remaining waypoint is reachable, and the first that is not."""
+    from jointlock.scenario._task import scenario_task
+
+    scenario, out, _ = audited
+    sc = jl.load_scenario(scenario)
+    task, arm = scenario_task(sc.data), jl.load_robot("puma6")
+    with open_ledger(out) as ledger:
+        rows = [r for r in ledger.rows() if r["status"] == "ok"]
+    assert rows
+    for row in rows:
+        joint, t = row["params"]["failure.joint"], row["params"]["failure.time_s"]
+        expected = jl.task_completion(arm, task, joint, t)
+        assert row["record"]["halt.task_completion.completable"] == expected.completable
+        assert row["record"]["halt.task_completion.first_unreachable_s"] == expected.first_unreachable_s
+    # joint 3 locked at t = 0 misses the next waypoint; at the last one nothing is left to miss
+    cells = {(r["params"]["failure.joint"], r["params"]["failure.time_s"]): r["record"] for r in rows}
+    assert cells[3, 0.0]["halt.task_completion.first_unreachable_s"] == 3.0
+    assert cells[3, 6.0]["halt.task_completion.completable"] is True
 
 
 def test_audit_windows_on_hand_made_cells():

@@ -37,7 +37,8 @@ __all__ = ["AUDIT_COLUMNS", "DEFAULT_AUDIT_TIMES", "AuditResult", "AuditWindows"
 #: Instants of the task audited by default (evenly spaced, both ends included).
 DEFAULT_AUDIT_TIMES = 11
 
-#: What each cell records: the halt's verdicts and figures (the halt job's result paths).
+#: What each cell records: the halt's verdicts and figures, and whether the rest of the task
+#: could be finished with the joint locked instead (the halt job's result paths).
 AUDIT_COLUMNS = (
     "halt.feasible",
     "halt.collision_free",
@@ -52,6 +53,8 @@ AUDIT_COLUMNS = (
     "halt.actuators.peak_brake_torque_Nm|max",
     "halt.sigma_min_at_failure",
     "halt.clearance.motion_min_m",
+    "halt.task_completion.completable",
+    "halt.task_completion.first_unreachable_s",
     "halt.state_source",
 )
 

@@ -27,6 +27,7 @@ from ...io.files import (
 from ...kinematics import generalized_jacobian, jacobian
 from ...model import ArmModel
 from ...papers import p000
+from ...planning.completion import TaskCompletion
 from ...planning.halt_config import HaltConfiguration
 from ...planning.halt_motion import (
     K_UNIT_SCALE,
@@ -116,6 +117,10 @@ class HaltPlan(JobResult):
     wheels
         What the spacecraft's attitude control can absorb (:class:`~jointlock.analysis.
         attitude_control.WheelCapacity`); the halt's load on it is :meth:`attitude_control`.
+    task_completion
+        With the state at failure taken from a planned motion (a scenario's ``[task]``): could
+        the rest of the task be finished with the joint locked instead of halting
+        (:func:`jointlock.task_completion`; issue 28); None otherwise.
     """
 
     job: ClassVar[str] = "halt"
@@ -134,6 +139,7 @@ class HaltPlan(JobResult):
     notes: tuple[str, ...] = ()
     clearance_settings: ClearanceSettings = field(default_factory=ClearanceSettings)
     wheels: WheelCapacity = field(default_factory=WheelCapacity)
+    task_completion: TaskCompletion | None = field(default=None, repr=False)
 
     @property
     def problem(self) -> HaltProblem:
@@ -228,6 +234,7 @@ class HaltPlan(JobResult):
             else {**clear, "verdict": next(iter(self._collision_line()), None)},
             "attitude_control": self.attitude_control().to_dict(),
             "sigma_min_at_failure": self.sigma_min_at_failure(),
+            "task_completion": None if self.task_completion is None else self.task_completion.to_dict(),
             "torque_limit_Nm": _none_for_inf(self.limits.torque),
             "brake_limit_Nm": _none_for_inf(self.limits.brake),
             "torque_limit_source": list(self.limits.torque_source),
@@ -524,6 +531,8 @@ class HaltPlan(JobResult):
         )
         if self.attitude_control().within is not False:  # (over capacity: the first line says so)
             lines.append(self.attitude_control().verdict())
+        if self.task_completion is not None:
+            lines += self.task_completion.summary()
         if p.objective != "mean_torque" and res.objective_value is not None:
             unit = OBJECTIVES[p.objective]
             lines.append(

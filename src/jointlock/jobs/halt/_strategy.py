@@ -22,6 +22,7 @@ from ...errors import InfeasibleError, ModelError, ScenarioError
 from ...locking import lock_joints
 from ...model import ArmModel
 from ...papers import p000
+from ...planning.completion import TaskCompletion, task_completion
 from ...planning.ga import GASettings
 from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal_halt_configuration
 from ...planning.halt_motion import (
@@ -34,7 +35,7 @@ from ...planning.halt_motion import (
 )
 from ...progress import Progress
 from ...robots import UrdfChain, load_robot
-from ...scenario._task import task_given
+from ...scenario._task import scenario_task, task_given
 from .._common import JobResult, joint_vector_deg, locked_deg, locked_text, scenario_clearance, scenario_locks
 from ._checks import (
     LIBRARY_NAMES,
@@ -480,7 +481,7 @@ def halt_from_scenario(
     elif not t["paper_qf"] and "halt_config" in previous:
         qf = np.asarray(cast(Any, previous["halt_config"]).q_best, dtype=float)  # the typed result, in radians
         names["qf"] = "the halt_config job's optimal halt configuration"
-    return plan_halt(
+    plan = plan_halt(
         model,
         state,
         T=float(t["T"]),
@@ -509,3 +510,22 @@ def halt_from_scenario(
         state_source=state_source,
         _names=names,
     )
+    if from_task and not data["failure"].get("also_locked_deg"):
+        plan = replace(plan, task_completion=_task_completion(data, base))
+    return plan
+
+
+#: The remaining times of a sampled task (a CSV/NPZ trajectory) at which the halt job checks
+#: that the rest of the task is still reachable (an IK solve each, ~0.06 s on a 7-joint arm).
+COMPLETION_SAMPLES = 6
+
+
+def _task_completion(data: Mapping[str, Any], base: str) -> TaskCompletion:
+    """Whether the scenario's task could be finished with ``failure.joint`` locked from
+    ``failure.time_s`` on (:func:`jointlock.planning.completion.task_completion`): its remaining
+    waypoints, or :data:`COMPLETION_SAMPLES` times of a sampled task."""
+    task = scenario_task(dict(data))
+    assert task is not None  # from_task: the scenario has one
+    whole = halt_model(data["robot"], None, base, chain=UrdfChain.from_fields(data))
+    fail = data["failure"]
+    return task_completion(whole, task, int(fail["joint"]), float(fail["time_s"]), samples=COMPLETION_SAMPLES)
