@@ -61,6 +61,9 @@ def test_every_cell_runs_once_and_the_windows_are_read_back(audited):
     assert json.loads((out / "audit.json").read_text()) == result.windows.to_dict()
     page = (out / "report.html").read_text()
     assert "Audit: safe windows" in page and "risk timeline" in page
+    # the grid again, interactive: each cell's numbers on hover (plotly, inline: no network)
+    assert "every cell, interactive" in page and "Plotly.newPlot" in page
+    assert "joint 3 locks at t = 0 s" in page and "task could be finished instead" in page
     worst = sorted((out / "worst").glob("*.toml"))
     assert worst and jl.load_scenario(worst[0]).data["task"]["waypoints_deg"] is not None  # re-runs as it is
     again = run_audit(scenario, out, joints=[2, 3], times=3, engine=in_process())  # resumes: nothing left
@@ -119,6 +122,24 @@ def test_audit_windows_on_hand_made_cells():
     assert w.windows == ((0.0, 0.0), (2.0, 2.0), (4.0, 4.0))
     assert w.unsafe_joints[1] == (2,) and w.unsafe_joints[3] == (1,) and w.worst_joint[0] == 2
     assert audit_windows([cell(1, 0.0, feasible=False)]).summary()[0].startswith("NO SAFE WINDOW")
+
+
+def test_the_interactive_grid_colours_and_labels_each_cell():
+    from jointlock.campaign._report import audit_cell_figure
+
+    def cell(j, t, **extra):
+        return {"key": f"k{j}{t}", "status": "ok", "failure.joint": j, "failure.time_s": t, "halt.feasible": True,
+                "halt.collision_free": True, "halt.minimum_T_s": 7.25, **extra}  # fmt: skip
+
+    rows = [cell(1, 0.0), cell(2, 0.0, **{"halt.collision_free": False}),
+            {"key": "bad", "status": "error", "failure.joint": 3, "failure.time_s": 0.0}]  # fmt: skip
+    fig = audit_cell_figure(rows, {"bad": "InfeasibleError: the state at failure already breaks a limit"})
+    by_name = {trace["name"]: trace for trace in fig["data"]}
+    assert by_name["safe"]["y"] == [1] and by_name["no safe halt"]["y"] == [2] and by_name["no halt"]["y"] == [3]
+    assert "smallest feasible halt time [s]: 7.250" in by_name["safe"]["text"][0]
+    assert "clear of the bus and the arm: NO" in by_name["no safe halt"]["text"][0]
+    assert "already breaks a limit" in by_name["no halt"]["text"][0]
+    assert fig["frames"] == [] and fig["layout"]["yaxis"]["tickvals"] == [1, 2, 3]
 
 
 def test_bad_audits_are_one_line(tmp_path):

@@ -29,6 +29,7 @@ from ..io.files import read_toml_file
 from ..robots import UrdfChain, load_robot
 from ..scenario import load_scenario
 from ..scenario._task import scenario_task
+from ._columns import audit_cell_safe
 from ._read import campaign_from_dict
 from ._spec import CampaignSpec
 
@@ -210,7 +211,7 @@ def audit_windows(rows: Sequence[dict[str, Any]]) -> AuditWindows:
     safe, worst, unsafe = [], [], []
     for t in times:
         by_joint = cells[t]
-        bad = tuple(j for j in joints if not _cell_safe(by_joint.get(j)))
+        bad = tuple(j for j in joints if not audit_cell_safe(by_joint.get(j)))
         unsafe.append(bad)
         safe.append(not bad)
         worst.append(bad[0] if bad else _longest_halt(by_joint))
@@ -224,17 +225,6 @@ def audit_windows(rows: Sequence[dict[str, Any]]) -> AuditWindows:
             windows.append((start, end))
             start = None
     return AuditWindows(tuple(times), tuple(safe), tuple(worst), tuple(unsafe), tuple(windows), tuple(joints))
-
-
-def _cell_safe(row: dict[str, Any] | None) -> bool:
-    """A finished cell whose halt keeps the limits, the clearance and the wheels' capacity."""
-    return (
-        row is not None
-        and row.get("status") == "ok"
-        and row.get("halt.feasible") is True
-        and row.get("halt.collision_free") is not False
-        and row.get("halt.attitude_control.within") is not False
-    )
 
 
 def _longest_halt(by_joint: dict[int, dict[str, Any]]) -> int | None:

@@ -193,3 +193,15 @@ def check_columns(spec: CampaignSpec, plan: CasePlan) -> tuple[str, ...]:
                 f"{', '.join(plan.jobs)})"
             )
     return tuple(spec.columns)
+
+
+def audit_cell_safe(row: Mapping[str, Any] | None) -> bool:
+    """A finished audit cell whose halt keeps the limits, the clearance and the wheels' capacity
+    (a campaign table's row: ``status`` and the recorded columns)."""
+    return (
+        row is not None
+        and row.get("status") == "ok"
+        and row.get("halt.feasible") is True
+        and row.get("halt.collision_free") is not False
+        and row.get("halt.attitude_control.within") is not False
+    )

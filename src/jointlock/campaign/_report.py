@@ -144,7 +144,11 @@ class CampaignReport:
     def html(self, folder: Path | None = None) -> str:
         """The report page (links to the worst cases' files relative to ``folder``)."""
         s, t = self.status, self.table
-        sections: list[rp.Section | None] = [_audit_section(Path(s.out)), _overview(s, self.spec), _varied(self.spec)]
+        sections: list[rp.Section | None] = [
+            _audit_section(Path(s.out), t.rows, {f["key"]: f["error_message"] for f in s.failures}),
+            _overview(s, self.spec),
+            _varied(self.spec),
+        ]
         ok_rows = [r for r in t.rows if r["status"] == "ok"]
         numeric = [m for m in t.metrics if is_numeric([r.get(m) for r in ok_rows])]
         sections.append(_headline(ok_rows, numeric))
@@ -435,9 +439,12 @@ def write_campaign_report(out: str | Path, path: str | Path | None = None, **opt
     return campaign_report(out, **options).write(path)
 
 
-def _audit_section(out: Path) -> rp.Section | None:
+def _audit_section(
+    out: Path, table_rows: Sequence[dict[str, Any]] = (), messages: dict[str, str] | None = None
+) -> rp.Section | None:
     """An audit's answer first (``audit.json``, :func:`~jointlock.campaign.run_audit`): the safe
-    windows, and the risk timeline: each joint's lock at each instant, safe or not."""
+    windows, the risk timeline (each joint's lock at each instant, safe or not) and the same grid
+    interactive, each cell's numbers on hover (from the campaign table's ``table_rows``)."""
     path = out / "audit.json"
     if not path.is_file():
         return None
@@ -475,4 +482,80 @@ def _audit_section(out: Path) -> rp.Section | None:
         ax.set_title("risk timeline: red, the lock leaves no safe halt; shaded, the safe windows", fontsize=9)
         fig.tight_layout()
         sec.images.append(("risk timeline", figure_png(fig)))
+    cells = [r for r in table_rows if r.get("failure.joint") is not None and r.get("failure.time_s") is not None]
+    if cells:
+        sec.animations.append(
+            ("every cell, interactive: hover a square for its numbers (green safe, red not, grey no halt)",
+             audit_cell_figure(cells, messages))
+        )  # fmt: skip
     return sec
+
+
+#: What the interactive audit grid shows of a cell on hover: (column, label, format).
+AUDIT_HOVER = (
+    ("halt.feasible", "halt within the limits", "yes"),
+    ("halt.collision_free", "clear of the bus and the arm", "yes"),
+    ("halt.attitude_control.within", "within the wheels' capacity", "yes"),
+    ("halt.minimum_T_s", "smallest feasible halt time [s]", ".3f"),
+    ("halt.binding_limit", "binding limit", "s"),
+    ("halt.clearance.motion_min_m", "closest approach [m]", "+.3f"),
+    ("halt.spacecraft.attitude_change_deg", "free spacecraft turns [deg]", ".2f"),
+    ("halt.attitude_control.peak_torque_Nm", "wheels' peak torque [N m]", ".4g"),
+    ("halt.attitude_control.peak_momentum_Nms", "wheels' momentum [N m s]", ".4g"),
+    ("halt.actuators.peak_brake_torque_Nm|max", "brake's peak torque [N m]", ".4g"),
+    ("halt.sigma_min_at_failure", "sigma_min at the failure", ".3g"),
+    ("halt.task_completion.completable", "task could be finished instead", "yes"),
+    ("halt.task_completion.first_unreachable_s", "first pose out of reach at [s]", "g"),
+)
+
+
+def _hover_value(value: Any, fmt: str) -> str:
+    if value is None:
+        return "n/a"
+    if fmt == "yes":
+        return "yes" if value else "NO"
+    if fmt == "s":
+        return html.escape(str(value))
+    try:
+        return format(float(value), fmt)
+    except (TypeError, ValueError):
+        return html.escape(str(value))
+
+
+def audit_cell_figure(rows: Sequence[dict[str, Any]], messages: dict[str, str] | None = None) -> dict[str, Any]:
+    """A plotly figure of an audit's cells (campaign-table rows with ``failure.joint`` and
+    ``failure.time_s``): one square per cell at (instant, joint), green where the cell is safe
+    (:func:`~jointlock.campaign._columns.audit_cell_safe`), red where its halt is not, grey where
+    it has none (an infeasible or failed cell); hovering shows the cell's numbers, or the reason
+    it has none (``messages``: case key -> error message)."""
+    from ._columns import audit_cell_safe
+
+    groups: dict[str, dict[str, list[Any]]] = {}
+    for row in rows:
+        ok = row.get("status") == "ok"
+        kind = "safe" if audit_cell_safe(row) else ("no safe halt" if ok else "no halt")
+        lines = [f"<b>joint {row['failure.joint']} locks at t = {float(row['failure.time_s']):g} s</b>"]
+        if ok:
+            lines += [f"{label}: {_hover_value(row.get(col), fmt)}" for col, label, fmt in AUDIT_HOVER if col in row]
+        else:
+            message = str((messages or {}).get(row.get("key", ""), "") or row.get("status"))
+            lines.append(html.escape(message[:160]))
+        g = groups.setdefault(kind, {"x": [], "y": [], "text": []})
+        g["x"].append(float(row["failure.time_s"]))
+        g["y"].append(int(row["failure.joint"]))
+        g["text"].append("<br>".join(lines))
+    colours = {"safe": "#176f2c", "no safe halt": "#b00020", "no halt": "#8a8f98"}
+    data = [
+        {"type": "scatter", "mode": "markers", "name": kind, "x": g["x"], "y": g["y"], "text": g["text"],
+         "hoverinfo": "text", "marker": {"symbol": "square", "size": 18, "color": colours[kind]}}
+        for kind, g in groups.items()
+    ]  # fmt: skip
+    joints = sorted({int(r["failure.joint"]) for r in rows})
+    layout = {
+        "xaxis": {"title": {"text": "failure instant t [s]"}},
+        "yaxis": {"title": {"text": "locked joint"}, "tickvals": joints, "range": [min(joints) - 0.7, max(joints) + 0.7]},
+        "margin": {"l": 60, "r": 20, "t": 20, "b": 50},
+        "hovermode": "closest",
+        "legend": {"orientation": "h"},
+    }
+    return {"data": data, "layout": layout, "config": {"displaylogo": False, "responsive": True}, "frames": []}
