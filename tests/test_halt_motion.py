@@ -799,7 +799,7 @@ def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
             continue  # feasible: the least-violating k is not asked for
         checked += 1
         grid = np.linspace(-3e-4, 3e-4, 57)
-        limits = _Limits(p)
+        limits = _Limits.of(p)
         assert np.array_equal(limits.within(grid[0], grid[-1]).relative_violation(grid), relative_violation(p, grid))
         narrow = limits.within(grid[10], grid[12])
         assert narrow.count < limits.count / 20  # most limits cannot bind there

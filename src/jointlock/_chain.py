@@ -346,6 +346,8 @@ def kernel_input(x: FloatArray) -> FloatArray:
     """``x`` as every compiled kernel takes its arrays: C-contiguous, writable float64 (a copy
     only where it is not), so that numba compiles one specialisation per kernel, not one per
     memory layout (read-only, broadcast, Fortran-ordered or integer input)."""
+    if isinstance(x, np.ndarray) and x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable:
+        return x  # at once: the jump integrator passes its arrays once per control step
     return np.require(x, dtype=float, requirements=["C", "W"])
 
 

@@ -12,6 +12,7 @@ from numpy.typing import ArrayLike
 from ..._search1d import bisect_boundary
 from ...model import FloatArray
 from ._constants import LIMIT_RTOL, LimitKind
+from ._polynomial import k_shape
 from ._problem import HaltProblem
 
 
@@ -152,7 +153,7 @@ def least_violating_k(problem: HaltProblem) -> float:
     ends = per[np.isfinite(per)]
     span = max(float(np.abs(ends).max()) if ends.size else 0.0, 1e-12)
     grid = np.linspace(-2 * span, 2 * span, 801)
-    limits = _Limits(problem)
+    limits = _Limits.of(problem)
     stretches = [grid[i : i + SCAN_STRETCH] for i in range(0, grid.size, SCAN_STRETCH)]
     viol = np.concatenate([limits.within(g[0], g[-1]).relative_violation(g) for g in stretches])
     i = int(np.argmin(viol))
@@ -173,6 +174,7 @@ def least_violating_k(problem: HaltProblem) -> float:
 SCAN_STRETCH = 25
 
 
+@dataclass(frozen=True)
 class _Limits:
     """Every limit of a halt problem (kind, check time, joint) as the terms of
     :func:`relative_violation`, flat: ``traj = base + k * shape`` against ``[lo, hi]``, divided
@@ -185,50 +187,55 @@ class _Limits:
     excess is at least the largest of the sides' smaller end values, ``L``; a limit whose sides
     stay below ``L`` at both ends (less a margin far above round-off) is never the largest."""
 
-    def __init__(self, problem: HaltProblem | None = None, *, terms: tuple[FloatArray, ...] | None = None) -> None:
-        if terms is None:
-            assert problem is not None
-            t = problem.times(problem.n_check)
-            lo, hi = _limits(problem)
-            base = np.stack(problem.base_profile(t))  # (3, n_t, n)
-            shape = np.broadcast_to(np.stack(problem.k_shape(t))[..., None], base.shape)  # (3, n_t, n)
-            scale = np.maximum(np.abs(lo), np.abs(hi))
-            scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
-            full = np.broadcast_arrays(base, shape, lo[:, None, :], hi[:, None, :], scale)
-            terms = tuple(np.ascontiguousarray(x).reshape(-1) for x in full)
-        self._base, self._shape, self._lo, self._hi, self._scale = terms
+    base: FloatArray  # (L,) the k = 0 angle, rate or acceleration [rad, rad/s, rad/s^2]
+    shape: FloatArray  # (L,) its k-part phi, phi' or phi''
+    lo: FloatArray  # (L,) the limits
+    hi: FloatArray
+    scale: FloatArray  # (L,) what an excess is relative to
+
+    @classmethod
+    def of(cls, problem: HaltProblem) -> _Limits:
+        """Every limit of ``problem`` at every check time (3 x n_check x n)."""
+        t = problem.times(problem.n_check)
+        lo, hi = _limits(problem)
+        base = np.stack(problem.base_profile(t))  # (3, n_t, n)
+        shape = np.broadcast_to(np.stack(problem.k_shape(t))[..., None], base.shape)  # (3, n_t, n)
+        scale = np.maximum(np.abs(lo), np.abs(hi))
+        scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
+        full = np.broadcast_arrays(base, shape, lo[:, None, :], hi[:, None, :], scale)
+        return cls(*(np.ascontiguousarray(x).reshape(-1) for x in full))
 
     @property
     def count(self) -> int:
         """Limits held."""
-        return int(self._base.size)
+        return int(self.base.size)
 
     def within(self, k_lo: float, k_hi: float) -> _Limits:
         """The limits that can give the largest excess for some ``k`` in ``[k_lo, k_hi]``."""
         with np.errstate(invalid="ignore"):  # an infinite limit: -inf at both ends, never kept
             ends = []
             for k in (k_lo, k_hi):
-                traj = self._base + k * self._shape
-                ends.append(((traj - self._hi) / self._scale, (self._lo - traj) / self._scale))
+                traj = self.base + k * self.shape
+                ends.append(((traj - self.hi) / self.scale, (self.lo - traj) / self.scale))
             high = [np.maximum(a, b) for a, b in zip(*ends)]  # per side, its larger end value
             floor = max(float(np.minimum(a, b).max(initial=-np.inf)) for a, b in zip(*ends))
         if not np.isfinite(floor):
             return self
         # far above the round-off of each term (that of base + k * shape and of the limit, over
         # the scale); a NaN term is kept (the full scan's maximum is NaN then too)
-        finite = [np.where(np.isfinite(x), np.abs(x), 0.0) for x in (self._lo, self._hi)]
+        finite = [np.where(np.isfinite(x), np.abs(x), 0.0) for x in (self.lo, self.hi)]
         k_big = max(abs(k_lo), abs(k_hi))
-        terms = np.abs(self._base) + k_big * np.abs(self._shape) + np.maximum(*finite)
-        margin = 1e-6 * (1.0 + abs(floor)) + 64 * np.finfo(float).eps * terms / self._scale
+        terms = np.abs(self.base) + k_big * np.abs(self.shape) + np.maximum(*finite)
+        margin = 1e-6 * (1.0 + abs(floor)) + 64 * np.finfo(float).eps * terms / self.scale
         keep = ~((high[0] < floor - margin) & (high[1] < floor - margin))
-        return _Limits(terms=tuple(x[keep] for x in (self._base, self._shape, self._lo, self._hi, self._scale)))
+        return _Limits(*(x[keep] for x in (self.base, self.shape, self.lo, self.hi, self.scale)))
 
     def relative_violation(self, k: FloatArray) -> FloatArray:
         """(m,) the largest relative excess (0 when within every limit) for ``k`` (m,)."""
         if self.count == 0:
             return np.zeros(k.shape)
-        traj = self._base + k[:, None] * self._shape  # the operations of HaltProblem.trajectory
-        excess = np.maximum(traj - self._hi, self._lo - traj) / self._scale
+        traj = self.base + k[:, None] * self.shape  # the operations of HaltProblem.trajectory
+        excess = np.maximum(traj - self.hi, self.lo - traj) / self.scale
         return np.maximum(excess.max(axis=-1), 0.0)
 
 
@@ -313,8 +320,7 @@ def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarr
         (dq0, ddq0 * t, 3 * a3 * t**2, 4 * a4 * t**3, 5 * a5 * t**4),
         (ddq0, 6 * a3 * t, 12 * a4 * t**2, 20 * a5 * t**3),
     )
-    u = t - T
-    shapes = (t**3 * u**3, 3 * t**2 * u**2 * (t + u), 6 * t * u * (t**2 + 3 * t * u + u**2))  # k_shape
+    shapes = k_shape(t, T)  # phi and its derivatives, every T at once (T broadcasts)
     lo, hi = _limits(problem)
     k_lo = np.full(T.shape[0], -np.inf)
     k_hi = np.full(T.shape[0], np.inf)

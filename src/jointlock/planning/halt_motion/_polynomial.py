@@ -85,9 +85,10 @@ def polynomial_profile(coefficients: ArrayLike, t: ArrayLike) -> tuple[FloatArra
     return tuple(np.einsum("...jc,tc->...tj", c, p) for p in (powers, d1, d2))
 
 
-def k_shape(t: ArrayLike, T: float) -> tuple[FloatArray, FloatArray, FloatArray]:
+def k_shape(t: ArrayLike, T: float | FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
     """The ``k``-part of eq. 27, ``phi(t) = t^3 (t - T)^3``, and its first two derivatives,
-    each (n_t,) [s^6, s^5, s^4]."""
+    each (n_t,) [s^6, s^5, s^4] (or the broadcast shape of ``t`` and ``T``, several halt times
+    at once)."""
     t = np.asarray(t, dtype=float)
     u = t - T
     phi = t**3 * u**3

@@ -166,14 +166,6 @@ def _reference_law(
     return qdot, w, null
 
 
-def _c(x: FloatArray) -> FloatArray:
-    """``x`` as the kernels take it (C-contiguous, writable float64): :func:`jointlock._chain.kernel_input`
-    with a quick exit for the arrays the integrator already makes so (once per step, it counts)."""
-    if x.dtype == np.float64 and x.flags.c_contiguous and x.flags.writeable:
-        return x
-    return kernel_input(x)
-
-
 def _compiled_law(
     jac: FloatArray, healthy: np.ndarray, xdot: FloatArray, kappa: FloatArray, axes: FloatArray
 ) -> tuple[FloatArray, FloatArray, FloatArray]:
@@ -187,9 +179,9 @@ def _compiled_law(
     # broadcast as numpy would (the kernel indexes every run's column; numba checks no bounds)
     healthy_c = np.ascontiguousarray(healthy if healthy.shape == (n, B) else np.broadcast_to(healthy, (n, B)),
                                      dtype=np.bool_)  # fmt: skip
-    jac_c = _c(jac)
-    axes_c = _c(axes if axes.shape == jac.shape else np.broadcast_to(axes, jac.shape))
-    xdot_c = _c(xdot if xdot.shape == (3, B) else np.broadcast_to(xdot, (3, B)))
+    jac_c = kernel_input(jac)
+    axes_c = kernel_input(axes if axes.shape == jac.shape else np.broadcast_to(axes, jac.shape))
+    xdot_c = kernel_input(xdot if xdot.shape == (3, B) else np.broadcast_to(xdot, (3, B)))
     kappa_c = np.array(np.broadcast_to(kappa, (B,)), dtype=float)  # a column of the schedules: strided
     _kernels.rate_law(jac_c, axes_c, healthy_c, xdot_c, kappa_c, SINGULAR_GRAM_RTOL, qdot, w, null, singular)
     if singular.any():
