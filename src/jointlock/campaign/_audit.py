@@ -45,6 +45,7 @@ AUDIT_COLUMNS = (
     "halt.collision_free",
     "halt.attitude_control.within",
     "halt.minimum_T_s",
+    "halt.minimum_T_clear_s",
     "halt.global_torque_Nm",
     "halt.violations|len",
     "halt.binding_limit",

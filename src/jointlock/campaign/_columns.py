@@ -31,6 +31,7 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
         "halt.feasible",
         "halt.T_s",
         "halt.minimum_T_s",
+        "halt.minimum_T_clear_s",
         "halt.k",
         "halt.global_torque_k0_Nm",
         "halt.global_torque_Nm",
@@ -64,6 +65,7 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
 WORSE: dict[str, str] = {
     "halt.feasible": "lower",
     "halt.minimum_T_s": "higher",
+    "halt.minimum_T_clear_s": "higher",
     "halt.global_torque_Nm": "higher",
     "halt.global_torque_k0_Nm": "higher",
     "halt.reduction": "lower",

@@ -497,6 +497,7 @@ AUDIT_HOVER = (
     ("halt.collision_free", "clear of the bus and the arm", "yes"),
     ("halt.attitude_control.within", "within the wheels' capacity", "yes"),
     ("halt.minimum_T_s", "smallest feasible halt time [s]", ".3f"),
+    ("halt.minimum_T_clear_s", "... keeping the clearance too [s]", ".3f"),
     ("halt.binding_limit", "binding limit", "s"),
     ("halt.clearance.motion_min_m", "closest approach [m]", "+.3f"),
     ("halt.spacecraft.attitude_change_deg", "free spacecraft turns [deg]", ".2f"),

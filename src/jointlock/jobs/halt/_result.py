@@ -35,6 +35,7 @@ from ...planning.halt_motion import (
     HaltMotion,
     HaltProblem,
     base_torque_history,
+    clear_T_range,
     halt_objective,
     infeasibility_message,
 )
@@ -50,6 +51,7 @@ from ...plots.halt import (
     plot_spacecraft_response,
 )
 from ...plots.motion import ArmMotion
+from ...sweep import swept_clearance
 from .._common import AT_LIMIT, JobResult, locked_deg, locked_text
 from .._motions import halt_motions
 from ._inputs import JointLimits, limits_text
@@ -117,6 +119,11 @@ class HaltPlan(JobResult):
     wheels
         What the spacecraft's attitude control can absorb (:class:`~jointlock.analysis.
         attitude_control.WheelCapacity`); the halt's load on it is :meth:`attitude_control`.
+    minimum_T_clear
+        With the clearance required, when the smallest feasible halt time was computed
+        (``minimum_T``, or an infeasible halt): the smallest halt time [s] whose halt keeps the
+        clearance too (:func:`~jointlock.planning.halt_motion.minimum_clear_halt_time`); None
+        when none up to twice the longer of ``T`` and the limits' smallest does, or not computed (:attr:`clearance_checked_for_T`).
     task_completion
         With the state at failure taken from a planned motion (a scenario's ``[task]``): could
         the rest of the task be finished with the joint locked instead of halting
@@ -140,6 +147,7 @@ class HaltPlan(JobResult):
     clearance_settings: ClearanceSettings = field(default_factory=ClearanceSettings)
     wheels: WheelCapacity = field(default_factory=WheelCapacity)
     task_completion: TaskCompletion | None = field(default=None, repr=False)
+    minimum_T_clear: float | None = None
 
     @property
     def problem(self) -> HaltProblem:
@@ -154,10 +162,23 @@ class HaltPlan(JobResult):
     @property
     def collision_free(self) -> bool | None:
         """Whether the halt motion keeps the clearance required (0 m when only reported) on
-        every sample of the constraint grid; a pair already closer at the state at failure must
-        not come closer still.  None for a model without collision shapes."""
+        every sample of the constraint grid, and between its samples to within the tunnelling
+        tolerance (:func:`jointlock.sweep.swept_clearance`); a pair already closer at the state at
+        failure must not come closer still.  None for a model without collision shapes."""
         data = self._clearance_dict()
         return None if data is None else not data["collides"]
+
+    @property
+    def clearance_checked_for_T(self) -> bool:
+        """Whether :attr:`minimum_T_clear` was computed: the smallest feasible halt time was, the
+        clearance is required, the model has shapes and ``k`` is shared."""
+        res = self.motion
+        return (
+            res.minimum_T is not None
+            and self.clearance_settings.required
+            and not res.per_joint
+            and self.collision_free is not None
+        )
 
     @property
     def k_deg(self) -> Any:
@@ -210,6 +231,7 @@ class HaltPlan(JobResult):
             else [[a / scale, b / scale] for a, b in res.k_segments],
             **({"joint_k_intervals_deg": res.joint_intervals / scale} if res.per_joint else {}),
             "minimum_T_s": res.minimum_T,
+            "minimum_T_clear_s": self.minimum_T_clear,
             "q_initial_deg": np.degrees(p.q0),
             "dq_initial_deg_s": np.degrees(p.dq0),
             "ddq_initial_deg_s2": np.degrees(p.ddq0),
@@ -297,10 +319,16 @@ class HaltPlan(JobResult):
         d = motion.pair_distance  # (n_check, P)
         # a pair already closer than allowed at the failure may not come closer still
         allowed = np.where(motion.mounted_pairs, 0.0, self.clearance_settings.margin)
-        shortfall = np.minimum(allowed, d[0]) - d  # > 0: closer than allowed, and than at the start
+        floor = np.minimum(allowed, d[0])
+        shortfall = floor - d  # > 0: closer than allowed, and than at the start
+        between = swept_clearance(
+            self.problem.model, self.motion.trajectory, t, floor, keep_out=self.clearance_settings.keep_out,
+            sampled=(*self.motion.trajectory(t), d),
+        )  # fmt: skip
         collides = bool(np.any(shortfall > 0))
         at, pair = np.unravel_index(int(np.argmax(shortfall) if collides else np.argmin(d)), d.shape)
         start_pair = int(np.argmax(allowed - d[0]))
+        swept_pair = between.worst()
         return {
             "halt_configuration_m": float(motion.distance[-1]),
             "halt_configuration_pair": motion.pair_at((motion.distance.size - 1,)),
@@ -310,9 +338,16 @@ class HaltPlan(JobResult):
             "motion_min_m": float(d[at, pair]),
             "motion_min_pair": motion.names[pair],
             "motion_min_time_s": float(t[at]),
+            "between_samples_min_m": float(between.lower_bound[swept_pair]),
+            "between_samples_pair": motion.names[swept_pair],
+            "between_samples_time_s": float(between.lower_bound_time[swept_pair]),
+            "between_samples_clear": bool(between.shortfall <= 0),
+            "tunnelling_tolerance_m": between.tolerance,
+            "refined_samples": between.refined_samples,
             "required_m": self.clearance_settings.min_m,
-            "collides": collides,
-            "worst_shortfall_m": float(max(shortfall.max(), 0.0)),
+            "collides": collides or bool(between.shortfall > 0),
+            "collides_at_samples": collides,
+            "worst_shortfall_m": float(max(shortfall.max(), between.shortfall, 0.0)),
             "samples": int(motion.distance.size),
             "mounted_pairs": list(motion.mounted),
         }
@@ -336,12 +371,30 @@ class HaltPlan(JobResult):
                 f"check the state, or the collision geometry: {self.problem.model.name}'s is documented with its "
                 "factory); "
             )
-        if data["collides"]:
+        if data["collides_at_samples"]:
             text += f"the halt reaches {reach(data['motion_min_m'])} {data['motion_min_pair']} at t = {data['motion_min_time_s']:.3g} s"
+        elif data["collides"]:
+            text += (
+                f"between its samples the halt may reach {reach(data['between_samples_min_m'])} "
+                f"{data['between_samples_pair']} near t = {data['between_samples_time_s']:.3g} s (a bound on how far "
+                "the links can move between two samples)"
+            )
         else:
             text += "the halt comes no closer"
         text += f"; the halt configuration keeps {data['halt_configuration_m']:+.3f} m ({data['halt_configuration_pair']})"
         return [text]
+
+    def _minimum_T_clear_lines(self) -> list[str]:
+        if not self.clearance_checked_for_T:
+            return []
+        margin = self.clearance_settings.margin
+        if self.minimum_T_clear is None:
+            return [
+                f"  no halt time up to {clear_T_range(self.problem.T, cast(float, self.motion.minimum_T)):.3g} s keeps the "
+                f"clearance ({margin:g} m) as well "
+                "(for this halt configuration)"
+            ]
+        return [f"  keeping the clearance ({margin:g} m) as well: T = {self.minimum_T_clear:.3f} s"]
 
     def sigma_min_at_failure(self) -> float:
         """Smallest singular value of the locked arm's Jacobian at the state at failure (how
@@ -491,7 +544,7 @@ class HaltPlan(JobResult):
             )
         scale = K_UNIT_SCALE["deg/s^6"]
         if not res.feasible:
-            lines += ["", "INFEASIBLE: " + infeasibility_message(res)]
+            lines += ["", "INFEASIBLE: " + infeasibility_message(res)] + self._minimum_T_clear_lines()
         elif res.per_joint:  # one k per joint: each within its own joint's interval
             lines += ["", f"feasible k per joint [deg/s^6]; solver {res.solver}"]
             for num, (lo, hi), kj in zip(nums, res.joint_intervals / scale, np.asarray(res.k) / scale):
@@ -516,6 +569,7 @@ class HaltPlan(JobResult):
                 )
         if res.feasible and res.minimum_T is not None:
             lines.append(f"smallest halt time with a feasible k: T = {res.minimum_T:.3f} s")
+            lines += self._minimum_T_clear_lines()
         sc = self.spacecraft_response()
         if sc is not None:
             label = (

@@ -31,6 +31,7 @@ from ...planning.halt_motion import (
     MomentAbout,
     clear_k_segments,
     clearance_shortfall,
+    minimum_clear_halt_time,
     optimal_halt_motion,
 )
 from ...progress import Progress
@@ -268,7 +269,9 @@ def plan_halt(
     minimum_T
         Also find the smallest halt time with a feasible ``k`` when the halt is feasible
         (:func:`~jointlock.planning.halt_motion.minimum_halt_time`, for the same halt
-        configuration); an infeasible halt always reports it.
+        configuration); an infeasible halt always reports it.  With the clearance required, also
+        the smallest whose halt keeps it (:attr:`HaltPlan.minimum_T_clear`,
+        :func:`~jointlock.planning.halt_motion.minimum_clear_halt_time`).
     progress
         Show progress bars on stderr.
     margin
@@ -385,6 +388,9 @@ def plan_halt(
         bar.close()
     motion, clear_note = _keep_clear(motion, clearance, solve)
     notes += clear_note
+    minimum_T_clear = None
+    if motion.minimum_T is not None and _keeps_clearance_as_constraint(motion, clearance):
+        minimum_T_clear = minimum_clear_halt_time(problem, clearance.margin, clearance.keep_out, start=motion.minimum_T)
     return HaltPlan(
         motion=motion,
         limits=limits,
@@ -400,7 +406,14 @@ def plan_halt(
         notes=notes,
         clearance_settings=clearance,
         wheels=wheels if wheels is not None else WheelCapacity(),
+        minimum_T_clear=minimum_T_clear,
     )
+
+
+def _keeps_clearance_as_constraint(motion: HaltMotion, settings: ClearanceSettings) -> bool:
+    """Whether the halt keeps the clearance as a constraint: required, shapes to check, and a
+    shared ``k`` (the per-joint solver's halt is reported only)."""
+    return settings.required and not motion.per_joint and bool(collision_pairs(motion.problem.model, settings.keep_out).names)
 
 
 def _keep_clear(
@@ -417,7 +430,7 @@ def _keep_clear(
     if not settings.required or not motion.feasible or not collision_pairs(problem.model, settings.keep_out).names:
         return motion, ()
     margin, keep_out = settings.margin, settings.keep_out
-    if motion.per_joint:
+    if not _keeps_clearance_as_constraint(motion, settings):
         return motion, (
             "solver 'vector' (one k per joint) does not keep the clearance, it reports it: solver 'scan' or 'ga' "
             "restricts the shared k to the halts that keep it",

@@ -47,7 +47,14 @@ from ._batch_feasibility import (
     _upper_envelope,
     feasible_k_interval_batch,
 )
-from ._clearance_limits import clear_k_segments, clearance_shortfall
+from ._clearance_limits import (
+    clear_k_exists,
+    clear_k_segments,
+    clear_T_range,
+    clearance_shortfall,
+    halt_swept_clearance,
+    minimum_clear_halt_time,
+)
 from ._constants import (
     CHUNK_SAMPLES,
     K_UNIT_SCALE,
@@ -94,16 +101,20 @@ __all__ = [
     "Solver",
     "Violation",
     "base_torque_history",
+    "clear_T_range",
+    "clear_k_exists",
     "clear_k_segments",
     "clearance_shortfall",
     "constraint_violations",
     "feasible_k_interval_batch",
     "feasible_k_intervals",
     "global_base_torque",
+    "halt_swept_clearance",
     "halt_coefficients",
     "infeasibility_message",
     "k_shape",
     "least_violating_k",
+    "minimum_clear_halt_time",
     "minimum_halt_time",
     "optimal_halt_motion",
     "polynomial_profile",

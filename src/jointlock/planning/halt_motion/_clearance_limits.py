@@ -7,6 +7,11 @@ the halt polynomial starts there) may not come closer still: its floor is its di
 ``t = 0``.  Like the torques, the clearance is not affine in ``k``, so its feasible set may be
 several stretches: a scan of ``n_scan`` values, each feasible/infeasible boundary bisected to
 :data:`BOUNDARY_RTOL` of the width (:func:`jointlock._search1d.bisect_boundary`).
+
+Between the samples of the grid a halt is held to the same floor by a certified bound
+(:func:`jointlock.sweep.swept_clearance`): it may come closer than its samples show by at most
+:data:`~jointlock.sweep.TUNNEL_TOLERANCE_M`, so that no link passes through another, or through
+the bus, unseen.
 """
 
 from __future__ import annotations
@@ -15,32 +20,53 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from ..._search1d import true_segments
+from ..._search1d import bisect_boundary, true_segments
 from ...collision import clearance
 from ...model import FloatArray
 from ...shapes import Shape
+from ...sweep import SweptClearance, swept_clearance
+from ._actuator_limits import torque_violations
 from ._constants import CHUNK_SAMPLES
+from ._feasibility import shared_k_interval
 from ._problem import HaltProblem
 
 #: Relative width of the refined boundaries of the clear set of ``k`` [-].
 BOUNDARY_RTOL = 1e-9
 #: Scan points of ``k`` for the clearance (each a whole motion on the constraint grid).
 CLEARANCE_SCAN = 41
-#: :func:`keeps_clearance` looks at every this many check times first.
+#: :func:`keeps_clearance` looks at every this many check times first,
 SCREEN_STRIDE = 16
+#: and at this many first check times: a halt from a state whose pair is at its floor and
+#: closing in breaks it on the first samples, whatever ``k`` and ``T``.
+SCREEN_HEAD = 4
+#: The screen's levels, coarse to fine: the first :data:`SCREEN_HEAD` check times (0), then
+#: every 128th, then every :data:`SCREEN_STRIDE`-th.
+SCREEN_LEVELS = (0, 128, SCREEN_STRIDE)
 
 
 def clearance_shortfall(
     problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = ()
 ) -> FloatArray:
     """(...) the largest amount [m] by which a halt at ``k`` (...) [rad/s^6] comes closer than
-    allowed on the constraint grid (for each pair the smaller of its allowance, ``margin`` or 0
-    for a mounted pair, and its distance at ``t = 0``); <= 0: clear."""
+    allowed (for each pair the smaller of its allowance, ``margin`` or 0 for a mounted pair, and
+    its distance at ``t = 0``): on the constraint grid, or between its samples by more than the
+    tunnelling tolerance (:func:`halt_swept_clearance`); <= 0: clear."""
     k = np.asarray(k, dtype=float)
-    flat = k.reshape(-1)
-    t = problem.times(problem.n_check)
     floor = _floor(problem, margin, keep_out)
-    return _shortfall_at(problem, flat, t, floor, keep_out).reshape(k.shape)
+    out = [halt_swept_clearance(problem, float(x), floor, keep_out).shortfall for x in k.reshape(-1)]
+    return np.array(out).reshape(k.shape)
+
+
+def halt_swept_clearance(
+    problem: HaltProblem, k: float, floor: FloatArray, keep_out: Sequence[Shape] = ()
+) -> SweptClearance:
+    """The clearance of the halt at a shared ``k`` [rad/s^6] on the constraint grid and between
+    its samples (:func:`jointlock.sweep.swept_clearance`), each pair held to ``floor`` (P,) [m]."""
+
+    def motion(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
+        return problem.trajectory(k, t)
+
+    return swept_clearance(problem.model, motion, problem.times(problem.n_check), floor, keep_out=keep_out)
 
 
 def _floor(problem: HaltProblem, margin: float, keep_out: Sequence[Shape]) -> FloatArray:
@@ -62,24 +88,63 @@ def _shortfall_at(
     return out
 
 
-def keeps_clearance(problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = ()) -> np.ndarray:
+def keeps_clearance(
+    problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = (), *, any_one: bool = False
+) -> np.ndarray:
     """(K,) bool: whether the halt at each ``k`` (K,) [rad/s^6] keeps the clearance on the whole
-    constraint grid (``clearance_shortfall(...) <= 0``, the same answer).
+    constraint grid and between its samples (``clearance_shortfall(...) <= 0``, the same answer).
 
-    Every :data:`SCREEN_STRIDE`-th check time is looked at first: a halt that comes too close
-    there does not keep it (most of a scan's colliding halts are caught so, at a fraction of the
-    cost); only the others are checked at the remaining times.  A configuration's distances do
-    not depend on the batch it is computed in, so the answer is that of the whole grid."""
+    The first :data:`SCREEN_HEAD` check times, then every 128th, then every
+    :data:`SCREEN_STRIDE`-th are looked at first (:data:`SCREEN_LEVELS`): a halt that comes too
+    close there does not keep it (most of a scan's colliding halts are caught so, at a fraction
+    of the cost); only the others are checked on the rest of the grid, and those clear there
+    between its samples.  A configuration's distances do not depend on the batch it is computed
+    in, so the answer is that of the whole grid.
+
+    ``any_one``: only whether one of them keeps it is asked.  The others are checked one at a
+    time, the clearest on the screen first, up to the first that keeps it (True); the rest are
+    left False."""
     k = np.asarray(k, dtype=float).reshape(-1)
     t = problem.times(problem.n_check)
     floor = _floor(problem, margin, keep_out)
-    screened = np.zeros(t.size, dtype=bool)
-    screened[:: SCREEN_STRIDE] = True
-    screened[-1] = True
-    ok = _shortfall_at(problem, k, t[screened], floor, keep_out) <= 0.0
+    # coarse to fine: a pair closing in on its floor at the failure is caught on the first
+    # samples, a halt sweeping through the bus on a few samples; each level looks only at the
+    # halts still clear and at times not looked at yet
+    screen = np.full(k.size, -np.inf)
+    seen = np.zeros(t.size, dtype=bool)
+    seen[0] = True  # the floor is the distance at t = 0 where that is smaller
+    for stride in SCREEN_LEVELS:
+        level = np.zeros(t.size, dtype=bool)
+        if stride:
+            level[::stride] = True
+            level[-1] = True
+        else:
+            level[:SCREEN_HEAD] = True
+        level &= ~seen
+        alive = screen <= 0.0
+        if alive.any() and level.any():
+            screen[alive] = np.maximum(screen[alive], _shortfall_at(problem, k[alive], t[level], floor, keep_out))
+        seen |= level
+    screened = seen
+    ok = screen <= 0.0
+    if any_one:
+        found = np.zeros_like(ok)
+        for i in np.flatnonzero(ok)[np.argsort(screen[ok], kind="stable")]:
+            if _shortfall_at(problem, k[i : i + 1], t[~screened], floor, keep_out)[0] <= 0.0 and _clear_between(
+                problem, float(k[i]), floor, keep_out
+            ):
+                found[i] = True
+                break
+        return found
     if ok.any():
         ok[ok] = _shortfall_at(problem, k[ok], t[~screened], floor, keep_out) <= 0.0
+    for i in np.flatnonzero(ok):  # clear on every sample: between the samples too?
+        ok[i] = _clear_between(problem, float(k[i]), floor, keep_out)
     return ok
+
+
+def _clear_between(problem: HaltProblem, k: float, floor: FloatArray, keep_out: Sequence[Shape]) -> bool:
+    return bool(halt_swept_clearance(problem, k, floor, keep_out).shortfall <= 0.0)
 
 
 def clear_k_segments(
@@ -97,3 +162,67 @@ def clear_k_segments(
         return keeps_clearance(problem, x, margin, keep_out).reshape(np.shape(x))
 
     return true_segments(clear, lo, hi, n_scan, BOUNDARY_RTOL)
+
+
+def clear_k_exists(
+    problem: HaltProblem, margin: float, keep_out: Sequence[Shape] = (), n_scan: int = CLEARANCE_SCAN
+) -> bool:
+    """Whether a shared ``k`` among the ``n_scan`` points of the feasible interval that
+    :func:`clear_k_segments` scans gives a halt keeping every limit (the motor and brake torques
+    too) and the clearance: the stretches the halt job can choose from are not empty."""
+    lo, hi = shared_k_interval(problem)
+    if not lo <= hi:
+        return False
+    grid = np.linspace(lo, hi, max(n_scan, 2)) if hi > lo else np.array([lo])
+    if problem.has_torque_limits:
+        grid = np.array([k for k in grid if not torque_violations(problem, float(k))])
+    return bool(grid.size) and bool(keeps_clearance(problem, grid, margin, keep_out, any_one=True).any())
+
+
+#: Growth of the halt time per step of :func:`minimum_clear_halt_time` [-].
+CLEAR_T_GROWTH = 1.1
+#: Width to which :func:`minimum_clear_halt_time` refines its bracket [s].
+CLEAR_T_TOL = 1e-2
+#: :func:`minimum_clear_halt_time` looks up to this many times the longer of the halt time
+#: asked and the limits' smallest one.
+CLEAR_T_SPAN = 2.0
+
+
+def clear_T_range(T: float, start: float) -> float:
+    """The longest halt time [s] :func:`minimum_clear_halt_time` tries, for the halt time ``T``
+    asked and the limits' smallest ``start`` [s]."""
+    return CLEAR_T_SPAN * max(T, start)
+
+
+def minimum_clear_halt_time(
+    problem: HaltProblem, margin: float, keep_out: Sequence[Shape] = (), *, start: float | None
+) -> float | None:
+    """Smallest halt time [s] whose halt keeps every limit and the clearance (a shared ``k`` of
+    :func:`clear_k_exists`): from ``start`` (the limits' smallest ``T``: none, None), ``T`` grows
+    by :data:`CLEAR_T_GROWTH` per step up to :func:`clear_T_range`, then the first bracket
+    without and with such a ``k`` is bisected to :data:`CLEAR_T_TOL`.  None when no halt time in
+    that range has one.
+
+    The clearance need not improve with ``T`` (a longer halt carries the arm further along its
+    rate at failure first), so this is the first such ``T`` on that grid, not a proven minimum;
+    and the range is shorter than the limits' (``max(10 T, 120 s)``): most halts that collide
+    start closing in on the bus at the failure, whatever ``T``, and each step is a scan of ``k``
+    with the clearance."""
+    if start is None:
+        return None
+    t_max = clear_T_range(problem.T, start)
+
+    def ok(T: float) -> bool:
+        return clear_k_exists(problem.with_time(T), margin, keep_out)
+
+    t, prev = float(start), None
+    while t <= t_max:
+        if ok(t):
+            if prev is None:
+                return t
+            found = bisect_boundary(
+                lambda x: np.array([ok(float(v)) for v in np.ravel(x)]).reshape(np.shape(x)), prev, t, xtol=CLEAR_T_TOL
+            )
+            return float(found.true_end)
+        prev, t = t, t * CLEAR_T_GROWTH
+    return None
