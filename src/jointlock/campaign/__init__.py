@@ -46,7 +46,15 @@ Modules (private; import from ``jointlock.campaign``): ``_spec`` (the validated 
 
 from __future__ import annotations
 
-from ._audit import AUDIT_COLUMNS, AuditResult, AuditWindows, audit_campaign, audit_windows, run_audit
+from ._audit import (
+    AUDIT_COLUMNS,
+    AUDIT_JUMP_COLUMNS,
+    AuditResult,
+    AuditWindows,
+    audit_campaign,
+    audit_windows,
+    run_audit,
+)
 from ._cases import Case, CasePlan, case_key, case_seed, expand, plan_cases, resolve_case
 from ._columns import DEFAULT_COLUMNS, column_value, default_columns
 from ._engines import Engine, InProcessExecutor, dask_cluster, default_workers, in_process, process_pool
@@ -69,6 +77,7 @@ from ._worker import BatchTask, CaseOutcome, make_task, run_batch
 
 __all__ = [
     "AUDIT_COLUMNS",
+    "AUDIT_JUMP_COLUMNS",
     "AuditResult",
     "AuditWindows",
     "audit_campaign",

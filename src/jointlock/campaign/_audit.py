@@ -33,7 +33,7 @@ from ._columns import audit_cell_safe
 from ._read import campaign_from_dict
 from ._spec import CampaignSpec
 
-__all__ = ["AUDIT_COLUMNS", "DEFAULT_AUDIT_TIMES", "AuditResult", "AuditWindows", "audit_campaign", "audit_windows", "run_audit"]
+__all__ = ["AUDIT_COLUMNS", "AUDIT_JUMP_COLUMNS", "DEFAULT_AUDIT_TIMES", "AuditResult", "AuditWindows", "audit_campaign", "audit_windows", "run_audit"]
 
 #: Instants of the task audited by default (evenly spaced, both ends included).
 DEFAULT_AUDIT_TIMES = 11
@@ -58,6 +58,17 @@ AUDIT_COLUMNS = (
     "halt.task_completion.completable",
     "halt.task_completion.first_unreachable_s",
     "halt.state_source",
+)
+
+#: What each cell records besides, when the scenario runs the jump study of a Cartesian task
+#: (001: the joint-rate jump at the lock without and with the compensation, whether it keeps the
+#: limits); the cells then leave out the task's last instant.
+AUDIT_JUMP_COLUMNS = (
+    "jump.kappa",
+    "jump.jump_before",
+    "jump.jump_after",
+    "jump.mean_reduction",
+    "jump.limits_ok",
 )
 
 
@@ -113,11 +124,19 @@ def audit_campaign(
             f"audit: joints must be distinct joint numbers 1..{dof}; got {chosen}" + (f" (not joints: {bad})" if bad else "")
         )
     instants = [round(task.start + v, 9) for v in _instants(task.duration, times, dt)]
+    columns = list(AUDIT_COLUMNS)
+    fixed: dict[str, Any] = {}
+    if "jump" in base.jobs:
+        # a lock at the task's very end leaves no motion for the jump study to follow
+        instants = [t for t in instants if t < task.end] or instants[:1]
+        columns += AUDIT_JUMP_COLUMNS
+        fixed["jump.on_infeasible"] = "report"  # no kappa is the jump's answer; the halt keeps its own
     data: dict[str, Any] = {
         "title": f"audit: {base.data.get('title') or path.stem}",
         "scenario": str(path.resolve()),
         "seed": seed,
-        "columns": list(AUDIT_COLUMNS),
+        "columns": columns,
+        **({"set": fixed} if fixed else {}),
         "grid": {"failure.joint": chosen, "failure.time_s": instants},
         # the worst cells: by ``worst``, else the report's first column with a value (the smallest
         # feasible halt time when some cell has one)

@@ -507,6 +507,9 @@ AUDIT_HOVER = (
     ("halt.sigma_min_at_failure", "sigma_min at the failure", ".3g"),
     ("halt.task_completion.completable", "task could be finished instead", "yes"),
     ("halt.task_completion.first_unreachable_s", "first pose out of reach at [s]", "g"),
+    ("jump.jump_before", "joint-rate jump, uncompensated [rad/s]", ".4g"),
+    ("jump.jump_after", "joint-rate jump, compensated [rad/s]", ".4g"),
+    ("jump.limits_ok", "jump study keeps the limits", "yes"),
 )
 
 

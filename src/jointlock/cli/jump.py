@@ -13,6 +13,7 @@ stderr as ignored.
 from __future__ import annotations
 
 import argparse
+import sys
 import warnings
 from typing import TYPE_CHECKING, Any
 
@@ -131,10 +132,24 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="fix of kappa(t) verified as well (default auto: clip+ramp only when a limit breaks; "
         "sweep with the search only)",
     )
+    p.add_argument(
+        "--on-infeasible",
+        choices=("raise", "report"),
+        default="raise",
+        help="--fail-at without a kappa that keeps the limits: an error (raise, default), or the "
+        "uncompensated jump with the reason (report: what an audit's cell records)",
+    )
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.add_argument("--out", metavar="DIR", help="write results.json, CSV and figures (PNG) here")
     p.add_argument("--quiet", action="store_true", help="no progress bars")
     p.set_defaults(func=run)
+
+
+#: What ``--scenario FILE`` prints once (issue 28: 001's task is a kind of ``[task]`` now).
+TASK_FILE_NOTE = (
+    "note: this task can also be the [task] table of a `jointlock run` scenario (its q0_deg, dx_m, duration_s, ...), "
+    "which the halt, the audit and the jump study all follow (docs/audit.md)"
+)
 
 
 def _scenario(args: argparse.Namespace) -> JumpScenario:
@@ -214,6 +229,8 @@ def run(args: argparse.Namespace) -> int:
 
     out_dir = check_out_dir(args.out)
     sc = _scenario(args)
+    if args.scenario and not (args.quiet or args.json):
+        print(TASK_FILE_NOTE, file=sys.stderr)
     model = load_robot(args.robot, base=sc.base, chain=chain_from_args(args))
     _check_q0(args, sc, model)
     _warn_ignored(args)
@@ -227,6 +244,7 @@ def run(args: argparse.Namespace) -> int:
         fix={None: "auto", "none": None}.get(args.fix, args.fix),
         single=args.single,
         progress=not args.quiet,
+        on_infeasible=args.on_infeasible,
     )
     if out_dir is not None:
         result.write(out_dir)

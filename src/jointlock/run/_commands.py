@@ -139,6 +139,7 @@ def job_argv(
         # only the options the mode uses (the command warns about the others)
         if t["fail_at"] is not None:
             argv += ["--fail-at", _num(t["fail_at"])]
+            argv += ["--on-infeasible", t["on_infeasible"]] if t["on_infeasible"] != "raise" else []
         elif t["kappa"] is None:
             argv += ["--sweep", str(t["sweep"])]
         if t["kappa"] is not None:

@@ -247,6 +247,30 @@ SHARED_TABLES: dict[str, dict[str, Field]] = {
         "scaling": Field(
             "choice", "quintic", choices=("quintic", "trapezoidal"), help="time scaling of each waypoint segment"
         ),
+        "dx_m": Field(
+            "numbers",
+            None,
+            lo=-1e3,
+            hi=1e3,
+            length=3,
+            unit="m",
+            help="or a Cartesian task (001's): the end effector's straight-line displacement, followed by resolved "
+            "rates from task.q0_deg (the jump study's task, [jump]'s fields)",
+        ),
+        "q0_deg": _deg("Cartesian task: its start, every joint of the arm"),
+        "duration_s": _time("Cartesian task: its time (default 12)"),
+        "blend_s": _pos("s", "Cartesian task: parabolic blend time (default 2)", hi=MAX_TIME_S),
+        "dt_s": _time("Cartesian task: control step (default 0.05)", lo=MIN_STEP_S),
+        "kp": Field("number", None, lo=0.0, hi=MAX_GAIN, unit="1/s", help="Cartesian task: feedback gain (default 2)"),
+        "feedforward": Field(
+            "choice", None, choices=("step", "instant"), help="Cartesian task: feed-forward over a control step"
+        ),
+        "base": Field(
+            "choice",
+            None,
+            choices=("fixed", "floating"),
+            help="Cartesian task: base of its resolved rates (default jump.base, else the top-level base)",
+        ),
     },
     "spacecraft": {
         "wheel_torque_max_Nm": _pos(
@@ -366,6 +390,13 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
             help="constant kappa instead of the search",
         ),
         "order": Field("int", 5, lo=1, hi=9, help="polynomial order of kappa(t)"),
+        "on_infeasible": Field(
+            "choice",
+            "raise",
+            choices=("raise", "report"),
+            help="one failure time without a kappa that keeps the limits: an error (raise), or the "
+            "uncompensated jump with the reason (report: an audit's cells)",
+        ),
         "fix": Field(
             "choice",
             "auto",

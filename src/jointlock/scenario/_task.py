@@ -1,5 +1,12 @@
-"""The ``[task]`` table (issue 28): a planned joint motion, and the state at failure taken from
-it at ``[failure] time_s`` (the joint locks at the angle the task has it then)."""
+"""The ``[task]`` table (issue 28): a planned motion, and the state at failure taken from it at
+``[failure] time_s`` (the joint locks at the angle the task has it then).
+
+Three kinds: a joint trajectory file (``file``), waypoints with durations (``waypoints_deg``,
+``durations_s``), or 001's Cartesian task (``dx_m`` from ``q0_deg``, with ``duration_s``,
+``blend_s``, ``dt_s``, ``kp``, ``feedforward``, ``base``: the fields of a ``[jump]`` table), which
+the healthy arm follows by resolved rates (:func:`jointlock.planning.jump.cartesian_task`).  With a
+Cartesian task the jump study follows that task (its ``[jump]`` table then gives no task fields).
+"""
 
 from __future__ import annotations
 
@@ -19,10 +26,31 @@ from ..planning.task import Task, load_task_file
 ROUND_DEG = 9
 
 
+#: The fields of a Cartesian ``[task]`` (001's task: :class:`~jointlock.planning.jump.JumpScenario`'s).
+CARTESIAN_FIELDS = ("q0_deg", "dx_m", "duration_s", "blend_s", "dt_s", "kp", "feedforward")
+
+
 def task_given(out: Mapping[str, Any]) -> bool:
     """Whether the scenario has a planned motion."""
     t = out.get("task") or {}
-    return t.get("file") is not None or t.get("waypoints_deg") is not None
+    return t.get("file") is not None or t.get("waypoints_deg") is not None or t.get("dx_m") is not None
+
+
+def cartesian_given(out: Mapping[str, Any]) -> bool:
+    """Whether the scenario's task is 001's Cartesian task (``task.dx_m``)."""
+    return (out.get("task") or {}).get("dx_m") is not None
+
+
+def cartesian_base(out: Mapping[str, Any]) -> str:
+    """The base of a Cartesian task's resolved rates: ``task.base``, else ``jump.base``, else the
+    top-level base."""
+    return str((out.get("task") or {}).get("base") or (out.get("jump") or {}).get("base") or out["base"])
+
+
+def cartesian_fields(out: Mapping[str, Any]) -> dict[str, Any]:
+    """A Cartesian task's fields in :func:`jointlock.planning.jump.scenario_from_mapping` form."""
+    t = out["task"]
+    return {**{k: t[k] for k in CARTESIAN_FIELDS if t.get(k) is not None}, "base": cartesian_base(out)}
 
 
 def resolve_task_file(out: dict[str, Any], source: str, base_dir: Path) -> None:
@@ -42,6 +70,14 @@ def resolve_task_file(out: dict[str, Any], source: str, base_dir: Path) -> None:
 def scenario_task(out: dict[str, Any], source: str = "scenario") -> Task | None:
     """The :class:`~jointlock.planning.task.Task` of a resolved scenario, or None."""
     t = out.get("task") or {}
+    if t.get("dx_m") is not None:
+        return _cartesian_task(out, source)
+    cartesian_only = [k for k in (*CARTESIAN_FIELDS, "base") if t.get(k) is not None]
+    if cartesian_only:
+        raise ScenarioError(
+            f"{source}: task.{cartesian_only[0]} belongs to a Cartesian task: give task.dx_m (the straight line) "
+            "too, or leave it out"
+        )
     if t.get("file") is not None:
         if t.get("waypoints_deg") is not None or t.get("durations_s") is not None:
             raise ScenarioError(f"{source}: task.file and task.waypoints_deg exclude each other; give one")
@@ -55,6 +91,32 @@ def scenario_task(out: dict[str, Any], source: str = "scenario") -> Task | None:
     return Task.from_waypoints(t["waypoints_deg"], t["durations_s"], t["scaling"], source=f"{source}: [task]")
 
 
+def _cartesian_task(out: dict[str, Any], source: str) -> Task:
+    """001's Cartesian task of the scenario as a joint motion (the arm loaded with the task's base)."""
+    from ..errors import JointlockError
+    from ..planning.jump import cartesian_task, scenario_from_mapping
+    from ..robots import UrdfChain, load_robot
+
+    t = out["task"]
+    others = [k for k in ("file", "waypoints_deg", "durations_s") if t.get(k) is not None]
+    if others:
+        raise ScenarioError(f"{source}: task.dx_m (a Cartesian task) and task.{others[0]} exclude each other; give one")
+    if t.get("q0_deg") is None:
+        raise ScenarioError(f"{source}: task.dx_m needs task.q0_deg (where the task starts, every joint of the arm)")
+    try:
+        task = scenario_from_mapping(cartesian_fields(out), source=f"{source}: [task]")
+        model = load_robot(out["robot"], base=task.base, chain=UrdfChain.from_fields(out))
+    except JointlockError as exc:
+        if str(exc).startswith(source):
+            raise
+        raise ScenarioError(f"{source}: [task]: {exc}") from None
+    if len(task.q0) != model.dof:
+        raise ScenarioError(
+            f"{source}: task.q0_deg needs {model.dof} values (every joint of {model.name}); got {len(task.q0)}"
+        )
+    return cartesian_task(model, task)
+
+
 def state_from_task(out: dict[str, Any], jobs: tuple[str, ...], source: str, model: Any) -> None:
     """With a ``[task]``: check it against the arm, and with ``failure.time_s`` fill the state at
     failure (the healthy joints' angles, rates and accelerations of the task then) and the locked
@@ -66,12 +128,14 @@ def state_from_task(out: dict[str, Any], jobs: tuple[str, ...], source: str, mod
     task.check(model)
     fail = out["failure"]
     time_s = fail["time_s"]
-    if "jump" in jobs:
+    if "jump" in jobs and not cartesian_given(out):
         raise ScenarioError(
-            f"{source}: [task] is a planned joint motion; the jump study follows its own Cartesian task ([jump]): "
-            "run them in separate scenarios"
+            f"{source}: [task] is a planned joint motion; the jump study follows a Cartesian task (task.dx_m, or its own "
+            "[jump]): run them in separate scenarios"
         )
     if time_s is None:
+        if cartesian_given(out) and set(jobs) <= {"jump"}:
+            return  # the jump study alone: it sweeps the failure times itself
         raise ScenarioError(
             f"{source}: [task] needs failure.time_s (the instant the joint locks, in [{task.start:g}, {task.end:g}] s)"
         )

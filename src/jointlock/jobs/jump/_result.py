@@ -273,6 +273,8 @@ def _single_json(robot: str, sc: JumpScenario, r: JumpAtTime) -> dict:
         "task_jump_replan_after_m_s": r.task_jump_replan_after,
         "limits_before": limits_json(r.limits_before),
         "limits_after": limits_json(r.limits_after),
+        # only when no kappa keeps the limits and that was to be reported (an audit's cell)
+        **({"infeasible": r.infeasible} if r.infeasible is not None else {}),
     }
 
 

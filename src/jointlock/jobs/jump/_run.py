@@ -40,6 +40,7 @@ def run_jump_study(
     fix: Fix | None = "auto",
     single: bool = False,
     progress: bool = False,
+    on_infeasible: Literal["raise", "report"] = "raise",
 ) -> JumpJobResult:
     """The velocity jump of seed 001 when ``task.lock_joint`` locks (``jointlock jump``).
 
@@ -69,6 +70,10 @@ def run_jump_study(
         (sweep with the search only).
     progress
         Show progress bars on stderr (when it is a terminal).
+    on_infeasible
+        ``fail_at`` with the search: when no kappa keeps every limit, ``"raise"``
+        (:class:`~jointlock.errors.InfeasibleError`) or ``"report"`` (the uncompensated jump,
+        the reason in :attr:`~jointlock.planning.jump.JumpAtTime.infeasible`; an audit's cells).
 
     Returns
     -------
@@ -84,7 +89,7 @@ def run_jump_study(
     given = None if kappa is None else float(kappa)
     if fail_at is not None:
         p = bar(sc.n_steps, "kappa search")  # the grid pass updates once per control step
-        res = jump_at_time(model, sc, fail_at, kappa=given, progress=p)
+        res = jump_at_time(model, sc, fail_at, kappa=given, progress=p, on_infeasible=on_infeasible)
         p.close()
         return JumpJobResult("fail_at", model, sc, at_time=res, kappa=given)
     if given is not None:
@@ -148,7 +153,9 @@ def jump_from_scenario(
     sc = task_as_the_command_reads_it(scenario_from_mapping(jump_fields(data), source="[jump]"))
     model = load_robot(data["robot"], base=sc.base, chain=UrdfChain.from_fields(data))
     if t["fail_at"] is not None:
-        return run_jump_study(model, sc, fail_at=t["fail_at"], kappa=t["kappa"], progress=progress)
+        return run_jump_study(
+            model, sc, fail_at=t["fail_at"], kappa=t["kappa"], progress=progress, on_infeasible=t["on_infeasible"]
+        )
     if t["kappa"] is not None:
         return run_jump_study(model, sc, kappa=t["kappa"], progress=progress)
     fix = None if t["fix"] == "none" else t["fix"]

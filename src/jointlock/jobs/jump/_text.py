@@ -74,6 +74,8 @@ def summary_lines(r: Mapping[str, Any], *, kappa_given: bool = False) -> list[st
             f"limits kept: {la['ok']} (max {la['max_velocity_deg_s']:.3f} deg/s, "
             f"{la['max_acceleration_deg_s2']:.3f} deg/s^2, {la['max_deviation_mm']:.3f} mm)",
         ]
+        if r.get("infeasible"):
+            lines.insert(0, f"INFEASIBLE: {r['infeasible']} (the jump below is the uncompensated one, kappa = 0)")
         return lines
     if "kappa_fit" in r:
         f = r["kappa_fit"]

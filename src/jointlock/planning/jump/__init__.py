@@ -88,6 +88,7 @@ from ._engine import _unsort as _unsort
 from ._fit import KappaFit, fit_kappa
 from ._fit import _feasible_samples as _feasible_samples
 from ._fit import _fit_single as _fit_single
+from ._joint_motion import cartesian_task
 from ._path import CartesianPath, cartesian_trapezoid
 from ._pieces import KappaPiece, find_breaks, fit_pieces
 from ._pieces import _crossings as _crossings
@@ -135,6 +136,7 @@ __all__ = [
     "SINGULAR_W",
     "Trajectory",
     "Verification",
+    "cartesian_task",
     "cartesian_trapezoid",
     "compensated_rates",
     "feasible_band",

@@ -53,6 +53,9 @@ class JumpAtTime:
         The search (None when ``kappa`` was given).
     scenario
         The settings.
+    infeasible
+        With ``on_infeasible="report"``: why no kappa keeps the limits (the metrics are then those
+        of kappa = 0, no compensation); None when one does.
     """
 
     fail_time: float
@@ -72,6 +75,7 @@ class JumpAtTime:
     limits_after: LimitReport
     search: KappaSearch | None
     scenario: JumpScenario
+    infeasible: str | None = None
 
     @property
     def reduction(self) -> float:
@@ -88,22 +92,32 @@ def jump_at_time(
     kappa: float | None = None,
     search_options: Mapping[str, Any] | None = None,
     progress: Any = None,
+    on_infeasible: Literal["raise", "report"] = "raise",
 ) -> JumpAtTime:
-    """Jump metrics at one failure time, with the optimal kappa (``kappa=None``) or a given one."""
+    """Jump metrics at one failure time, with the optimal kappa (``kappa=None``) or a given one.
+
+    When no kappa keeps every limit: ``on_infeasible="raise"`` raises
+    :class:`~jointlock.errors.InfeasibleError` saying why; ``"report"`` returns the metrics of
+    kappa = 0 (the uncompensated jump) with the reason in :attr:`JumpAtTime.infeasible` (an
+    audit's cell: infeasible is an answer, and the cell's other jobs keep theirs)."""
     sc = JumpScenario() if scenario is None else scenario
     prob = _problem(model, sc)
     k = int(sc.step_of(fail_time))
     search = None
     interval = np.array([np.nan, np.nan])
+    infeasible = None
     if kappa is None:
         search = search_kappa(model, sc, [k * sc.dt], progress=progress, **dict(search_options or {}))
         kappa = float(search.kappa_opt[0])
         interval = search.interval[0]
         if not np.isfinite(kappa):
-            raise InfeasibleError(
+            infeasible = (
                 f"no kappa in [{search.probe_range[0]:.4g}, {search.probe_range[1]:.4g}] keeps every limit "
                 f"with joint {sc.lock_joint} locking at {k * sc.dt:g} s; {_why_no_kappa(model, sc)}"
             )
+            if on_infeasible != "report":
+                raise InfeasibleError(infeasible)
+            kappa = 0.0
     krows = _kappa_rows(prob, np.array([0.0, float(kappa)]))
     healthy, post = _branched_runs(prob, krows, np.array([0, 1]), np.array([k, k]))
     table = _table(prob, krows, healthy)
@@ -130,6 +144,7 @@ def jump_at_time(
         reps[1],
         search,
         sc,
+        infeasible,
     )
 
 

@@ -251,7 +251,9 @@ def load_jump_task(path: str | Path) -> JumpScenario:
     """Read a jump task file: a flat TOML table, the fields of :data:`SCENARIO_FIELDS`.
 
     Not a ``jointlock run`` scenario file (tables such as ``[jump]``): those are read by
-    :func:`jointlock.scenario.load_scenario`, and refused here with a message saying so.
+    :func:`jointlock.scenario.load_scenario`, and refused here with a message saying so.  The
+    same task can be a scenario's ``[task]`` table (issue 28: ``q0_deg``, ``dx_m``, ...), which
+    every job then follows (:func:`jointlock.planning.jump.cartesian_task`).
     """
     data = read_toml_file(path, "scenario file", ScenarioError)
     _refuse_run_scenario(data, str(path))
