@@ -50,7 +50,7 @@ def audited(tmp_path_factory):
     folder = tmp_path_factory.mktemp("audit")
     scenario = folder / "plan.toml"
     scenario.write_text(PUMA)
-    result = run_audit(scenario, folder / "out", joints=[2, 3], times=3, engine=in_process())
+    result = jl.audit(scenario, folder / "out", joints=[2, 3], times=3, engine=in_process())  # = run_audit
     return scenario, folder / "out", result
 
 

@@ -131,6 +131,7 @@ _LAZY = {
     "run_scenario": "jointlock.run",
     "RunResult": "jointlock.run",
     "run_demo": "jointlock.run._demo",
+    "audit": "jointlock.campaign",  # every joint x instant of a planned motion (jointlock audit)
     # simulators
     "mjcf_text": "jointlock.mjcf",
     "write_mjcf": "jointlock.mjcf",
@@ -144,6 +145,7 @@ __getattr__, __dir__ = lazy_attributes(__name__, _LAZY, _LAZY_MODULES, globals()
 
 
 __all__ = [
+    "audit",
     "compiled_kernels",
     "compiled_mode",
     "set_compiled_mode",

@@ -51,6 +51,7 @@ from ._audit import (
     AUDIT_JUMP_COLUMNS,
     AuditResult,
     AuditWindows,
+    audit,
     audit_campaign,
     audit_windows,
     run_audit,
@@ -78,6 +79,7 @@ from ._worker import BatchTask, CaseOutcome, make_task, run_batch
 __all__ = [
     "AUDIT_COLUMNS",
     "AUDIT_JUMP_COLUMNS",
+    "audit",
     "AuditResult",
     "AuditWindows",
     "audit_campaign",

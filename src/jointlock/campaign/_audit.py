@@ -33,7 +33,17 @@ from ._columns import audit_cell_safe
 from ._read import campaign_from_dict
 from ._spec import CampaignSpec
 
-__all__ = ["AUDIT_COLUMNS", "AUDIT_JUMP_COLUMNS", "DEFAULT_AUDIT_TIMES", "AuditResult", "AuditWindows", "audit_campaign", "audit_windows", "run_audit"]
+__all__ = [
+    "AUDIT_COLUMNS",
+    "AUDIT_JUMP_COLUMNS",
+    "DEFAULT_AUDIT_TIMES",
+    "AuditResult",
+    "AuditWindows",
+    "audit",
+    "audit_campaign",
+    "audit_windows",
+    "run_audit",
+]
 
 #: Instants of the task audited by default (evenly spaced, both ends included).
 DEFAULT_AUDIT_TIMES = 11
@@ -309,3 +319,7 @@ def run_audit(
     atomic_write_json(folder / "audit.json", windows.to_dict())
     written = [str(p) for p in write_campaign_report(folder)]
     return AuditResult(run, windows, (*written, str(folder / "audit.json")))
+
+
+#: ``jl.audit``: the library's ``jointlock audit`` (:func:`run_audit`).
+audit = run_audit
