@@ -110,3 +110,47 @@ def test_the_halt_reports_its_clearance_between_samples():
     assert data["tunnelling_tolerance_m"] == TUNNEL_TOLERANCE_M
     assert data["start_m"] - TUNNEL_TOLERANCE_M <= data["between_samples_min_m"] <= data["motion_min_m"]
     assert data["collides_at_samples"] is False
+
+
+def _jump(obstacle: bool = False):
+    """001's jump study of canadarm7 at 6 s; ``obstacle``: a 0.15 m ball fixed to the bus where
+    the end effector passes 9 s into the task (a payload left in the way)."""
+    from jointlock.geometry import with_root_shapes
+    from jointlock.jobs.jump import run_jump_study
+    from jointlock.planning.jump import JumpScenario, simulate
+
+    arm = jl.load_robot("canadarm7", base="fixed")
+    if obstacle:
+        at = jl.ee_pose(arm, simulate(arm, JumpScenario()).q[180])[:3, 3]
+        arm = with_root_shapes(arm, [Sphere(at, 0.15, name="payload")])
+    return run_jump_study(arm, JumpScenario(), fail_at=6.0)
+
+
+def _dense(run, factor: int = 20):
+    """The run's joint motion (rates held over each control step) at ``factor`` times its steps."""
+    t = np.linspace(run.t[0], run.t[-1], factor * (run.t.size - 1) + 1)
+    k = np.clip(np.searchsorted(run.t, t, side="right") - 1, 0, run.qd.shape[0] - 1)
+    return run.q[k] + run.qd[k] * (t - run.t[k])[:, None]
+
+
+def test_the_jump_studys_runs_report_their_clearance():
+    """001's runs on canadarm7 keep clear of the bus (+0.27 m, link3 - bus), between the control
+    steps too (20 times finer sampling agrees); with a ball on the end effector's path 9 s in,
+    both runs hit it and say so first."""
+    result = _jump()
+    data = result.clearance()
+    r0, r1, _ = result.runs()
+    for label, run in (("uncompensated", r0), ("compensated", r1)):
+        steps = clearance(result.model, run.q)
+        assert data[label]["min_clearance_m"] == pytest.approx(float(steps.distance.min()), abs=1e-12)
+        assert data[label]["collides"] is False
+        dense = clearance(result.model, _dense(run)).distance.min()
+        assert data[label]["between_steps_min_m"] <= dense + 1e-12
+    assert result.to_dict()["clearance"] == data
+    assert not result.summary()[0].startswith("COLLIDES")
+
+    hit = _jump(obstacle=True)
+    data = hit.clearance()
+    assert all(data[label]["collides"] for label in data)
+    assert data["compensated"]["closest_pair"] == "payload - link7" and data["compensated"]["min_clearance_m"] < -0.1
+    assert hit.summary()[0].startswith("COLLIDES: the uncompensated run")

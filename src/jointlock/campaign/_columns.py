@@ -50,6 +50,8 @@ DEFAULT_COLUMNS: dict[str, tuple[str, ...]] = {
         "jump.mean_reduction",
         "jump.share_improved",
         "jump.limits_ok",
+        "jump.clearance.compensated.min_clearance_m",
+        "jump.clearance.compensated.collides",
     ),
     "tolerance_angle": ("tolerance_angle.roots|len", "tolerance_angle.chosen.gamma_deg"),
     "replan": (

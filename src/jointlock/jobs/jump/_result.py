@@ -12,6 +12,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
+from ...collision import clearance, collision_pairs
 from ...io.files import atomic_write_json, atomic_write_text, csv_text, write_figure
 from ...model import ArmModel
 from ...planning.jump import (
@@ -35,6 +36,7 @@ from ...plots.jump import (
 )
 from ...plots.motion import ArmMotion
 from ...plots.spacecraft import plot_spacecraft_responses
+from ...sweep import swept_clearance
 from .._common import JobResult
 from .._motions import jump_motions
 from ._text import summary_lines
@@ -108,11 +110,15 @@ class JumpJobResult(JobResult):
         responses = self.spacecraft_responses()
         if responses is not None:
             out["spacecraft"] = {"fail_time_s": self.runs()[2], **{k: r.to_dict() for k, r in responses.items()}}
+        out["clearance"] = self.clearance()
         return out
 
     def summary(self) -> list[str]:
         """The lines ``jointlock jump`` prints (jumps in deg/s)."""
         lines = summary_lines(self.to_dict(), kappa_given=self.kappa_given)
+        clear = clearance_lines(self.clearance())
+        lines = [line for line in clear if line.startswith("COLLIDES")] + lines
+        lines += [line for line in clear if not line.startswith("COLLIDES")]
         responses = self.spacecraft_responses()
         if responses is not None:
             t_fail = self.runs()[2]
@@ -134,6 +140,21 @@ class JumpJobResult(JobResult):
             return spacecraft_response(self.model, run.t, run.q, dq, rates="hold")
 
         return {"uncompensated": response(r0), "compensated": response(r1)}
+
+    def clearance(self) -> dict[str, dict[str, Any]] | None:
+        """Clearance of the two runs of :meth:`runs` (issue 27: the 001 runs are collision-aware):
+        for ``"uncompensated"`` and ``"compensated"``, the smallest signed distance between the
+        arm's links and its spacecraft bus on the control steps (:func:`jointlock.collision.
+        clearance`), its pair and time, and a certified bound between the steps
+        (:func:`jointlock.sweep.swept_clearance`; the rates are held over each step, so the
+        joints move linearly between them).  ``collides``: a pair overlaps that did not at the
+        start, or one overlapping at the start goes deeper.  None for a model without shapes."""
+        if not collision_pairs(self.model).names:
+            return None
+        if "clearance" not in self._cache:
+            r0, r1, _ = self.runs()
+            self._cache["clearance"] = {"uncompensated": _run_clearance(self.model, r0), "compensated": _run_clearance(self.model, r1)}
+        return self._cache["clearance"]
 
     def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]]:
         """The two runs of :meth:`runs` to animate (:func:`~jointlock.jobs._motions.jump_motions`)."""
@@ -203,6 +224,64 @@ class JumpJobResult(JobResult):
             names += _save(out, FIG_SPACECRAFT, plot_spacecraft_responses(responses, fig=offscreen_figure((7, 5)), title=title))
         atomic_write_text(out / "runs.csv", runs_csv(self.model, r0, r1))
         return names + ["runs.csv"] + self._write_motions(out)
+
+
+#: Round-off allowed to a pair in contact at the start of a run [m] (two capsules of an elbow
+#: touching along the whole run: distances of +-1e-16 m).
+TOUCH_M = 1e-9
+
+
+def _run_clearance(model: ArmModel, run: Trajectory) -> dict[str, Any]:
+    """:meth:`JumpJobResult.clearance` of one run."""
+    rates = np.concatenate([run.qd, np.zeros((1, run.qd.shape[1]))])  # at rest after the task
+    steps = clearance(model, run.q)
+    # no overlap, or none deeper than at the start (a pair touching there may touch to round-off)
+    floor = np.minimum(0.0, steps.pair_distance[0]) - TOUCH_M
+
+    def motion(t: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        k = np.clip(np.searchsorted(run.t, t, side="right") - 1, 0, run.qd.shape[0] - 1)
+        return run.q[k] + rates[k] * (t - run.t[k])[:, None], rates[k], np.zeros((t.size, rates.shape[1]))
+
+    between = swept_clearance(
+        model, motion, run.t, floor, sampled=(run.q, rates, np.zeros_like(rates), steps.pair_distance)
+    )
+    at = steps.worst()
+    worst = between.worst()  # the pair furthest below its floor
+    collides = bool(between.shortfall > 0)
+    deepest = int(np.argmin(steps.pair_distance[:, worst]))
+    return {
+        "min_clearance_m": float(steps.distance[at]),
+        "closest_pair": steps.pair_at(at),
+        "time_s": float(run.t[at[0]]) if at else 0.0,
+        "between_steps_min_m": float(between.lower_bound[worst]),
+        "between_steps_pair": between.names[worst],
+        "collides": collides,
+        "colliding_pair": between.names[worst] if collides else None,
+        "colliding_min_m": float(steps.pair_distance[deepest, worst]) if collides else None,
+        "colliding_time_s": float(run.t[deepest]) if collides else None,
+        "colliding_at_steps": bool(steps.pair_distance[deepest, worst] < floor[worst]) if collides else None,
+    }
+
+
+def clearance_lines(data: dict[str, dict[str, Any]] | None) -> list[str]:
+    """The summary's clearance lines of :meth:`JumpJobResult.clearance` (a colliding run first)."""
+    if not data:
+        return []
+    first: list[str] = []
+    lines: list[str] = []
+    for label, c in data.items():
+        if c["collides"] and c["colliding_at_steps"]:
+            into = f"{-c['colliding_min_m']:.3f} m into" if c["colliding_min_m"] < 0 else f"within {c['colliding_min_m']:.3f} m of"
+            first.append(
+                f"COLLIDES: the {label} run reaches {into} {c['colliding_pair']} at t = {c['colliding_time_s']:.3g} s"
+            )
+        elif c["collides"]:
+            first.append(
+                f"COLLIDES: between its control steps the {label} run may reach {-c['between_steps_min_m']:.3f} m into "
+                f"{c['between_steps_pair']} (a bound on how far the links move in a step)"
+            )
+        lines.append(f"clearance of the {label} run: {c['min_clearance_m']:+.3f} m ({c['closest_pair']}, t = {c['time_s']:.3g} s)")
+    return first + lines
 
 
 # -- JSON ----------------------------------------------------------------------------------------
