@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -263,6 +264,17 @@ def test_the_default_output_folder_is_beside_the_campaign_file(tmp_path, monkeyp
     assert load_campaign(path).default_out() == tmp_path / "mine-campaign"
     other = write_campaign(tmp_path, 'out = "results/here"\n[grid]\n"halt.T" = [9.0]\n', name="o.toml")
     assert load_campaign(other).default_out() == tmp_path / "results" / "here"
+
+
+def test_the_example_campaigns_keep_their_keys():
+    """The fields added since (srdf, a Cartesian [task]'s, jump.on_infeasible) leave the keys of
+    the example campaigns' cases as they were (computed by the code before them)."""
+    for name, first in (
+        ("jump_canadarm7.toml", ["e5f4cd52837b6cf10bbd0f05", "d7bfc767402d750d906a076d"]),
+        ("halt7.toml", ["265d6274313541bc56dc22c8", "8e0625a5b093cff6b1b94882"]),
+    ):
+        spec = load_campaign(Path(__file__).resolve().parents[1] / "examples" / "campaigns" / name)
+        assert [c.key for c in plan_cases(spec).cases][:2] == first, name
 
 
 def test_keys_do_not_move_with_fields_added_later(tmp_path):

@@ -20,7 +20,9 @@ the full arm, 0 for the root body), so the pairs are the same before and after a
   mounted, negative when it goes deeper) and is exempt from a clearance margin, so that a boom
   mounted on the bus's face is flagged when it swings into the bus, never for touching it;
   :attr:`Clearance.mounted` lists them;
-* a keep-out volume is checked against every link but not the root body (both are fixed).
+* a keep-out volume is checked against every link but not the root body (both are fixed);
+* pairs of shape names the model disables (:attr:`~jointlock.model.ArmModel.disabled_pairs`: an
+  SRDF's ``<disable_collisions>``, read by :func:`jointlock.io.srdf.read_srdf`) are never checked.
 
 Distances are exact for capsule-capsule (spheres included) and capsule-box pairs and are
 computed by compiled kernels (:mod:`jointlock._kernels._distance`), tested against coal
@@ -128,9 +130,13 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], mounted: dict[tuple[int, 
     offsets: list[float] = []
     seen: dict[tuple[int, str, int, str], int] = {}
 
+    disabled = set(model.disabled_pairs)
+
     def add(kind: int, i: int, j: int, a: tuple[int, Shape], b: tuple[int, Shape]) -> None:
         la, lb = int(a[1].link), int(b[1].link)  # type: ignore[arg-type]
         if not _checked(la, lb, a[0], b[0]):
+            return
+        if tuple(sorted((_shape_name(a[1]), _shape_name(b[1])))) in disabled:
             return
         key = (la, _shape_name(a[1]), lb, _shape_name(b[1]))
         seen[key] = seen.get(key, 0) + 1

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
+from typing import cast
 
 from .errors import ModelError
 from .model import ArmModel, Body
@@ -48,3 +49,13 @@ def bus_box(spacecraft: Body, name: str = "bus") -> Box:
     """The spacecraft bus as the uniform box of ``spacecraft``'s mass and inertia, in the root
     frame (:func:`jointlock.shapes.box_from_inertia`): the box the 3-D view draws."""
     return box_from_inertia(spacecraft.mass, spacecraft.com, spacecraft.inertia, name=name)
+
+
+def with_disabled_pairs(model: ArmModel, pairs: Sequence[tuple[str, str]]) -> ArmModel:
+    """``model`` whose clearance never checks ``pairs`` of shape names (URDF link names; an SRDF's
+    ``<disable_collisions>``, :func:`jointlock.io.srdf.read_srdf`), added to those it disables
+    already; the arm before its locks (``unlocked``) disables them too."""
+    # checked by ArmModel (each a pair of names)
+    both = cast(tuple[tuple[str, str], ...], tuple(model.disabled_pairs) + tuple(tuple(p) for p in pairs))
+    unlocked = None if model.unlocked is None else replace(model.unlocked, disabled_pairs=both)
+    return replace(model, disabled_pairs=both, unlocked=unlocked)

@@ -262,6 +262,10 @@ class ArmModel:
         The arm before any lock (same base), kept by :func:`jointlock.locking.lock` so that
         the locked joints' brake torques can be computed (None for an arm without locks, or
         when unknown).  Not compared.
+    disabled_pairs
+        Pairs of shape names (URDF link names) whose clearance is never checked: an SRDF's
+        ``<disable_collisions>`` (:func:`jointlock.io.srdf.read_srdf`,
+        :func:`jointlock.geometry.with_disabled_pairs`), each pair sorted.  Not compared.
     """
 
     name: str
@@ -273,6 +277,7 @@ class ArmModel:
     locked: tuple[LockedJoint, ...] = ()
     description: str = ""
     unlocked: ArmModel | None = field(default=None, compare=False, repr=False)
+    disabled_pairs: tuple[tuple[str, str], ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
         joints = tuple(self.joints)
@@ -310,6 +315,12 @@ class ArmModel:
         object.__setattr__(self, "bodies", bodies)
         object.__setattr__(self, "tool", _readonly(_transform(self.tool, f"model {shown(self.name)}: tool")))
         object.__setattr__(self, "locked", tuple(self.locked))
+        pairs = []
+        for pair in self.disabled_pairs:
+            if not (isinstance(pair, (tuple, list)) and len(pair) == 2 and all(isinstance(n, str) for n in pair)):
+                raise ModelError(f"model {shown(self.name)}: disabled_pairs must be pairs of shape names; got {shown(pair)}")
+            pairs.append(tuple(sorted(pair)))
+        object.__setattr__(self, "disabled_pairs", tuple(sorted(set(pairs))))
 
     def __repr__(self) -> str:
         """One line (the arrays stay in the fields): name, joints, locks, base and mass."""

@@ -20,7 +20,7 @@ import numpy as np
 from .bounds import shown
 from .dh import from_dh
 from .errors import ModelError
-from .geometry import bus_box, with_link_capsules, with_root_shapes
+from .geometry import bus_box, with_disabled_pairs, with_link_capsules, with_root_shapes
 from .io.files import check_path_text
 from .model import ArmModel, Body, FloatArray, Joint
 from .shapes import Box
@@ -302,7 +302,7 @@ def _mentions_urdf(path: Path) -> bool:
 
 
 #: A scenario's fields naming the chain of a URDF tree (the command line's --root, --tip, --freeze).
-CHAIN_FIELDS: tuple[str, ...] = ("root_link", "tip_link", "freeze_deg", "freeze_m")
+CHAIN_FIELDS: tuple[str, ...] = ("root_link", "tip_link", "freeze_deg", "freeze_m", "srdf")
 
 
 @dataclass(frozen=True)
@@ -311,13 +311,16 @@ class UrdfChain:
     ``tip_link`` and ``freeze``), as a scenario or the command line gives it.
 
     ``freeze_deg``: ``((revolute joint, value [deg]), ...)``; ``freeze_m``: ``((prismatic
-    joint, value [m]), ...)``.  Hashable: part of :func:`load_robot`'s cache key.
+    joint, value [m]), ...)``; ``srdf``: an SRDF file whose ``<disable_collisions>`` pairs the
+    clearance never checks (:func:`jointlock.io.srdf.read_srdf`).  Hashable: part of
+    :func:`load_robot`'s cache key.
     """
 
     root_link: str | None = None
     tip_link: str | None = None
     freeze_deg: tuple[tuple[str, float], ...] = ()
     freeze_m: tuple[tuple[str, float], ...] = ()
+    srdf: str | None = None
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any]) -> UrdfChain | None:
@@ -331,13 +334,14 @@ class UrdfChain:
             data.get("tip_link") or None,
             tuple((str(k), float(v)) for k, v in (data.get("freeze_deg") or {}).items()),
             tuple((str(k), float(v)) for k, v in (data.get("freeze_m") or {}).items()),
+            data.get("srdf") or None,
         )
         return chain if chain != cls() else None
 
     def fields(self) -> dict[str, Any]:
         """The given fields as a scenario writes them (``freeze_deg = {joint = value}``)."""
         out: dict[str, Any] = {"root_link": self.root_link, "tip_link": self.tip_link}
-        out.update(freeze_deg=dict(self.freeze_deg), freeze_m=dict(self.freeze_m))
+        out.update(freeze_deg=dict(self.freeze_deg), freeze_m=dict(self.freeze_m), srdf=self.srdf)
         return {k: v for k, v in out.items() if v}
 
 
@@ -346,6 +350,11 @@ def _read_urdf_chain(path: str, base: BaseMode, chain: UrdfChain | None) -> ArmM
 
     if chain is None:
         return read_urdf(path, base=base)
+    if chain.srdf is not None:
+        from .io.srdf import read_srdf
+
+        plain = UrdfChain(chain.root_link, chain.tip_link, chain.freeze_deg, chain.freeze_m)
+        return with_disabled_pairs(_read_urdf_chain(path, base, plain), read_srdf(chain.srdf))
     freeze = {k: math.radians(v) for k, v in chain.freeze_deg} | dict(chain.freeze_m)
     units = {k: "deg" for k, _ in chain.freeze_deg} | {k: "m" for k, _ in chain.freeze_m}
     if len(units) < len(chain.freeze_deg) + len(chain.freeze_m):

@@ -139,9 +139,14 @@ def resolve_case(spec: CampaignSpec, overrides: Mapping[str, Any]) -> Scenario:
     return scenario_from_dict(data, source=spec.scenario_source, base_dir=spec.scenario_dir)
 
 
-#: Top-level fields added after :data:`KEY_FORMAT` was set, left out of a key while unset, so that
-#: the cases of earlier campaigns keep their keys and seeds (and resume).
-UNKEYED_WHEN_UNSET = ("compiled",)
+#: Fields added after :data:`KEY_FORMAT` was set (top level, or ``table.field``), left out of a key
+#: while unset (None), so that the cases of earlier campaigns keep their keys and seeds (and resume).
+UNKEYED_WHEN_UNSET = (
+    "compiled",
+    "srdf",
+    "jump.on_infeasible",
+    *(f"task.{name}" for name in ("dx_m", "q0_deg", "duration_s", "blend_s", "dt_s", "kp", "feedforward", "base")),
+)
 
 
 def case_key(scenario: Scenario, campaign_seed: int) -> str:
@@ -155,6 +160,10 @@ def case_key(scenario: Scenario, campaign_seed: int) -> str:
         for key, value in scenario.data.items()
         if key not in ("title", "description", "out") and not (key in UNKEYED_WHEN_UNSET and value is None)
     }
+    for name in UNKEYED_WHEN_UNSET:
+        table, _, field = name.partition(".")
+        if field and isinstance(data.get(table), dict) and field in data[table] and data[table][field] is None:
+            data[table] = {k: v for k, v in data[table].items() if k != field}
     data["jobs"] = list(scenario.jobs)
     robot = Path(str(data["robot"]))
     if robot.suffix.lower() in (".toml", ".urdf"):

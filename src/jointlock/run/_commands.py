@@ -51,6 +51,7 @@ def _chain_args(data: Mapping[str, Any]) -> list[str]:
     argv += ["--tip", chain.tip_link] if chain.tip_link else []
     for name, value in (*chain.freeze_deg, *chain.freeze_m):
         argv += ["--freeze", f"{name}={_num(value)}"]
+    argv += ["--srdf", chain.srdf] if chain.srdf else []
     return argv
 
 
@@ -139,7 +140,7 @@ def job_argv(
         # only the options the mode uses (the command warns about the others)
         if t["fail_at"] is not None:
             argv += ["--fail-at", _num(t["fail_at"])]
-            argv += ["--on-infeasible", t["on_infeasible"]] if t["on_infeasible"] != "raise" else []
+            argv += ["--on-infeasible", t["on_infeasible"]] if t["on_infeasible"] == "report" else []
         elif t["kappa"] is None:
             argv += ["--sweep", str(t["sweep"])]
         if t["kappa"] is not None:

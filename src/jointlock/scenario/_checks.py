@@ -38,6 +38,8 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
             f"{source}: {chain}: chooses the chain of a URDF robot; robot {shown(name)} is {what} (allowed with "
             "robot = a .urdf file; a .toml model file names its chain itself)"
         )
+    if out.get("srdf") is not None:
+        out["srdf"] = _existing_file(out["srdf"], base_dir, f"{source}: srdf", "SRDF file")
     if name in BUILTIN_ROBOTS:
         return
     check_path_text(name, f"{source}: robot: model file", ScenarioError)
@@ -59,6 +61,15 @@ def _resolve_robot(out: dict[str, Any], source: str, base_dir: Path) -> None:
     if not found:
         raise ScenarioError(f"{source}: robot: model file {shown(name)} not found (looked for {path})")
     out["robot"] = str(path)
+
+
+def _existing_file(name: str, base_dir: Path, where: str, what: str) -> str:
+    """``name`` as an absolute path (relative to ``base_dir``), checked to be a file."""
+    check_path_text(name, where, ScenarioError)
+    path = Path(name) if Path(name).is_absolute() else (base_dir / name).resolve()
+    if not path.is_file():
+        raise ScenarioError(f"{where}: {what} {shown(name)} not found (looked for {path})")
+    return str(path)
 
 
 def _load(out: dict[str, Any], base: str, source: str, cache: dict) -> Any:

@@ -140,6 +140,10 @@ TOP_FIELDS: dict[str, Field] = {
         help="URDF robot only: revolute joints held at these angles, their links merged (other joints off the "
         "chain are held at 0; a <mimic> joint follows its leader)",
     ),  # fmt: skip
+    "srdf": Field(
+        "str", None, help="URDF robot only: an SRDF file (relative to the scenario's folder) whose "
+        "<disable_collisions> link pairs the clearance never checks",
+    ),
     "freeze_m": Field(
         "joint_values", None, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m",
         help="URDF robot only: prismatic joints held at these positions (gripper fingers, a torso lift)",
@@ -392,9 +396,9 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "order": Field("int", 5, lo=1, hi=9, help="polynomial order of kappa(t)"),
         "on_infeasible": Field(
             "choice",
-            "raise",
+            None,
             choices=("raise", "report"),
-            help="one failure time without a kappa that keeps the limits: an error (raise), or the "
+            help="one failure time without a kappa that keeps the limits: an error (raise, the default), or the "
             "uncompensated jump with the reason (report: an audit's cells)",
         ),
         "fix": Field(

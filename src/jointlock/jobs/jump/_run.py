@@ -154,7 +154,7 @@ def jump_from_scenario(
     model = load_robot(data["robot"], base=sc.base, chain=UrdfChain.from_fields(data))
     if t["fail_at"] is not None:
         return run_jump_study(
-            model, sc, fail_at=t["fail_at"], kappa=t["kappa"], progress=progress, on_infeasible=t["on_infeasible"]
+            model, sc, fail_at=t["fail_at"], kappa=t["kappa"], progress=progress, on_infeasible=t["on_infeasible"] or "raise"
         )
     if t["kappa"] is not None:
         return run_jump_study(model, sc, kappa=t["kappa"], progress=progress)
