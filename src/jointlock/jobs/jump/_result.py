@@ -13,6 +13,7 @@ import numpy as np
 
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...collision import clearance, collision_pairs
+from ...errors import JointlockError
 from ...io.files import atomic_write_json, atomic_write_text, csv_text, write_figure
 from ...model import ArmModel
 from ...planning.jump import (
@@ -148,12 +149,20 @@ class JumpJobResult(JobResult):
         clearance`), its pair and time, and a certified bound between the steps
         (:func:`jointlock.sweep.swept_clearance`; the rates are held over each step, so the
         joints move linearly between them).  ``collides``: a pair overlaps that did not at the
-        start, or one overlapping at the start goes deeper.  None for a model without shapes."""
+        start, or one overlapping at the start goes deeper.  None for a model without shapes,
+        or when a run diverges (a kappa far too large)."""
         if not collision_pairs(self.model).names:
             return None
         if "clearance" not in self._cache:
-            r0, r1, _ = self.runs()
-            self._cache["clearance"] = {"uncompensated": _run_clearance(self.model, r0), "compensated": _run_clearance(self.model, r1)}
+            try:
+                r0, r1, _ = self.runs()
+            except JointlockError:  # a kappa far too large: its run diverges (the result says so)
+                self._cache["clearance"] = None
+            else:
+                self._cache["clearance"] = {
+                    "uncompensated": _run_clearance(self.model, r0),
+                    "compensated": _run_clearance(self.model, r1),
+                }
         return self._cache["clearance"]
 
     def arm_motions(self) -> tuple[ArmModel, list[ArmMotion]]:
