@@ -98,7 +98,8 @@ def test_the_audits_jump_cells_equal_jointlock_jump_and_infeasible_keeps_the_hal
         assert recorded[key] == pytest.approx(command[key], rel=1e-12, abs=1e-15), key
     # joint 5: no kappa keeps the limits (001's task breaks them after any lock of joint 5)
     cell = rows[5, 6.0]["record"]
-    assert cell["jump.limits_ok"] is False and cell["jump.kappa"] == 0.0
+    assert cell["jump.limits_ok"] is False and cell["jump.kappa"] is None and cell["jump.mean_reduction"] is None
+    assert cell["jump.infeasible"].startswith("no kappa")
     assert cell["halt.feasible"] is not None  # the cell keeps its halt
     with pytest.raises(InfeasibleError, match="no kappa"):
         jl.jobs.jump.run_jump_study(jl.load_robot("canadarm7", base="fixed"), JumpScenario(lock_joint=5), fail_at=6.0)
@@ -122,6 +123,8 @@ LINE = "dx_m = [1.2, -1.5, 0.8]\n"
         (CARTESIAN.replace("[jump]\n", "[jump]\nduration_s = 10.0\n"), "jump.duration_s and the Cartesian [task] both give the task"),
         (CARTESIAN.replace("[jump]\n", '[jump]\nbase = "floating"\n'), "jump.base = 'floating' but task.base = 'fixed'"),
         (CARTESIAN.replace(LINE, LINE + "dt_s = 0.07\n"), "whole number"),
+        (CARTESIAN.replace("[jump]\n", "[jump]\nfail_at = 3.0\n"), "jump.fail_at = 3 s with a Cartesian [task]"),
+        (CARTESIAN.replace("[jump]\n", "[jump]\nsweep = 5\n"), "jump.sweep with a Cartesian [task]"),
     ],
 )
 def test_bad_cartesian_tasks_are_one_line(tmp_path, text, words):

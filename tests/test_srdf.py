@@ -111,3 +111,21 @@ def test_an_srdf_needs_a_urdf_robot(tmp_path):
     path.write_text('robot = "puma6"\nsrdf = "x.srdf"\n[workspace]\n')
     with pytest.raises(ScenarioError, match="srdf: chooses the chain of a URDF robot"):
         jl.load_scenario(path)
+
+
+def test_a_campaign_keys_the_srdf_by_content_and_another_robots_srdf_is_said(tmp_path):
+    from jointlock.campaign import case_key
+
+    urdf, srdf = _files()
+    keys = []
+    for folder, text in (("a", srdf.read_text()), ("b", srdf.read_text()), ("c", "<robot/>")):
+        (tmp_path / folder).mkdir()
+        (tmp_path / folder / "p.srdf").write_text(text)
+        path = tmp_path / folder / "s.toml"
+        path.write_text(f'robot = "{urdf}"\ntip_link = "panda_hand"\nsrdf = "p.srdf"\n[workspace]\n')
+        keys.append(case_key(jl.load_scenario(path), 0))
+    assert keys[0] == keys[1] != keys[2]  # the same file in two folders; another content
+    other = tmp_path / "other.srdf"
+    other.write_text("<robot><disable_collisions link1='wheel' link2='mast'/></robot>")
+    with pytest.warns(UserWarning, match="is it this robot's SRDF"):
+        jl.load_robot(urdf, chain=UrdfChain(tip_link="panda_hand", srdf=str(other)))

@@ -144,8 +144,10 @@ def test_the_jump_studys_runs_report_their_clearance():
         steps = clearance(result.model, run.q)
         assert data[label]["min_clearance_m"] == pytest.approx(float(steps.distance.min()), abs=1e-12)
         assert data[label]["collides"] is False
-        dense = clearance(result.model, _dense(run)).distance.min()
-        assert data[label]["between_steps_min_m"] <= dense + 1e-12
+        pair = collision_pairs(result.model).names.index(data[label]["between_steps_pair"])
+        dense = clearance(result.model, _dense(run)).pair_distance[:, pair].min()
+        assert data[label]["between_steps_min_m"] <= dense + 1e-12  # that pair's bound, below its truth
+        assert data[label]["between_steps_pair"] == "link3 - bus"  # not a mounted pair at its floor
     assert result.to_dict()["clearance"] == data
     assert not result.summary()[0].startswith("COLLIDES")
 
@@ -154,3 +156,21 @@ def test_the_jump_studys_runs_report_their_clearance():
     assert all(data[label]["collides"] for label in data)
     assert data["compensated"]["closest_pair"] == "payload - link7" and data["compensated"]["min_clearance_m"] < -0.1
     assert hit.summary()[0].startswith("COLLIDES: the uncompensated run")
+
+
+def test_a_motion_with_nan_rates_is_refused_and_a_short_grid_works():
+    from jointlock.errors import ConfigurationError
+    from jointlock.planning.halt_motion._clearance_limits import keeps_clearance
+
+    plan, p, motion = _halt7_halt()
+
+    def broken(t):
+        q, dq, ddq = motion(t)
+        dq = dq.copy()
+        dq[len(dq) // 2] = np.nan
+        return q, dq, ddq
+
+    with pytest.raises(ConfigurationError, match="not finite at t = "):
+        swept_clearance(p.model, broken, p.times(51), np.zeros(len(collision_pairs(p.model).names)))
+    short = replace(p, n_check=5)  # every check time on the screen: nothing left for the rest
+    assert keeps_clearance(short, np.array([float(plan.motion.k)]), 0.05).shape == (1,)

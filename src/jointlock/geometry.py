@@ -8,6 +8,7 @@ The shapes themselves are :mod:`jointlock.shapes`; a model carries them on its b
 
 from __future__ import annotations
 
+import warnings
 from collections.abc import Sequence
 from dataclasses import replace
 from typing import cast
@@ -54,7 +55,17 @@ def bus_box(spacecraft: Body, name: str = "bus") -> Box:
 def with_disabled_pairs(model: ArmModel, pairs: Sequence[tuple[str, str]]) -> ArmModel:
     """``model`` whose clearance never checks ``pairs`` of shape names (URDF link names; an SRDF's
     ``<disable_collisions>``, :func:`jointlock.io.srdf.read_srdf`), added to those it disables
-    already; the arm before its locks (``unlocked``) disables them too."""
+    already; the arm before its locks (``unlocked``) disables them too.  Pairs that name no shape
+    of the model are kept (an SRDF covers the whole robot, a chain only part of it); when none of
+    ``pairs`` names one, a ``UserWarning`` says so (another robot's SRDF?)."""
+    names = {s.name for body in (model.root_body, *model.bodies) for s in body.shapes}
+    if pairs and not any(a in names or b in names for a, b in pairs):
+        warnings.warn(
+            f"none of the {len(pairs)} disabled pairs names a link of {model.name}'s collision shapes: is it "
+            "this robot's SRDF?",
+            UserWarning,
+            stacklevel=2,
+        )
     # checked by ArmModel (each a pair of names)
     both = cast(tuple[tuple[str, str], ...], tuple(model.disabled_pairs) + tuple(tuple(p) for p in pairs))
     unlocked = None if model.unlocked is None else replace(model.unlocked, disabled_pairs=both)

@@ -25,8 +25,9 @@ two sampled distances into a lower bound of the distance over the whole interval
   least ``(d(t0) + d(t1) - D) / 2``, ``D`` the pair's relative travel (the smaller of the two
   straight lines from the ends meeting at the lowest point).
 
-An interval whose bound falls more than ``tolerance`` below the distance a pair must keep
-(``floor``) is cut into :data:`SUBDIVISIONS` pieces, the motion evaluated at the new samples, and
+The acceleration bound grows with the refined samples' accelerations as they come.  An interval
+whose bound falls more than ``tolerance`` below the distance a pair must keep (``floor``) is cut
+into :data:`SUBDIVISIONS` pieces, the motion evaluated at the new samples, and
 so on, at most :data:`MAX_DEPTH` times; what is left then is reported as it stands (a bound,
 not proven clear).  Most intervals of a halt are far from their floor and never refined.
 """
@@ -42,6 +43,7 @@ from numpy.typing import ArrayLike
 
 from ._cache import cached_on
 from .collision import CollisionPairs, clearance, collision_pairs
+from .errors import ConfigurationError
 from .model import ArmModel, FloatArray
 from .shapes import Shape
 
@@ -55,6 +57,9 @@ SUBDIVISIONS = 8
 MAX_DEPTH = 4
 #: Most new samples one motion may ask for; beyond, the bound is reported as it stands.
 MAX_REFINED_SAMPLES = 200_000
+#: Round-off allowed to a sample against its pair's floor [m]: a pair in contact at the start
+#: (its floor its own distance then) is not "closer" for a nanometre of floating point.
+ROUND_OFF_M = 1e-9
 
 #: A motion: (n_t,) times [s] -> q, dq, ddq, each (n_t, n) [rad, rad/s, rad/s^2].
 Motion = Callable[[FloatArray], tuple[FloatArray, FloatArray, FloatArray]]
@@ -131,8 +136,9 @@ class SweptClearance:
 
     @property
     def sampled_shortfall(self) -> float:
-        """The most by which a sample comes closer than its pair's floor [m] (<= 0: none)."""
-        return float((self.floor - self.sampled_min).max()) if self.names else -np.inf
+        """The most by which a sample comes closer than its pair's floor [m], beyond
+        :data:`ROUND_OFF_M` (<= 0: none)."""
+        return float((self.floor - ROUND_OFF_M - self.sampled_min).max()) if self.names else -np.inf
 
     @property
     def shortfall(self) -> float:
@@ -213,6 +219,7 @@ def swept_clearance(
         distance = clearance(model, q, keep_out=keep_out).pair_distance
     else:
         q, dq, ddq, distance = sampled
+    _check_finite(t, dq, ddq, distance)
     reach = pair_reach(model, pairs) if keep_out else cached_on(model, "pair_reach", lambda: pair_reach(model, pairs))
     accel = np.abs(ddq).max(axis=0)
     lower = distance.min(axis=0)
@@ -226,7 +233,7 @@ def swept_clearance(
         h = end_t - start_t
         bound = 0.5 * (start_d + end_d - joint_travel(start_v, end_v, accel, h) @ reach.T)  # (m, P)
         # refine where the bound may hide a shortfall, unless a sample already shows one
-        ends_clear = np.all(np.minimum(start_d, end_d) >= floor, axis=1)
+        ends_clear = np.all(np.minimum(start_d, end_d) >= floor - ROUND_OFF_M, axis=1)
         refine = np.any(bound < floor - tolerance, axis=1) & ends_clear
         if depth == max_depth or refined + refine.sum() * (SUBDIVISIONS - 1) > MAX_REFINED_SAMPLES:
             refine[:] = False
@@ -241,8 +248,10 @@ def swept_clearance(
             break
         fractions = np.arange(1, SUBDIVISIONS) / SUBDIVISIONS
         inner = start_t[refine, None] + h[refine, None] * fractions  # (r, S - 1)
-        q_in, dq_in, _ = motion(inner.ravel())
+        q_in, dq_in, ddq_in = motion(inner.ravel())
         d_in = clearance(model, q_in, keep_out=keep_out).pair_distance
+        _check_finite(inner.ravel(), dq_in, ddq_in, d_in)
+        accel = np.maximum(accel, np.abs(ddq_in).max(axis=0))  # the refined samples' too
         refined += inner.size
         sampled_min = np.minimum(sampled_min, d_in.min(axis=0))
         r, n_p = int(refine.sum()), distance.shape[1]
@@ -262,3 +271,13 @@ def swept_clearance(
         samples=int(t.size),
         refined_samples=refined,
     )
+
+
+def _check_finite(t: FloatArray, dq: FloatArray, ddq: FloatArray, distance: FloatArray) -> None:
+    """A motion with a NaN or infinite rate, acceleration or distance has no bound: one line."""
+    bad = ~(np.isfinite(dq).all(axis=-1) & np.isfinite(ddq).all(axis=-1) & np.isfinite(distance).all(axis=-1))
+    if bad.any():
+        raise ConfigurationError(
+            f"the motion's rates, accelerations or clearances are not finite at t = {float(np.ravel(t)[np.argmax(bad)]):g} s: "
+            "no bound between its samples"
+        )

@@ -79,6 +79,7 @@ AUDIT_JUMP_COLUMNS = (
     "jump.jump_after",
     "jump.mean_reduction",
     "jump.limits_ok",
+    "jump.infeasible",
     "jump.clearance.compensated.collides",
 )
 

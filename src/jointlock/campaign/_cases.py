@@ -152,8 +152,8 @@ UNKEYED_WHEN_UNSET = (
 def case_key(scenario: Scenario, campaign_seed: int) -> str:
     """Hash (24 hex digits of SHA-256) of a case's fully resolved inputs: the resolved
     scenario without its title, description and output folder (nor the fields of
-    :data:`UNKEYED_WHEN_UNSET` while unset), a model file by its name and content, the campaign
-    seed and :data:`KEY_FORMAT`."""
+    :data:`UNKEYED_WHEN_UNSET` while unset), a model file and an SRDF by name and content, the
+    campaign seed and :data:`KEY_FORMAT`."""
     # the resolved data as Scenario.to_dict gives it, without copying it: only serialised here
     data = {
         key: value
@@ -168,6 +168,8 @@ def case_key(scenario: Scenario, campaign_seed: int) -> str:
     robot = Path(str(data["robot"]))
     if robot.suffix.lower() in (".toml", ".urdf"):
         data["robot"] = {"file": robot.name, "sha256": _file_digest(str(robot))}
+    if data.get("srdf"):  # as the robot: by name and content, not where the folder lies
+        data["srdf"] = {"file": Path(str(data["srdf"])).name, "sha256": _file_digest(str(data["srdf"]))}
     payload = json.dumps(
         {"format": KEY_FORMAT, "campaign_seed": campaign_seed, "scenario": data},
         sort_keys=True,

@@ -221,6 +221,13 @@ def _warn_ignored(args: argparse.Namespace) -> None:
                 else "a constant kappa verified at every step, no sampling or fit"
             )
             warnings.warn(f"{', '.join(ignored)} ignored with {mode} ({what})", UserWarning, stacklevel=2)
+    if args.on_infeasible == "report" and (args.fail_at is None or args.kappa is not None):
+        warnings.warn(
+            "--on-infeasible report is used with --fail-at and the kappa search only (a sweep reports its failure "
+            "times without a feasible kappa; a given kappa is verified as it is)",
+            UserWarning,
+            stacklevel=2,
+        )
 
 
 def run(args: argparse.Namespace) -> int:

@@ -52,6 +52,13 @@ def _check_jump(out: dict[str, Any], source: str, model: Any) -> None:
             raise ScenarioError(
                 f"{source}: jump.{twice[0]} and the Cartesian [task] both give the task; give it once, in [task]"
             )
+        time_s = out["failure"]["time_s"]
+        if time_s is not None and (j["sweep"] is not None or (j["fail_at"] is not None and j["fail_at"] != time_s)):
+            given = "jump.sweep" if j["sweep"] is not None else f"jump.fail_at = {j['fail_at']:g} s"
+            raise ScenarioError(
+                f"{source}: {given} with a Cartesian [task] and failure.time_s = {time_s:g} s: every job starts from "
+                "the task at failure.time_s, the jump study too; leave it out (or leave out failure.time_s to sweep)"
+            )
         task_base = (out.get("task") or {}).get("base")
         if j["base"] is not None and task_base is not None and j["base"] != task_base:
             raise ScenarioError(

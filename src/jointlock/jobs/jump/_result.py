@@ -255,20 +255,25 @@ def _run_clearance(model: ArmModel, run: Trajectory) -> dict[str, Any]:
         model, motion, run.t, floor, sampled=(run.q, rates, np.zeros_like(rates), steps.pair_distance)
     )
     at = steps.worst()
-    worst = between.worst()  # the pair furthest below its floor
     collides = bool(between.shortfall > 0)
+    # the pair that breaks its floor most (on a step first, else between steps); when none does,
+    # the smallest bound counted as Clearance.distance counts (a mounted pair only below its floor)
+    at_steps = floor - between.sampled_min  # > 0: below the floor on a step (or a refined sample)
+    worst = int(np.argmax(at_steps)) if at_steps.max() > 0 else int(np.argmax(floor - between.lower_bound))
+    ranked = np.where(steps.mounted_pairs & (between.lower_bound >= floor - between.tolerance), np.inf, between.lower_bound)
+    smallest = worst if collides else int(np.argmin(ranked))
     deepest = int(np.argmin(steps.pair_distance[:, worst]))
     return {
         "min_clearance_m": float(steps.distance[at]),
         "closest_pair": steps.pair_at(at),
         "time_s": float(run.t[at[0]]) if at else 0.0,
-        "between_steps_min_m": float(between.lower_bound[worst]),
-        "between_steps_pair": between.names[worst],
+        "between_steps_min_m": float(between.lower_bound[smallest]),
+        "between_steps_pair": between.names[smallest],
         "collides": collides,
         "colliding_pair": between.names[worst] if collides else None,
         "colliding_min_m": float(steps.pair_distance[deepest, worst]) if collides else None,
         "colliding_time_s": float(run.t[deepest]) if collides else None,
-        "colliding_at_steps": bool(steps.pair_distance[deepest, worst] < floor[worst]) if collides else None,
+        "colliding_at_steps": bool(at_steps[worst] > 0) if collides else None,
     }
 
 
@@ -343,12 +348,13 @@ def _single_json(robot: str, sc: JumpScenario, r: JumpAtTime) -> dict:
         "scenario": sc.to_fields(),
         "lock_joint": sc.lock_joint,
         "fail_time_s": r.fail_time,
-        "kappa": r.kappa,
+        # no kappa keeps the limits (reported): the jump is the uncompensated one, there is no kappa
+        "kappa": None if r.infeasible is not None else r.kappa,
         "kappa_unit": KAPPA_UNIT,
         "kappa_interval": r.interval,
         "jump_before": r.jump_before,
         "jump_after": r.jump_after,
-        "mean_reduction": r.reduction,
+        "mean_reduction": None if r.infeasible is not None else r.reduction,
         "share_improved": improved_share(r.jump_before, r.jump_after),
         "limits_ok": r.limits_after.ok,
         "joint_jump_before_rad_s": r.joint_jump_before,

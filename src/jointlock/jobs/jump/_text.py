@@ -32,8 +32,8 @@ def _deg(rad_s: float) -> float:
     return math.degrees(rad_s)
 
 
-def _kappa(value: float) -> str:
-    return f"{value:.6g} {KAPPA_UNIT}"
+def _kappa(value: float | None) -> str:
+    return "none" if value is None else f"{value:.6g} {KAPPA_UNIT}"
 
 
 def _interval_text(r: dict, given: bool) -> str:
@@ -67,7 +67,7 @@ def summary_lines(r: Mapping[str, Any], *, kappa_given: bool = False) -> list[st
             f"failure at {r['fail_time_s']:g} s, kappa = {_kappa(r['kappa'])} "
             f"({_interval_text(dict(r), kappa_given)})",
             f"joint jump ||dq||: {_deg(r['jump_before']):.5g} -> {_deg(r['jump_after']):.5g} deg/s "
-            f"({_less(r['mean_reduction'])})",
+            f"({'not compensated' if r.get('infeasible') else _less(r['mean_reduction'])})",
             f"without re-planning: locked joint stops from {_deg(r['joint_jump_noreplan_before']):.5g} / "
             f"{_deg(r['joint_jump_noreplan_after']):.5g} deg/s; task jump {r['task_jump_noreplan_before_m_s']:.4g} / "
             f"{r['task_jump_noreplan_after_m_s']:.4g} m/s (re-planned: {r['task_jump_replan_after_m_s']:.2g} m/s)",

@@ -58,15 +58,22 @@ def clearance_shortfall(
 
 
 def halt_swept_clearance(
-    problem: HaltProblem, k: float, floor: FloatArray, keep_out: Sequence[Shape] = ()
+    problem: HaltProblem,
+    k: float,
+    floor: FloatArray,
+    keep_out: Sequence[Shape] = (),
+    *,
+    sampled: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = None,
 ) -> SweptClearance:
     """The clearance of the halt at a shared ``k`` [rad/s^6] on the constraint grid and between
-    its samples (:func:`jointlock.sweep.swept_clearance`), each pair held to ``floor`` (P,) [m]."""
+    its samples (:func:`jointlock.sweep.swept_clearance`), each pair held to ``floor`` (P,) [m];
+    ``sampled``: the grid's q, dq, ddq and distances, already computed."""
 
     def motion(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         return problem.trajectory(k, t)
 
-    return swept_clearance(problem.model, motion, problem.times(problem.n_check), floor, keep_out=keep_out)
+    t = problem.times(problem.n_check)
+    return swept_clearance(problem.model, motion, t, floor, keep_out=keep_out, sampled=sampled)
 
 
 def _floor(problem: HaltProblem, margin: float, keep_out: Sequence[Shape]) -> FloatArray:
@@ -78,7 +85,10 @@ def _floor(problem: HaltProblem, margin: float, keep_out: Sequence[Shape]) -> Fl
 def _shortfall_at(
     problem: HaltProblem, k: FloatArray, t: FloatArray, floor: FloatArray, keep_out: Sequence[Shape]
 ) -> FloatArray:
-    """(K,) the largest shortfall [m] of the halts at ``k`` (K,) over the times ``t`` (n_t,)."""
+    """(K,) the largest shortfall [m] of the halts at ``k`` (K,) over the times ``t`` (n_t,)
+    (-inf when there are no times)."""
+    if t.size == 0:
+        return np.full(k.size, -np.inf)
     out = np.empty(k.size)
     step = max(1, CHUNK_SAMPLES // t.size)
     for start in range(0, k.size, step):
@@ -125,26 +135,26 @@ def keeps_clearance(
         if alive.any() and level.any():
             screen[alive] = np.maximum(screen[alive], _shortfall_at(problem, k[alive], t[level], floor, keep_out))
         seen |= level
-    screened = seen
-    ok = screen <= 0.0
-    if any_one:
-        found = np.zeros_like(ok)
-        for i in np.flatnonzero(ok)[np.argsort(screen[ok], kind="stable")]:
-            if _shortfall_at(problem, k[i : i + 1], t[~screened], floor, keep_out)[0] <= 0.0 and _clear_between(
-                problem, float(k[i]), floor, keep_out
-            ):
-                found[i] = True
-                break
-        return found
-    if ok.any():
-        ok[ok] = _shortfall_at(problem, k[ok], t[~screened], floor, keep_out) <= 0.0
-    for i in np.flatnonzero(ok):  # clear on every sample: between the samples too?
-        ok[i] = _clear_between(problem, float(k[i]), floor, keep_out)
+    survivors = np.flatnonzero(screen <= 0.0)
+    if any_one:  # the clearest on the screen first
+        survivors = survivors[np.argsort(screen[survivors], kind="stable")]
+    ok = np.zeros(k.size, dtype=bool)
+    for i in survivors:
+        ok[i] = _clear_everywhere(problem, float(k[i]), t, floor, keep_out)
+        if any_one and ok[i]:
+            break
     return ok
 
 
-def _clear_between(problem: HaltProblem, k: float, floor: FloatArray, keep_out: Sequence[Shape]) -> bool:
-    return bool(halt_swept_clearance(problem, k, floor, keep_out).shortfall <= 0.0)
+def _clear_everywhere(
+    problem: HaltProblem, k: float, t: FloatArray, floor: FloatArray, keep_out: Sequence[Shape]
+) -> bool:
+    """Whether the halt at ``k`` keeps ``floor`` on every check time ``t`` and between them."""
+    q, dq, ddq = problem.trajectory(k, t)
+    distance = clearance(problem.model, q, keep_out=keep_out).pair_distance
+    if distance.shape[-1] and float((floor - distance).max()) > 0.0:
+        return False
+    return bool(halt_swept_clearance(problem, k, floor, keep_out, sampled=(q, dq, ddq, distance)).shortfall <= 0.0)
 
 
 def clear_k_segments(
