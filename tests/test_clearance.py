@@ -614,3 +614,20 @@ def test_a_report_opens_with_the_clearance_verdict(tmp_path):
     assert page[first:].startswith('<h2 id="') and "Clearance: read this first" in page[first : first + 200]
     assert "the state at failure already reaches 0.051 m into link3 - bus" in page
     assert page.index("Clearance: read this first</h2>") < page.index("Scenario</h2>")
+
+
+def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance():
+    """000's scenario on the configuration whose limits' optimum comes closer (as in
+    test_the_halt_motion_moves_k_to_keep_the_clearance): the vector solver's per-joint optimum
+    comes closer too, so the halt is the best shared k that keeps the clearance, and says so."""
+    from jointlock.planning.halt_motion import clearance_shortfall
+
+    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    alone = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, solver="vector", clearance=jl.ClearanceSettings.off())
+    assert alone.motion.per_joint
+    assert clearance_shortfall(alone.problem, np.asarray(alone.motion.k), 0.05, per_joint=True) > 0
+    vector = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, solver="vector")
+    assert not vector.motion.per_joint and vector.motion.solver == "scan"
+    assert vector.collision_free is True and vector.feasible
+    assert vector.notes[0].startswith("solver 'vector': the per-joint optimum comes closer than allowed (0.05 m)")
+    assert float(vector.motion.k) == pytest.approx(float(kept.motion.k), rel=1e-9)  # the shared k kept

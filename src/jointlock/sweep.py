@@ -115,6 +115,8 @@ class SweptClearance:
         (P,) the middle of the interval that gives it [s].
     sampled_min
         (P,) each pair's smallest distance on the samples, the refined ones included [m].
+    grid_min
+        (P,) the same on the samples given (``t``) only [m].
     floor
         (P,) the distance each pair must keep [m].
     names
@@ -128,6 +130,7 @@ class SweptClearance:
     lower_bound: FloatArray
     lower_bound_time: FloatArray
     sampled_min: FloatArray
+    grid_min: FloatArray
     floor: FloatArray
     names: tuple[str, ...]
     tolerance: float
@@ -136,9 +139,11 @@ class SweptClearance:
 
     @property
     def sampled_shortfall(self) -> float:
-        """The most by which a sample comes closer than its pair's floor [m], beyond
-        :data:`ROUND_OFF_M` (<= 0: none)."""
-        return float((self.floor - ROUND_OFF_M - self.sampled_min).max()) if self.names else -np.inf
+        """The most by which a sample comes closer than its pair's floor [m]: a sample given
+        exactly, a refined one beyond :data:`ROUND_OFF_M` (<= 0: none)."""
+        if not self.names:
+            return -np.inf
+        return float(max((self.floor - self.grid_min).max(), (self.floor - ROUND_OFF_M - self.sampled_min).max()))
 
     @property
     def shortfall(self) -> float:
@@ -265,6 +270,7 @@ def swept_clearance(
         lower_bound=lower,
         lower_bound_time=lower_time,
         sampled_min=sampled_min,
+        grid_min=distance.min(axis=0),
         floor=np.array(floor),
         names=pairs.names,
         tolerance=float(tolerance),

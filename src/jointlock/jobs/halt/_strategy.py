@@ -377,10 +377,11 @@ def plan_halt(
     if qf is not None:  # checked by HaltProblem first: one value or one per healthy joint
         _check_qf_clearance(model, problem.qf, clearance, _names["qf"])
     bar = Progress(ga.n_gen, "GA generations", enabled=None if progress else False) if solver == "ga" else None
-    def solve(k_bounds: tuple[float, float] | None = None) -> HaltMotion:
+    def solve(k_bounds: tuple[float, float] | None = None, with_solver: Solver | None = None) -> HaltMotion:
         return optimal_halt_motion(
-            problem, solver=solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T,
-            progress=bar if k_bounds is None else None, prefer_margin=prefer_margin, k_bounds=k_bounds,
+            problem, solver=with_solver or solver, rng=rng, ga_settings=ga, find_minimum_T=minimum_T,
+            progress=bar if k_bounds is None and with_solver is None else None, prefer_margin=prefer_margin,
+            k_bounds=k_bounds,
         )  # fmt: skip
 
     motion = solve()
@@ -423,17 +424,25 @@ def _keep_clear(
     keeps it; else the best optimum over the stretches of the feasible ``k`` whose halts keep
     it (:func:`~jointlock.planning.halt_motion.clear_k_segments`, each solved with
     ``k_bounds``; the result keeps the limits' interval of ``k``, the note gives the stretch);
-    else the optimum as it is (reported as colliding).  Shared ``k`` (solver "scan" or "ga")
-    only: the per-joint solver's halt is reported, with a note.  Returns the motion and the
-    notes."""
+    else the optimum as it is (reported as colliding).  The per-joint solver's halt when it keeps
+    the clearance; else the best shared ``k`` of solver "scan" that keeps it, with a note.  Returns
+    the motion and the notes."""
     problem = motion.problem
     if not settings.required or not motion.feasible or not collision_pairs(problem.model, settings.keep_out).names:
         return motion, ()
     margin, keep_out = settings.margin, settings.keep_out
-    if not _keeps_clearance_as_constraint(motion, settings):
+    if motion.per_joint:
+        if clearance_shortfall(problem, np.asarray(motion.k), margin, keep_out, per_joint=True) <= 0:
+            return motion, ()
+        shared, notes = _keep_clear(solve(None, "scan"), settings, lambda segment: solve(segment, "scan"))
+        if shared.feasible and clearance_shortfall(problem, np.asarray(float(shared.k)), margin, keep_out) <= 0:
+            return shared, (
+                f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m); the halt is the best "
+                "shared k that keeps the clearance (solver 'scan')",
+            ) + notes
         return motion, (
-            "solver 'vector' (one k per joint) does not keep the clearance, it reports it: solver 'scan' or 'ga' "
-            "restricts the shared k to the halts that keep it",
+            f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m), and no shared k keeps "
+            "the clearance either: the halt below is the per-joint optimum over the limits alone",
         )
     if clearance_shortfall(problem, np.asarray(float(motion.k)), margin, keep_out) <= 0:
         return motion, ()

@@ -45,32 +45,36 @@ SCREEN_LEVELS = (0, 128, SCREEN_STRIDE)
 
 
 def clearance_shortfall(
-    problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = ()
+    problem: HaltProblem, k: FloatArray, margin: float, keep_out: Sequence[Shape] = (), *, per_joint: bool = False
 ) -> FloatArray:
     """(...) the largest amount [m] by which a halt at ``k`` (...) [rad/s^6] comes closer than
     allowed (for each pair the smaller of its allowance, ``margin`` or 0 for a mounted pair, and
     its distance at ``t = 0``): on the constraint grid, or between its samples by more than the
-    tunnelling tolerance (:func:`halt_swept_clearance`); <= 0: clear."""
+    tunnelling tolerance (:func:`halt_swept_clearance`); <= 0: clear.  ``per_joint``: ``k`` is
+    one halt's (n,) per-joint ``k`` (the vector solver's); the result a 0-d array."""
     k = np.asarray(k, dtype=float)
     floor = _floor(problem, margin, keep_out)
+    if per_joint:
+        return np.asarray(halt_swept_clearance(problem, k, floor, keep_out).shortfall)
     out = [halt_swept_clearance(problem, float(x), floor, keep_out).shortfall for x in k.reshape(-1)]
     return np.array(out).reshape(k.shape)
 
 
 def halt_swept_clearance(
     problem: HaltProblem,
-    k: float,
+    k: float | FloatArray,
     floor: FloatArray,
     keep_out: Sequence[Shape] = (),
     *,
     sampled: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = None,
 ) -> SweptClearance:
-    """The clearance of the halt at a shared ``k`` [rad/s^6] on the constraint grid and between
-    its samples (:func:`jointlock.sweep.swept_clearance`), each pair held to ``floor`` (P,) [m];
-    ``sampled``: the grid's q, dq, ddq and distances, already computed."""
+    """The clearance of the halt at a shared ``k`` [rad/s^6] (or (n,) per joint) on the
+    constraint grid and between its samples (:func:`jointlock.sweep.swept_clearance`), each pair
+    held to ``floor`` (P,) [m]; ``sampled``: the grid's q, dq, ddq and distances, already computed."""
+    per_joint = np.ndim(k) == 1
 
     def motion(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
-        return problem.trajectory(k, t)
+        return problem.trajectory(k, t, per_joint=per_joint)
 
     t = problem.times(problem.n_check)
     return swept_clearance(problem.model, motion, t, floor, keep_out=keep_out, sampled=sampled)
