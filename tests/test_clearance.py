@@ -631,3 +631,8 @@ def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance(
     assert vector.collision_free is True and vector.feasible
     assert vector.notes[0].startswith("solver 'vector': the per-joint optimum comes closer than allowed (0.05 m)")
     assert float(vector.motion.k) == pytest.approx(float(kept.motion.k), rel=1e-9)  # the shared k kept
+    assert vector.to_dict()["notes"][0] == vector.notes[0]  # said in the JSON too
+    from jointlock.errors import ConfigurationError
+
+    with pytest.raises(ConfigurationError, match=r"per_joint: k must be one halt's per-joint k, shape \(6,\)"):
+        clearance_shortfall(alone.problem, np.zeros((2, 6)), 0.05, per_joint=True)

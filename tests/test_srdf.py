@@ -129,3 +129,11 @@ def test_a_campaign_keys_the_srdf_by_content_and_another_robots_srdf_is_said(tmp
     other.write_text("<robot><disable_collisions link1='wheel' link2='mast'/></robot>")
     with pytest.warns(UserWarning, match="is it this robot's SRDF"):
         jl.load_robot(urdf, chain=UrdfChain(tip_link="panda_hand", srdf=str(other)))
+
+
+@pytest.mark.parametrize("pair", [("a", "b", "c"), "ab", ("a", 3)])
+def test_disabled_pairs_must_be_two_names(pair):
+    from jointlock.geometry import with_disabled_pairs
+
+    with pytest.raises(ModelError, match="pairs of shape names"):
+        with_disabled_pairs(jl.load_robot("puma6"), [pair])

@@ -58,6 +58,9 @@ def with_disabled_pairs(model: ArmModel, pairs: Sequence[tuple[str, str]]) -> Ar
     already; the arm before its locks (``unlocked``) disables them too.  Pairs that name no shape
     of the model are kept (an SRDF covers the whole robot, a chain only part of it); when none of
     ``pairs`` names one, a ``UserWarning`` says so (another robot's SRDF?)."""
+    for pair in pairs:
+        if isinstance(pair, str) or len(pair) != 2 or not all(isinstance(n, str) for n in pair):
+            raise ModelError(f"disabled pairs must be pairs of shape names (two strings each); got {pair!r}")
     names = {s.name for body in (model.root_body, *model.bodies) for s in body.shapes}
     if pairs and not any(a in names or b in names for a, b in pairs):
         warnings.warn(

@@ -269,6 +269,7 @@ class HaltPlan(JobResult):
             "velocity_limit_deg_s": np.degrees(p.dq_max),
             "acceleration_limit_deg_s2": np.degrees(p.ddq_max),
             "solver": res.solver,
+            "notes": list(self.notes),  # how it was planned: e.g. a solver's fallback to keep the clearance
             "seed": res.seed,
             # 000's printed numbers, for 000 §5's scenario on halt7 only (None otherwise)
             "paper": dict(p000.HALT_RESULTS) if self.paper_scenario else None,

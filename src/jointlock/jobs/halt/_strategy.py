@@ -412,8 +412,9 @@ def plan_halt(
 
 
 def _keeps_clearance_as_constraint(motion: HaltMotion, settings: ClearanceSettings) -> bool:
-    """Whether the halt keeps the clearance as a constraint: required, shapes to check, and a
-    shared ``k`` (the per-joint solver's halt is reported only)."""
+    """Whether the halt's smallest clear halt time applies: the clearance required, shapes to
+    check, and a shared ``k`` (the per-joint solver keeps the clearance by falling back to a
+    shared ``k``, ``_keep_clear``)."""
     return settings.required and not motion.per_joint and bool(collision_pairs(motion.problem.model, settings.keep_out).names)
 
 
@@ -435,15 +436,14 @@ def _keep_clear(
         if clearance_shortfall(problem, np.asarray(motion.k), margin, keep_out, per_joint=True) <= 0:
             return motion, ()
         shared, notes = _keep_clear(solve(None, "scan"), settings, lambda segment: solve(segment, "scan"))
+        head = f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m)"
         if shared.feasible and clearance_shortfall(problem, np.asarray(float(shared.k)), margin, keep_out) <= 0:
             return shared, (
-                f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m); the halt is the best "
-                "shared k that keeps the clearance (solver 'scan')",
+                f"{head}; the halt is the best shared k that keeps the clearance (solver 'scan', on the limits the "
+                "vector solver keeps)",
             ) + notes
-        return motion, (
-            f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m), and no shared k keeps "
-            "the clearance either: the halt below is the per-joint optimum over the limits alone",
-        )
+        why = "no shared k keeps the clearance either" if shared.feasible else "no shared k keeps the limits"
+        return motion, (f"{head}, and {why}: the halt below is the per-joint optimum over the limits alone",)
     if clearance_shortfall(problem, np.asarray(float(motion.k)), margin, keep_out) <= 0:
         return motion, ()
     lo, hi = (float(v) for v in motion.k_interval)

@@ -258,7 +258,7 @@ def _run_clearance(model: ArmModel, run: Trajectory) -> dict[str, Any]:
     collides = bool(between.shortfall > 0)
     # the pair that breaks its floor most (on a step first, else between steps); when none does,
     # the smallest bound counted as Clearance.distance counts (a mounted pair only below its floor)
-    at_steps = floor - between.sampled_min  # > 0: below the floor on a step (or a refined sample)
+    at_steps = floor - between.grid_min  # > 0: below the floor on a control step
     worst = int(np.argmax(at_steps)) if at_steps.max() > 0 else int(np.argmax(floor - between.lower_bound))
     ranked = np.where(steps.mounted_pairs & (between.lower_bound >= floor - between.tolerance), np.inf, between.lower_bound)
     smallest = worst if collides else int(np.argmin(ranked))

@@ -22,6 +22,7 @@ import numpy as np
 
 from ..._search1d import bisect_boundary, true_segments
 from ...collision import clearance
+from ...errors import ConfigurationError
 from ...model import FloatArray
 from ...shapes import Shape
 from ...sweep import SweptClearance, swept_clearance
@@ -55,7 +56,11 @@ def clearance_shortfall(
     k = np.asarray(k, dtype=float)
     floor = _floor(problem, margin, keep_out)
     if per_joint:
-        return np.asarray(halt_swept_clearance(problem, k, floor, keep_out).shortfall)
+        if k.shape != (problem.dof,):
+            raise ConfigurationError(
+                f"per_joint: k must be one halt's per-joint k, shape ({problem.dof},) [rad/s^6]; got shape {k.shape}"
+            )
+        return np.asarray(halt_swept_clearance(problem, k, floor, keep_out, per_joint=True).shortfall)
     out = [halt_swept_clearance(problem, float(x), floor, keep_out).shortfall for x in k.reshape(-1)]
     return np.array(out).reshape(k.shape)
 
@@ -66,12 +71,13 @@ def halt_swept_clearance(
     floor: FloatArray,
     keep_out: Sequence[Shape] = (),
     *,
+    per_joint: bool = False,
     sampled: tuple[FloatArray, FloatArray, FloatArray, FloatArray] | None = None,
 ) -> SweptClearance:
-    """The clearance of the halt at a shared ``k`` [rad/s^6] (or (n,) per joint) on the
-    constraint grid and between its samples (:func:`jointlock.sweep.swept_clearance`), each pair
-    held to ``floor`` (P,) [m]; ``sampled``: the grid's q, dq, ddq and distances, already computed."""
-    per_joint = np.ndim(k) == 1
+    """The clearance of the halt at a shared ``k`` [rad/s^6] (``per_joint``: (n,), one per
+    joint) on the constraint grid and between its samples (:func:`jointlock.sweep.
+    swept_clearance`), each pair held to ``floor`` (P,) [m]; ``sampled``: the grid's q, dq, ddq
+    and distances, already computed."""
 
     def motion(t: FloatArray) -> tuple[FloatArray, FloatArray, FloatArray]:
         return problem.trajectory(k, t, per_joint=per_joint)
