@@ -6,7 +6,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ..errors import JointlockError, ScenarioError
-from ._task import CARTESIAN_FIELDS, cartesian_base, cartesian_fields, cartesian_given
+from ._task import CARTESIAN_FIELDS, cartesian_base, cartesian_fields, cartesian_given, in_table
 
 #: JumpScenario fields a [jump] table may set.
 JUMP_SCENARIO_FIELDS = (
@@ -74,10 +74,7 @@ def _check_jump(out: dict[str, Any], source: str, model: Any) -> None:
     try:
         sc = scenario_from_mapping(jump_fields(out), source=f"{source}: [jump]")
     except JointlockError as exc:
-        if str(exc).startswith(source):
-            raise
-
-        raise ScenarioError(f"{source}: [jump]: {exc}") from None
+        raise in_table(exc, source, "jump") from None
     if len(sc.q0) != model.dof:
         raise ScenarioError(
             f"{source}: jump.q0_deg needs {model.dof} values (every joint of {model.name}); got {len(sc.q0)}"

@@ -18,7 +18,7 @@ from typing import Any
 import numpy as np
 
 from ..bounds import shown
-from ..errors import ScenarioError
+from ..errors import JointlockError, ScenarioError
 from ..io.files import check_path_text
 from ..planning.task import Task, load_task_file
 
@@ -91,9 +91,14 @@ def scenario_task(out: dict[str, Any], source: str = "scenario") -> Task | None:
     return Task.from_waypoints(t["waypoints_deg"], t["durations_s"], t["scaling"], source=f"{source}: [task]")
 
 
+def in_table(exc: JointlockError, source: str, table: str) -> JointlockError:
+    """``exc`` raised while reading the scenario's ``[table]``: as it is when it names ``source``
+    already, else a :class:`~jointlock.errors.ScenarioError` saying where (one line)."""
+    return exc if str(exc).startswith(source) else ScenarioError(f"{source}: [{table}]: {exc}")
+
+
 def _cartesian_task(out: dict[str, Any], source: str) -> Task:
     """001's Cartesian task of the scenario as a joint motion (the arm loaded with the task's base)."""
-    from ..errors import JointlockError
     from ..planning.jump import cartesian_task, scenario_from_mapping
     from ..robots import UrdfChain, load_robot
 
@@ -107,9 +112,7 @@ def _cartesian_task(out: dict[str, Any], source: str) -> Task:
         task = scenario_from_mapping(cartesian_fields(out), source=f"{source}: [task]")
         model = load_robot(out["robot"], base=task.base, chain=UrdfChain.from_fields(out))
     except JointlockError as exc:
-        if str(exc).startswith(source):
-            raise
-        raise ScenarioError(f"{source}: [task]: {exc}") from None
+        raise in_table(exc, source, "task") from None
     if len(task.q0) != model.dof:
         raise ScenarioError(
             f"{source}: task.q0_deg needs {model.dof} values (every joint of {model.name}); got {len(task.q0)}"

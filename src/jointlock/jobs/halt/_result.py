@@ -16,14 +16,6 @@ from ...analysis.actuators import ActuatorLoads, actuator_loads
 from ...analysis.attitude_control import AttitudeControlCheck, WheelCapacity, attitude_control_check
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
 from ...collision import Clearance, ClearanceSettings, clearance, collision_pairs
-from ...io.files import (
-    atomic_write_bytes,
-    atomic_write_json,
-    atomic_write_text,
-    csv_text,
-    npz_bytes,
-    write_figure,
-)
 from ...kinematics import generalized_jacobian, jacobian
 from ...model import ArmModel
 from ...papers import p000
@@ -35,25 +27,17 @@ from ...planning.halt_motion import (
     HaltMotion,
     HaltProblem,
     base_torque_history,
-    clear_T_range,
     halt_objective,
     infeasibility_message,
 )
-from ...plots._common import offscreen_figure
 from ...plots.halt import (
-    global_torque_curve,
     k_text,
-    plot_actuator_loads,
-    plot_base_torque_vs_time,
-    plot_clearance,
-    plot_global_torque_vs_k,
-    plot_joint_profiles,
-    plot_spacecraft_response,
 )
 from ...plots.motion import ArmMotion
-from ...sweep import swept_clearance
 from .._common import AT_LIMIT, JobResult, locked_deg, locked_text
 from .._motions import halt_motions
+from ._clearance import clearance_report, collision_line, minimum_T_clear_lines
+from ._files import write_halt_files
 from ._inputs import JointLimits, limits_text
 from ._text import (
     MOMENT_TEXT,
@@ -310,92 +294,22 @@ class HaltPlan(JobResult):
         return cached_on(self, "clearance", compute)
 
     def _clearance_dict(self) -> dict[str, Any] | None:
-        return cached_on(self, "clearance_dict", self._compute_clearance_dict)
+        """:func:`~._clearance.clearance_report` of the halt (None without collision shapes)."""
 
-    def _compute_clearance_dict(self) -> dict[str, Any] | None:
-        motion = self.clearance()
-        if motion is None:
-            return None
-        t = self.problem.times(self.problem.n_check)
-        d = motion.pair_distance  # (n_check, P)
-        # a pair already closer than allowed at the failure may not come closer still
-        allowed = np.where(motion.mounted_pairs, 0.0, self.clearance_settings.margin)
-        floor = np.minimum(allowed, d[0])
-        shortfall = floor - d  # > 0: closer than allowed, and than at the start
-        between = swept_clearance(
-            self.problem.model, self.motion.trajectory, t, floor, keep_out=self.clearance_settings.keep_out,
-            sampled=(*self.motion.trajectory(t), d),
-        )  # fmt: skip
-        collides = bool(np.any(shortfall > 0))
-        at, pair = np.unravel_index(int(np.argmax(shortfall) if collides else np.argmin(d)), d.shape)
-        start_pair = int(np.argmax(allowed - d[0]))
-        swept_pair = between.worst()
-        return {
-            "halt_configuration_m": float(motion.distance[-1]),
-            "halt_configuration_pair": motion.pair_at((motion.distance.size - 1,)),
-            "start_m": float(d[0, start_pair]),
-            "start_pair": motion.names[start_pair],
-            "start_closer_than_allowed": bool(allowed[start_pair] > d[0, start_pair]),
-            "motion_min_m": float(d[at, pair]),
-            "motion_min_pair": motion.names[pair],
-            "motion_min_time_s": float(t[at]),
-            "between_samples_min_m": float(between.lower_bound[swept_pair]),
-            "between_samples_pair": motion.names[swept_pair],
-            "between_samples_time_s": float(between.lower_bound_time[swept_pair]),
-            "between_samples_clear": bool(between.shortfall <= 0),
-            "tunnelling_tolerance_m": between.tolerance,
-            "refined_samples": between.refined_samples,
-            "required_m": self.clearance_settings.min_m,
-            "collides": collides or bool(between.shortfall > 0),
-            "collides_at_samples": collides,
-            "worst_shortfall_m": float(max(shortfall.max(), between.shortfall, 0.0)),
-            "samples": int(motion.distance.size),
-            "mounted_pairs": list(motion.mounted),
-        }
+        def compute() -> dict[str, Any] | None:
+            sampled = self.clearance()
+            return None if sampled is None else clearance_report(self.motion, self.clearance_settings, sampled)
+
+        return cached_on(self, "clearance_dict", compute)
 
     def _collision_line(self) -> list[str]:
         """The first line of the summary when the halt comes closer than required."""
-        data = self._clearance_dict()
-        if data is None or not (data["collides"] or data["start_closer_than_allowed"]):
-            return []
-
-        def reach(d: float) -> str:
-            return f"{-d:.3f} m into" if d < 0 else f"within {d:.3f} m of"
-
-        head = "COLLIDES" if data["collides"] else "CLEARANCE"
-        minimum = self.clearance_settings.min_m
-        required = "clearance reported, not required" if minimum is None else f"required {minimum:g} m"
-        text = f"{head}: "
-        if data["start_closer_than_allowed"]:
-            text += (
-                f"the state at failure already reaches {reach(data['start_m'])} {data['start_pair']} ({required}: "
-                f"check the state, or the collision geometry: {self.problem.model.name}'s is documented with its "
-                "factory); "
-            )
-        if data["collides_at_samples"]:
-            text += f"the halt reaches {reach(data['motion_min_m'])} {data['motion_min_pair']} at t = {data['motion_min_time_s']:.3g} s"
-        elif data["collides"]:
-            text += (
-                f"between its samples the halt may reach {reach(data['between_samples_min_m'])} "
-                f"{data['between_samples_pair']} near t = {data['between_samples_time_s']:.3g} s (a bound on how far "
-                "the links can move between two samples)"
-            )
-        else:
-            text += "the halt comes no closer"
-        text += f"; the halt configuration keeps {data['halt_configuration_m']:+.3f} m ({data['halt_configuration_pair']})"
-        return [text]
+        return collision_line(self._clearance_dict(), self.clearance_settings, self.problem.model.name)
 
     def _minimum_T_clear_lines(self) -> list[str]:
         if not self.clearance_checked_for_T:
             return []
-        margin = self.clearance_settings.margin
-        if self.minimum_T_clear is None:
-            return [
-                f"  no halt time up to {clear_T_range(self.problem.T, cast(float, self.motion.minimum_T)):.3g} s keeps the "
-                f"clearance ({margin:g} m) as well "
-                "(for this halt configuration)"
-            ]
-        return [f"  keeping the clearance ({margin:g} m) as well: T = {self.minimum_T_clear:.3f} s"]
+        return minimum_T_clear_lines(self.motion, self.clearance_settings.margin, self.minimum_T_clear)
 
     def sigma_min_at_failure(self) -> float:
         """Smallest singular value of the locked arm's Jacobian at the state at failure (how
@@ -632,76 +546,5 @@ class HaltPlan(JobResult):
 
     def write(self, out: str | Path) -> list[str]:
         """Plots like 000 Figs. 8-9, base torque vs time, time series (CSV, NPZ) and
-        result.json in ``out``; returns the file names."""
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        res, p = self.motion, self.problem
-        grid, tau = global_torque_curve(res)
-        ts = self.time_series()
-        figures: tuple[Any, ...] = (
-            (
-                "global_torque_vs_k.png",
-                (7, 4),
-                # laid out: the x label's superscript reaches past the edge (a costlier crop)
-                lambda fig: plot_global_torque_vs_k(res, ax=fig.add_subplot()).figure.tight_layout(),
-            ),
-            ("joint_profiles.png", (3 * p.dof, 7), lambda fig: plot_joint_profiles(res, fig=fig)),
-            (
-                "base_torque_vs_time.png",
-                (7, 4),
-                lambda fig: plot_base_torque_vs_time(res, ax=fig.add_subplot()),
-            ),
-        )
-        loads = self.actuator_loads()
-        if loads is not None:
-            figures += (
-                ("actuator_torques.png", (7, 6), lambda fig: plot_actuator_loads(
-                    loads, motor_limits=self.limits.torque, brake_limits=self.limits.brake, fig=fig)),
-            )  # fmt: skip
-        sc = self.spacecraft_response()
-        if sc is not None:
-            figures += (
-                ("spacecraft_attitude.png", (7, 4), lambda fig: plot_spacecraft_response(sc, fig=fig)),
-            )
-        clear = self.clearance()
-        if clear is not None:
-            figures += (
-                ("clearance.png", (7, 4), lambda fig: plot_clearance(
-                    clear, p.times(p.n_check), margin=self.clearance_settings.margin, ax=fig.add_subplot())),
-            )  # fmt: skip
-        written = []
-        for name, size, draw in figures:
-            fig = offscreen_figure(size)
-            draw(fig)
-            written += write_figure(fig, out, name)
-        cols = {"t_s": ts["t"]}
-        for j, num in enumerate(p.model.joint_numbers):
-            cols[f"q{num}_deg"] = np.degrees(ts["q"][:, j])
-            cols[f"dq{num}_deg_s"] = np.degrees(ts["dq"][:, j])
-            cols[f"ddq{num}_deg_s2"] = np.degrees(ts["ddq"][:, j])
-        for i, ax_name in enumerate("xyz"):
-            cols[f"tau_b_{ax_name}_Nm"] = ts["tau_b"][:, i]
-        for i, ax_name in enumerate("xyz"):
-            cols[f"tau_b0_{ax_name}_Nm"] = ts["tau_b_k0"][:, i]
-        atomic_write_text(out / "halt_motion.csv", csv_text(cols))
-        atomic_write_bytes(out / "halt_motion.npz", npz_bytes(**cast(dict[str, Any], ts), k_grid=grid, global_torque_grid=tau))
-        atomic_write_json(out / "result.json", self.to_dict())
-        files = written + ["halt_motion.csv", "halt_motion.npz", "result.json", *self._write_motions(out)]
-        if loads is not None:
-            atomic_write_text(out / "actuators.csv", csv_text({"t_s": loads.t, **loads.columns()}))
-            files.append("actuators.csv")
-        if clear is not None:
-            columns = {"t_s": p.times(p.n_check), "clearance_m": clear.distance}
-            columns.update({f"{name}_m": clear.pair_distance[:, i] for i, name in enumerate(clear.names)})
-            atomic_write_text(out / "clearance.csv", csv_text(columns))
-            files.append("clearance.csv")
-        if sc is not None:
-            cols = {"t_s": sc.t, "attitude_change_deg": sc.attitude_change_deg}
-            cols.update({f"q_{c}": sc.attitude[:, i] for i, c in enumerate("wxyz")})
-            cols.update(
-                {f"omega_{c}_deg_s": np.degrees(sc.angular_velocity[:, i]) for i, c in enumerate("xyz")}
-            )
-            cols.update({f"com_{c}_m": sc.com_displacement[:, i] for i, c in enumerate("xyz")})
-            atomic_write_text(out / "spacecraft.csv", csv_text(cols))
-            files.append("spacecraft.csv")
-        return files
+        result.json in ``out`` (:func:`~._files.write_halt_files`); returns the file names."""
+        return write_halt_files(self, Path(out))
