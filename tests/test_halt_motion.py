@@ -481,7 +481,7 @@ def test_halt_of_a_model_with_a_continuous_joint(capsys):
 
 
 def _figures(monkeypatch):
-    import jointlock.jobs.halt._result as halt_job  # HaltPlan.write renders its figures there
+    import jointlock.jobs.halt._files as halt_job  # HaltPlan.write renders its figures there
 
     figs = []
     real = halt_job.write_figure
