@@ -636,3 +636,113 @@ def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance(
 
     with pytest.raises(ConfigurationError, match=r"per_joint: k must be one halt's per-joint k, shape \(6,\)"):
         clearance_shortfall(alone.problem, np.zeros((2, 6)), 0.05, per_joint=True)
+
+
+@pytest.mark.oracle
+def test_the_fused_kernels_primitives_equal_coal():
+    """The branch-free distances of the fused kernel (:mod:`jointlock._kernels._clearance`) on
+    the random pairs of the scalar kernel's coal test: segment-segment and segment-box, the
+    latter where the segment is apart from the box (nearer ones go to the scalar kernel)."""
+    from jointlock._kernels._clearance import NEAR_BOX_M, _segment_box_sq, _segments_sq
+
+    rng = np.random.default_rng(28)
+    count = 600
+    caps = rng.normal(size=(count, 2, 6)) * rng.uniform(0.2, 1.5, size=(count, 2, 1))
+    caps[::5, 1, 3:] = caps[::5, 1, :3]  # spheres
+    caps[1::7, 1, 3:] = caps[1::7, 1, :3] + 2 * (caps[1::7, 0, 3:] - caps[1::7, 0, :3])  # parallel
+    caps[3::11, 1, 3:] = caps[3::11, 1, :3] + np.array([0.4, 0.0, 0.0])  # along a box axis
+    radius, halves = 0.1, np.array([0.5, 0.8, 0.3])
+    box = coal.Box(*(2 * halves))
+    apart = 0
+    for n in range(count):
+        (a, b), (c, d) = caps[n, 0].reshape(2, 3), caps[n, 1].reshape(2, 3)
+        ours = math.sqrt(_segments_sq(*a, *(b - a), *c, *(d - c))) - 2 * radius
+        theirs = _coal_distance(*_coal_capsule(a, b, radius), *_coal_capsule(c, d, radius))
+        assert abs(ours - theirs) < COAL_ATOL, n
+        rot = _random_rotation(rng) if n % 3 else np.eye(3)  # axis-aligned segments too
+        centre = rng.normal(size=3) * 0.5
+        p, v = rot.T @ (c - centre), rot.T @ (d - c)
+        squared = _segment_box_sq(*p, *v, *halves)
+        if squared > NEAR_BOX_M**2:
+            theirs = _coal_distance(*_coal_capsule(c, d, radius), box, coal.Transform3s(rot, centre))
+            assert abs(math.sqrt(squared) - radius - theirs) < COAL_ATOL, n
+            apart += 1
+        else:
+            assert squared <= 1e-20  # near the box means in it, in this sample
+    assert apart > count / 3
+
+
+def _shape_by_shape(model: jl.ArmModel, q: np.ndarray, keep_out=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The scalar kernel on shapes placed by numpy's forward kinematics: the fused kernel's
+    reference (its pairs' distances, closest pair and witness points)."""
+    from jointlock.forward import chain_state
+
+    pairs = collision_pairs(model, keep_out)
+    state = chain_state(model, q)
+    count = q.shape[0]
+
+    def place(body: int, points: np.ndarray) -> np.ndarray:  # (3,) body frame -> (N, 3) root
+        if body < 0:
+            return np.broadcast_to(points, (count, 3))
+        return np.einsum("nij,j->ni", state.rotations[..., body, :, :], points) + state.positions[..., body, :]
+
+    caps = np.stack(
+        [np.hstack([place(b, p[:3]), place(b, p[3:])]) for b, p in zip(pairs.capsule_body, pairs.capsule_points)], axis=1
+    )
+    boxes = np.empty((count, max(len(pairs.box_body), 1), 12))
+    for k, (body, pose) in enumerate(zip(pairs.box_body, pairs.box_poses)):
+        rot = pose[:3, :3] if body < 0 else state.rotations[..., body, :, :] @ pose[:3, :3]
+        boxes[:, k, :9] = np.broadcast_to(rot, (count, 3, 3)).reshape(count, 9)
+        boxes[:, k, 9:] = place(body, pose[:3, 3])
+    dist = np.empty((count, len(pairs.names)))
+    closest = np.empty(count, dtype=np.int64)
+    witness = np.zeros((count, 2, 3))
+    halves = pairs.box_halves if len(pairs.box_body) else np.ones((1, 3))
+    pair_distances(caps, pairs.capsule_radii, boxes, halves, pairs.pairs, pairs.offsets, dist, closest, witness)
+    return dist, closest, witness
+
+
+def ours_offsets(model: jl.ArmModel, keep_out) -> np.ndarray:
+    """(P,) the pairs' zero-pose offsets (a mounted pair's witness points are its raw distance
+    apart)."""
+    return collision_pairs(model, keep_out).offsets
+
+
+@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda"])
+def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
+    """clearance() (frames, placements and distances in one compiled pass) against the scalar
+    kernel on shapes placed by numpy: every pair, the closest one and its witness points, on
+    random configurations (most halt7 ones colliding), with keep-outs (a box, a sphere) and on
+    joints about other axes than z (the Panda's URDF)."""
+    if name == "panda":
+        from robot_data import robot_file
+
+        arm = jl.read_urdf(robot_file("panda_description/urdf/panda_collision.urdf"), tip_link="panda_hand")
+    else:
+        arm = jl.load_robot(name)
+    keep_out = (
+        Box(half_extents=(0.3, 0.2, 0.4), pose=translation([0.8, 0.3, 0.5]), name="dock"),
+        Sphere(center=(0.2, -0.6, 0.9), radius=0.25, name="payload"),
+    )
+    q = np.random.default_rng(5).uniform(-np.pi, np.pi, (700, arm.dof))  # > one block of 128
+    q[0] = 0.0
+    for keep in ((), keep_out):
+        dist, closest, witness = _shape_by_shape(arm, q, keep)
+        ours = clearance(arm, q, keep_out=keep)
+        assert np.allclose(ours.pair_distance, dist, rtol=0, atol=1e-12)
+        assert np.array_equal(ours.closest, closest) or np.allclose(
+            dist[np.arange(len(q)), ours.closest], dist[np.arange(len(q)), closest], atol=1e-12
+        )
+        same = ours.closest == closest
+        # the witness points' offset (their position along a face parallel to the segment is
+        # not unique: any point of it is as deep), and their distance
+        offset = ours.witness[:, 1] - ours.witness[:, 0]
+        assert np.allclose(offset[same], (witness[:, 1] - witness[:, 0])[same], atol=1e-9)
+        counted = np.isfinite(ours.distance)
+        gap = np.linalg.norm(offset, axis=1)[counted]
+        raw = ours.distance[counted] + ours_offsets(arm, keep)[ours.closest[counted]]
+        assert np.allclose(gap, np.abs(raw), atol=1e-9)
+        assert np.any(dist < 0) and np.any(dist > 0)
+        quick = clearance(arm, q, keep_out=keep, witness=False)
+        assert np.array_equal(quick.pair_distance, ours.pair_distance) and np.all(np.isnan(quick.witness))
+        assert quick.to_dict()["witness_points_m"] is None

@@ -40,9 +40,9 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ._cache import cached_on
+from ._chain import link_constants
 from .bounds import MAX_LENGTH_M, as_real, shown
 from .errors import ConfigurationError, ModelError
-from .forward import DEFAULT_CHUNK, chain_state
 from .model import ArmModel, FloatArray, as_joint_array
 from .shapes import Box, Capsule, Shape, Sphere, check_shapes
 
@@ -189,7 +189,7 @@ def _zero_pose_contacts(model: ArmModel) -> dict[tuple[int, str, int, str], floa
     pairs = _build(full, (), {})
     if not len(pairs.names):
         return {}
-    distance, _, _ = _distances(full, pairs, np.zeros((1, full.dof)))
+    distance, _, _, _ = _distances(full, pairs, np.zeros((1, full.dof)), witness=False)
     return {key: min(float(d), -1e-12) for key, d in zip(pairs.keys, distance[0]) if d <= 0.0}
 
 
@@ -203,55 +203,75 @@ def collision_pairs(model: ArmModel, keep_out: Sequence[Shape] = ()) -> Collisio
     return _build(model, keep, mounted)
 
 
-def _distances(model: ArmModel, pairs: CollisionPairs, q: FloatArray) -> tuple[FloatArray, np.ndarray, FloatArray]:
-    """(N, P) signed distances (a mounted pair's from its zero-pose depth), (N,) closest pair and
-    (N, 2, 3) its witness points of configurations q (N, n)."""
-    from ._kernels._distance import pair_distances
+@dataclass(frozen=True, eq=False)
+class _KernelShapes:
+    """The chain and the shapes as :func:`jointlock._kernels._clearance.clearance_distances`
+    takes them: link constants in ``z``-joint frames, shapes in those frames."""
+
+    rot: FloatArray  # (n, 3, 3)
+    pos: FloatArray  # (n, 3)
+    capsule_points: FloatArray  # (C, 6)
+    box_frames: FloatArray  # (B, 12)
+
+
+def _kernel_shapes(model: ArmModel, pairs: CollisionPairs) -> _KernelShapes:
+    # a link's z-joint frame is its body frame turned by Q (jointlock._chain.link_constants):
+    # a point x of the body is Q^T x there
+    links = link_constants(model, np.zeros(3))
+    turn = [link.frame.T for link in links]
+    points = pairs.capsule_points.copy()
+    for c, body in enumerate(pairs.capsule_body):
+        if body >= 0:
+            points[c] = (turn[body] @ points[c].reshape(2, 3).T).T.ravel()
+    frames = np.empty((pairs.box_halves.shape[0], 12))
+    for k, body in enumerate(pairs.box_body):
+        pose = pairs.box_poses[k]
+        rot, centre = (pose[:3, :3], pose[:3, 3]) if body < 0 else (turn[body] @ pose[:3, :3], turn[body] @ pose[:3, 3])
+        frames[k, :9], frames[k, 9:] = rot.ravel(), centre
+    return _KernelShapes(
+        rot=np.ascontiguousarray(np.array([link.rot for link in links], dtype=float).reshape(-1, 3, 3)),
+        pos=np.ascontiguousarray(np.array([link.pos for link in links], dtype=float).reshape(-1, 3)),
+        capsule_points=np.ascontiguousarray(points),
+        box_frames=np.ascontiguousarray(frames),
+    )
+
+
+def _distances(
+    model: ArmModel, pairs: CollisionPairs, q: FloatArray, witness: bool = True
+) -> tuple[FloatArray, FloatArray, np.ndarray, FloatArray]:
+    """(N, P) signed distances (a mounted pair's from its zero-pose depth), (N,) the smallest
+    (a mounted pair counting only when deeper than at the zero pose; +inf when none counts),
+    (N,) its pair and (N, 2, 3) its witness points (NaN unless ``witness``) of configurations
+    q (N, n), in one compiled pass (:mod:`jointlock._kernels._clearance`)."""
+    from ._kernels._clearance import clearance_distances
 
     count = q.shape[0]
-    n_caps, n_boxes, n_pairs = pairs.capsule_radii.size, pairs.box_halves.shape[0], pairs.pairs.shape[0]
-    distance = np.empty((count, n_pairs))
+    n_pairs = pairs.pairs.shape[0]
+    by_pair = np.empty((n_pairs, count))
+    lowest = np.full(count, np.inf)
     closest = np.zeros(count, dtype=np.int64)
-    witness = np.zeros((count, 2, 3))
-    if n_pairs == 0 or count == 0:
-        return distance, closest, witness
-    for start in range(0, count, DEFAULT_CHUNK):
-        stop = min(start + DEFAULT_CHUNK, count)
-        m = stop - start
-        state = chain_state(model, q[start:stop]) if model.dof else None
-        caps = np.empty((m, n_caps, 6))
-        boxes = np.empty((m, max(n_boxes, 1), 12))
-        for c in range(n_caps):
-            body, pts = int(pairs.capsule_body[c]), pairs.capsule_points[c]
-            for half in (0, 3):
-                if body < 0:
-                    caps[:, c, half : half + 3] = pts[half : half + 3]
-                else:
-                    assert state is not None
-                    rot, pos = state.soa_rotations[body], state.soa_positions[body]
-                    caps[:, c, half : half + 3] = (np.einsum("ijn,j->in", rot, pts[half : half + 3]) + pos).T
-        for b in range(n_boxes):
-            body, frame = int(pairs.box_body[b]), pairs.box_poses[b]
-            if body < 0:
-                boxes[:, b, :9] = frame[:3, :3].ravel()
-                boxes[:, b, 9:] = frame[:3, 3]
-            else:
-                assert state is not None
-                rot, pos = state.soa_rotations[body], state.soa_positions[body]
-                boxes[:, b, :9] = np.einsum("ijn,jk->nik", rot, frame[:3, :3]).reshape(m, 9)
-                boxes[:, b, 9:] = (np.einsum("ijn,j->in", rot, frame[:3, 3]) + pos).T
-        pair_distances(
-            caps,
+    points = np.zeros((count, 2, 3)) if witness else np.full((count, 2, 3), np.nan)
+    if n_pairs and count:
+        shapes = cached_on(pairs, "kernel_shapes", lambda: _kernel_shapes(model, pairs))
+        clearance_distances(
+            np.ascontiguousarray(q, dtype=float),
+            shapes.rot,
+            shapes.pos,
+            np.ascontiguousarray(pairs.capsule_body),
+            shapes.capsule_points,
             np.ascontiguousarray(pairs.capsule_radii),
-            boxes,
-            np.ascontiguousarray(pairs.box_halves if n_boxes else np.ones((1, 3))),
+            np.ascontiguousarray(pairs.box_body),
+            shapes.box_frames,
+            np.ascontiguousarray(pairs.box_halves),
             np.ascontiguousarray(pairs.pairs),
             np.ascontiguousarray(pairs.offsets),
-            distance[start:stop],
-            closest[start:stop],
-            witness[start:stop],
+            witness,
+            by_pair,
+            lowest,
+            closest,
+            points,
         )
-    return distance, closest, witness
+    return by_pair.T, lowest, closest, points
 
 
 @dataclass(frozen=True, eq=False)
@@ -269,7 +289,8 @@ class Clearance:
     witness
         (..., 2, 3) points on its two shapes, root frame [m]: the closest points of separate
         shapes, the deepest point of the first and where it would have to go for overlapping
-        ones (``|w[1] - w[0]|`` is the raw distance, a mounted pair's too).
+        ones (``|w[1] - w[0]|`` is the raw distance, a mounted pair's too); NaN when
+        :func:`clearance` was asked for the distances only (``witness=False``).
     pair_distance
         (..., P) every checked pair's signed distance [m] (a mounted pair's from its depth at the
         zero pose).
@@ -349,7 +370,7 @@ class Clearance:
             **base,
             "min_clearance_m": float(self.distance[at]),
             "closest_pair": self.pair_at(at),
-            "witness_points_m": self.witness[at].tolist(),
+            "witness_points_m": self.witness[at].tolist() if np.all(np.isfinite(self.witness[at])) else None,
             "configurations": int(self.distance.size),
             "closer_than_allowed": int(np.count_nonzero(self.colliding())),
             "pair_min_clearance_m": {name: float(v) for name, v in zip(self.names, flat.min(axis=0))},
@@ -364,7 +385,7 @@ def check_clearance_m(value: object, name: str) -> float:
 
 
 def clearance(
-    model: ArmModel, q: ArrayLike, *, keep_out: Sequence[Shape] = (), margin: float = 0.0
+    model: ArmModel, q: ArrayLike, *, keep_out: Sequence[Shape] = (), margin: float = 0.0, witness: bool = True
 ) -> Clearance:
     """Signed distances of configurations ``q`` (..., n) [rad] between the arm's links, its
     spacecraft bus and the ``keep_out`` volumes (shapes in the root frame).
@@ -380,6 +401,9 @@ def clearance(
     margin
         The clearance required [m] (``clearance_min_m``), kept on the result for
         :meth:`Clearance.colliding` and the summary.
+    witness
+        Whether to compute the closest pair's witness points; False leaves them NaN (a batch
+        screened for its distances only: about a quarter less time).
 
     Returns
     -------
@@ -390,18 +414,14 @@ def clearance(
     margin = check_clearance_m(margin, "margin")
     pairs = collision_pairs(model, keep_out)
     batch = q.shape[:-1]
-    distance, closest, witness = _distances(model, pairs, q.reshape(-1, model.dof))
-    # the smallest over the pairs, a mounted one only when it is deeper than at the zero pose
-    mounted = pairs.offsets < 0
-    ranked = np.where(mounted & (distance >= 0.0), np.inf, distance)
-    smallest = ranked.min(axis=1) if distance.shape[1] else np.full(distance.shape[0], np.inf)
+    distance, smallest, closest, points = _distances(model, pairs, q.reshape(-1, model.dof), witness)
     return Clearance(
         distance=smallest.reshape(batch),
         closest=closest.reshape(batch),
-        witness=witness.reshape(batch + (2, 3)),
+        witness=points.reshape(batch + (2, 3)),
         pair_distance=distance.reshape(batch + (distance.shape[1],)),
         names=pairs.names,
-        mounted_pairs=mounted,
+        mounted_pairs=pairs.offsets < 0,
         margin=margin,
     )
 

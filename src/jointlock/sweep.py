@@ -221,7 +221,7 @@ def swept_clearance(
     floor = np.broadcast_to(np.asarray(floor, dtype=float), (len(pairs.names),))
     if sampled is None:
         q, dq, ddq = motion(t)
-        distance = clearance(model, q, keep_out=keep_out).pair_distance
+        distance = clearance(model, q, keep_out=keep_out, witness=False).pair_distance
     else:
         q, dq, ddq, distance = sampled
     _check_finite(t, dq, ddq, distance)
@@ -254,7 +254,7 @@ def swept_clearance(
         fractions = np.arange(1, SUBDIVISIONS) / SUBDIVISIONS
         inner = start_t[refine, None] + h[refine, None] * fractions  # (r, S - 1)
         q_in, dq_in, ddq_in = motion(inner.ravel())
-        d_in = clearance(model, q_in, keep_out=keep_out).pair_distance
+        d_in = clearance(model, q_in, keep_out=keep_out, witness=False).pair_distance
         _check_finite(inner.ravel(), dq_in, ddq_in, d_in)
         accel = np.maximum(accel, np.abs(ddq_in).max(axis=0))  # the refined samples' too
         refined += inner.size

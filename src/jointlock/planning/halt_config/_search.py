@@ -180,7 +180,7 @@ def optimal_halt_configuration(
     checked = bool(collision_pairs(model_locked, keep_out).names)
     clear = None
     if clearance_min_m is not None and checked:
-        sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin)
+        sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin, witness=False)
         clear = ~sampled.colliding()
         admissible = clear if reachable is None else clear & reachable
         if not admissible.any():
@@ -233,7 +233,7 @@ def optimal_halt_configuration(
         starts = q[order[: min(int(refine_starts), n_ok)]]
 
         def keeps_clear(qs: FloatArray) -> np.ndarray:
-            return ~clearance(model_locked, qs, keep_out=keep_out).colliding(margin)
+            return ~clearance(model_locked, qs, keep_out=keep_out, witness=False).colliding(margin)
 
         refined_q, refined_cp, evaluations = _refine(
             exact, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None

@@ -103,7 +103,7 @@ def _shortfall_at(
     step = max(1, CHUNK_SAMPLES // t.size)
     for start in range(0, k.size, step):
         q, _, _ = problem.trajectory(k[start : start + step], t)
-        distance = clearance(problem.model, q, keep_out=keep_out).pair_distance  # (K, n_t, P)
+        distance = clearance(problem.model, q, keep_out=keep_out, witness=False).pair_distance  # (K, n_t, P)
         out[start : start + step] = (floor - distance).max(axis=(-2, -1)) if distance.shape[-1] else -np.inf
     return out
 
@@ -161,7 +161,7 @@ def _clear_everywhere(
 ) -> bool:
     """Whether the halt at ``k`` keeps ``floor`` on every check time ``t`` and between them."""
     q, dq, ddq = problem.trajectory(k, t)
-    distance = clearance(problem.model, q, keep_out=keep_out).pair_distance
+    distance = clearance(problem.model, q, keep_out=keep_out, witness=False).pair_distance
     if distance.shape[-1] and float((floor - distance).max()) > 0.0:
         return False
     return bool(halt_swept_clearance(problem, k, floor, keep_out, sampled=(q, dq, ddq, distance)).shortfall <= 0.0)

@@ -1,0 +1,331 @@
+"""Clearance of a batch of configurations in one compiled pass (issue 27's speed): the chain's
+frames, the shapes' placements and every pair's signed distance, block by block, without a
+Python step per configuration or per pair (:func:`jointlock.collision.clearance` calls it).
+
+Why a second kernel next to :func:`jointlock._kernels._distance.pair_distances`.  That kernel
+takes every configuration's shapes already placed (a numpy forward-kinematics pass and a copy
+per shape) and computes each pair's witness points on the way.  Here, for a block of
+:data:`~jointlock._kernels._common.BLOCK` configurations:
+
+1. the frames advance link by link (:func:`jointlock._kernels._arm._advance`, the chain
+   convention of :mod:`jointlock._kernels`) and each link's shapes are placed as soon as its
+   frame is known;
+2. every pair's signed distance is a branch-free loop over the block (one SIMD lane per
+   configuration): capsule-capsule as in ``_distance._capsule_capsule`` (the four end points
+   against the other segment and the interior critical point, minus both radii);
+   capsule-box from the derivative of the squared distance along the segment (below);
+3. a capsule-box pair whose segment comes within :data:`NEAR_BOX_M` of the box (touching or
+   overlapping: the penetration depth is a different computation) is computed again by the
+   scalar kernel of :mod:`jointlock._kernels._distance`, and the closest pair of each
+   configuration gets its witness points from it (when asked).
+
+Capsule-box, away from the box.  In the box frame the squared distance from ``p + t d`` to the
+box is ``f(t) = sum_k e_k(t)^2`` with ``e_k`` the excess of coordinate ``k`` over the half
+extent: convex, and ``f'(t) / 2 = g(t) = sum_k e_k(t) d_k`` is piecewise linear and
+non-decreasing, with breakpoints where a coordinate crosses a face plane.  ``g`` is evaluated
+at ``0``, ``1`` and the (at most six) breakpoints in between; the largest of them with ``g <=
+0`` and the smallest with ``g >= 0`` bracket the minimum with no breakpoint between them, so
+the root of ``g`` there is a linear interpolation (``t = 0`` when ``g(0) >= 0``, ``t = 1``
+when ``g(1) <= 0``): exact, with no sort and no branch.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ._arm import _advance, _identity_frames
+from ._common import BLOCK, _jit, _trig_block
+from ._distance import _capsule_box, _capsule_capsule
+
+#: A capsule-box pair whose segment comes this close to the box [m] is computed by the scalar
+#: kernel (touching or overlapping: its penetration depth and witness points).
+NEAR_BOX_M = 1e-6
+
+_inline = njit(inline="always", cache=True, error_model="numpy", nogil=True)
+
+
+@_inline
+def _point_segment_sq(px, py, pz, ax, ay, az, dx, dy, dz, inv_dd):
+    """Squared distance from point p to the segment a + t d, ``inv_dd = 1 / max(|d|^2, tiny)``,
+    branch-free (a zero-length segment gives t = 0: its dot product is 0)."""
+    t = ((px - ax) * dx + (py - ay) * dy + (pz - az) * dz) * inv_dd
+    t = min(max(t, 0.0), 1.0)
+    ex = ax + t * dx - px
+    ey = ay + t * dy - py
+    ez = az + t * dz - pz
+    return ex * ex + ey * ey + ez * ez
+
+
+@_inline
+def _segments_sq(ax, ay, az, dx, dy, dz, bx, by, bz, ex, ey, ez):
+    """Squared distance between the segments a + s d and b + t e (s, t in [0, 1]), branch-free:
+    the four end points against the other segment, and the interior critical point when it is
+    one (as ``_distance._capsule_capsule``)."""
+    aa = dx * dx + dy * dy + dz * dz
+    ee = ex * ex + ey * ey + ez * ez
+    inv_aa = 1.0 / max(aa, 1e-300)
+    inv_ee = 1.0 / max(ee, 1e-300)
+    best = _point_segment_sq(ax, ay, az, bx, by, bz, ex, ey, ez, inv_ee)
+    best = min(best, _point_segment_sq(ax + dx, ay + dy, az + dz, bx, by, bz, ex, ey, ez, inv_ee))
+    best = min(best, _point_segment_sq(bx, by, bz, ax, ay, az, dx, dy, dz, inv_aa))
+    best = min(best, _point_segment_sq(bx + ex, by + ey, bz + ez, ax, ay, az, dx, dy, dz, inv_aa))
+    de = dx * ex + dy * ey + dz * ez
+    denom = aa * ee - de * de
+    fx, fy, fz = ax - bx, ay - by, az - bz
+    df = dx * fx + dy * fy + dz * fz
+    ef = ex * fx + ey * fy + ez * fz
+    inv = 1.0 / max(denom, 1e-300)
+    s = (de * ef - df * ee) * inv
+    t = (aa * ef - de * df) * inv
+    gx = ax + s * dx - bx - t * ex
+    gy = ay + s * dy - by - t * ey
+    gz = az + s * dz - bz - t * ez
+    d2 = gx * gx + gy * gy + gz * gz
+    inside = (denom > 1e-14 * aa * ee) and (aa > 0.0) and (ee > 0.0) and (0.0 < s < 1.0) and (0.0 < t < 1.0)
+    return min(best, d2) if inside else best
+
+
+@_inline
+def _excess(x, h):
+    return max(x - h, 0.0) + min(x + h, 0.0)
+
+
+@_inline
+def _slope(px, py, pz, dx, dy, dz, hx, hy, hz, t):
+    """``g(t) = sum_k e_k(p_k + t d_k) d_k``: half the derivative of the squared distance."""
+    return (
+        _excess(px + t * dx, hx) * dx + _excess(py + t * dy, hy) * dy + _excess(pz + t * dz, hz) * dz
+    )
+
+
+@_inline
+def _cut(p, d, h):
+    """The two parameters where ``p + t d`` crosses ``-h`` and ``h``, or 0 outside (0, 1)."""
+    inv = 1.0 / d if d != 0.0 else 0.0
+    lo = (-h - p) * inv
+    hi = (h - p) * inv
+    return (lo if 0.0 < lo < 1.0 else 0.0), (hi if 0.0 < hi < 1.0 else 0.0)
+
+
+@_inline
+def _bracket(t, g, lo, glo, hi, ghi):
+    """Narrow the bracket [lo, hi] of the root of g with the candidate (t, g)."""
+    if g <= 0.0 and t > lo:
+        lo, glo = t, g
+    if g >= 0.0 and t < hi:
+        hi, ghi = t, g
+    return lo, glo, hi, ghi
+
+
+@_inline
+def _segment_box_sq(px, py, pz, dx, dy, dz, hx, hy, hz):
+    """Squared distance from the segment p + t d (t in [0, 1], box frame) to the box of half
+    extents h centred at the origin (see the module)."""
+    lo, glo = 0.0, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, 0.0)
+    hi, ghi = 1.0, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, 1.0)
+    g0, g1 = glo, ghi
+    c0, c1 = _cut(px, dx, hx)
+    c2, c3 = _cut(py, dy, hy)
+    c4, c5 = _cut(pz, dz, hz)
+    lo, glo, hi, ghi = _bracket(c0, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c0), lo, glo, hi, ghi)
+    lo, glo, hi, ghi = _bracket(c1, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c1), lo, glo, hi, ghi)
+    lo, glo, hi, ghi = _bracket(c2, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c2), lo, glo, hi, ghi)
+    lo, glo, hi, ghi = _bracket(c3, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c3), lo, glo, hi, ghi)
+    lo, glo, hi, ghi = _bracket(c4, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c4), lo, glo, hi, ghi)
+    lo, glo, hi, ghi = _bracket(c5, _slope(px, py, pz, dx, dy, dz, hx, hy, hz, c5), lo, glo, hi, ghi)
+    span = ghi - glo
+    t = lo + (hi - lo) * (-glo / span) if span > 0.0 else lo
+    t = min(max(t, min(lo, hi)), max(lo, hi))
+    t = 0.0 if g0 >= 0.0 else (1.0 if g1 <= 0.0 else t)
+    ex = _excess(px + t * dx, hx)
+    ey = _excess(py + t * dy, hy)
+    ez = _excess(pz + t * dz, hz)
+    return ex * ex + ey * ey + ez * ez
+
+
+@_jit
+def clearance_distances(
+    q, rot, pos, cap_body, cap_points, radii, box_body, box_frames, halves, pairs, offsets,
+    witness, out_distance, out_lowest, out_closest, out_witness,
+):
+    """Signed distances of every pair for every configuration, the closest pair and its
+    witness points.
+
+    Parameters
+    ----------
+    q
+        (N, n) joint angles [rad].
+    rot, pos
+        (n, 3, 3), (n, 3) [m]: ``E_i`` and ``p_i`` of every link (:mod:`jointlock._kernels`),
+        the root frame at the origin.
+    cap_body, cap_points, radii
+        (C,) int64 body of each capsule (-1 the root body and keep-outs, ``i`` link ``i``'s
+        ``z``-joint frame); (C, 6) its end points a, b in that frame [m]; (C,) radii [m].
+    box_body, box_frames, halves
+        (B,) int64 body of each box; (B, 12) its rotation (row-major, box axes as columns) and
+        centre in that frame [m]; (B, 3) half extents [m].
+    pairs, offsets
+        As :func:`jointlock._kernels._distance.pair_distances`.
+    witness
+        Whether to compute the closest pair's witness points (``out_witness`` is left as it is
+        otherwise).
+    out_distance, out_lowest, out_closest, out_witness
+        Written in place: (P, N) every pair's signed distance [m] (pair-major: each pair's row
+        is one contiguous store per block); (N,) the smallest, a mounted pair counting only when
+        it is deeper than at the zero pose (+inf when none counts); (N,) its pair (0 when none);
+        (N, 2, 3) its witness points [m], as :func:`jointlock._kernels._distance.pair_distances`.
+    """
+    count, n = q.shape
+    n_caps, n_boxes, n_pairs = cap_points.shape[0], box_frames.shape[0], pairs.shape[0]
+    frames = np.empty((12, BLOCK))
+    sn = np.empty(BLOCK)
+    cs = np.empty(BLOCK)
+    caps = np.empty(max(n_caps, 1) * 6 * BLOCK)  # row 6 c + k of capsule c, then the block
+    boxes = np.empty(max(n_boxes, 1) * 12 * BLOCK)
+    dist = np.empty(max(n_pairs, 1) * BLOCK)
+    lowest = np.empty(BLOCK)
+    nearest = np.zeros(BLOCK, dtype=np.int64)
+    w = np.empty((2, 3))
+    work = np.empty(14)
+    cap_world = np.empty((2, 6))
+    box_world = np.empty(12)
+    for s0 in range(0, count, BLOCK):
+        nb = min(BLOCK, count - s0)
+        _identity_frames(frames, nb)
+        for body in range(-1, n):
+            if body >= 0:
+                _trig_block(q, s0, nb, body, sn, cs)
+                e = rot[body]
+                p0, p1, p2 = pos[body, 0], pos[body, 1], pos[body, 2]
+                for b in range(nb):
+                    _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
+            for c in range(n_caps):
+                if cap_body[c] != body:
+                    continue
+                for end in range(2):
+                    x, y, z = cap_points[c, 3 * end], cap_points[c, 3 * end + 1], cap_points[c, 3 * end + 2]
+                    for r in range(3):
+                        row = (6 * c + 3 * end + r) * BLOCK
+                        for b in range(nb):
+                            caps[row + b] = (
+                                frames[3 * r, b] * x + frames[3 * r + 1, b] * y + frames[3 * r + 2, b] * z
+                                + frames[9 + r, b]
+                            )
+            for k in range(n_boxes):
+                if box_body[k] != body:
+                    continue
+                f = box_frames[k]
+                for r in range(3):
+                    for col in range(3):  # (F R)[r, col]
+                        row = (12 * k + 3 * r + col) * BLOCK
+                        for b in range(nb):
+                            boxes[row + b] = (
+                                frames[3 * r, b] * f[col] + frames[3 * r + 1, b] * f[3 + col]
+                                + frames[3 * r + 2, b] * f[6 + col]
+                            )
+                    row = (12 * k + 9 + r) * BLOCK
+                    for b in range(nb):
+                        boxes[row + b] = (
+                            frames[3 * r, b] * f[9] + frames[3 * r + 1, b] * f[10] + frames[3 * r + 2, b] * f[11]
+                            + frames[9 + r, b]
+                        )
+        for k in range(n_pairs):
+            kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+            a = 6 * i * BLOCK
+            out = k * BLOCK
+            if kind == 0:
+                o = 6 * j * BLOCK
+                gap = radii[i] + radii[j] + offsets[k]
+                for b in range(nb):
+                    ax, ay, az = caps[a + b], caps[a + BLOCK + b], caps[a + 2 * BLOCK + b]
+                    bx, by, bz = caps[o + b], caps[o + BLOCK + b], caps[o + 2 * BLOCK + b]
+                    d2 = _segments_sq(
+                        ax, ay, az,
+                        caps[a + 3 * BLOCK + b] - ax, caps[a + 4 * BLOCK + b] - ay, caps[a + 5 * BLOCK + b] - az,
+                        bx, by, bz,
+                        caps[o + 3 * BLOCK + b] - bx, caps[o + 4 * BLOCK + b] - by, caps[o + 5 * BLOCK + b] - bz,
+                    )
+                    dist[out + b] = math.sqrt(d2) - gap
+            else:
+                o = 12 * j * BLOCK
+                hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]
+                gap = radii[i] + offsets[k]
+                for b in range(nb):
+                    # the segment in the box frame (box axes are the rotation's columns)
+                    ox = caps[a + b] - boxes[o + 9 * BLOCK + b]
+                    oy = caps[a + BLOCK + b] - boxes[o + 10 * BLOCK + b]
+                    oz = caps[a + 2 * BLOCK + b] - boxes[o + 11 * BLOCK + b]
+                    vx = caps[a + 3 * BLOCK + b] - caps[a + b]
+                    vy = caps[a + 4 * BLOCK + b] - caps[a + BLOCK + b]
+                    vz = caps[a + 5 * BLOCK + b] - caps[a + 2 * BLOCK + b]
+                    r00, r01, r02 = boxes[o + b], boxes[o + BLOCK + b], boxes[o + 2 * BLOCK + b]
+                    r10, r11, r12 = boxes[o + 3 * BLOCK + b], boxes[o + 4 * BLOCK + b], boxes[o + 5 * BLOCK + b]
+                    r20, r21, r22 = boxes[o + 6 * BLOCK + b], boxes[o + 7 * BLOCK + b], boxes[o + 8 * BLOCK + b]
+                    d2 = _segment_box_sq(
+                        r00 * ox + r10 * oy + r20 * oz,
+                        r01 * ox + r11 * oy + r21 * oz,
+                        r02 * ox + r12 * oy + r22 * oz,
+                        r00 * vx + r10 * vy + r20 * vz,
+                        r01 * vx + r11 * vy + r21 * vz,
+                        r02 * vx + r12 * vy + r22 * vz,
+                        hx, hy, hz,
+                    )
+                    # near or in the box: NaN marks it for the scalar kernel below (q is finite)
+                    dist[out + b] = math.sqrt(d2) - gap if d2 > NEAR_BOX_M * NEAR_BOX_M else np.nan
+        # pairs near or in a box: the scalar kernel (penetration depth)
+        for k in range(n_pairs):
+            if pairs[k, 0] != 1:
+                continue
+            i, j = pairs[k, 1], pairs[k, 2]
+            for b in range(nb):
+                if dist[k * BLOCK + b] != dist[k * BLOCK + b]:
+                    _place(caps, boxes, i, j, b, cap_world, box_world)
+                    dist[k * BLOCK + b] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+        # the closest pair: a mounted one only when deeper than at the zero pose
+        for b in range(nb):
+            lowest[b] = np.inf
+            nearest[b] = 0
+        for k in range(n_pairs):
+            mounted = offsets[k] < 0.0
+            row = k * BLOCK
+            for b in range(nb):
+                value = dist[row + b]
+                out_distance[k, s0 + b] = value
+                rank = np.inf if mounted and value >= 0.0 else value
+                closer = rank < lowest[b]
+                lowest[b] = rank if closer else lowest[b]
+                nearest[b] = k if closer else nearest[b]
+        for b in range(nb):
+            out_lowest[s0 + b] = lowest[b]
+            out_closest[s0 + b] = nearest[b]
+        if not witness:
+            continue
+        for b in range(nb):
+            if lowest[b] == np.inf:
+                continue
+            k = nearest[b]
+            kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+            _place(caps, boxes, i, j if kind == 1 else 0, b, cap_world, box_world)
+            if kind == 0:
+                for r in range(6):
+                    cap_world[1, r] = caps[(6 * j + r) * BLOCK + b]
+                _capsule_capsule(cap_world[0], radii[i], cap_world[1], radii[j], w)
+            else:
+                _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work)
+            for r in range(2):
+                for col in range(3):
+                    out_witness[s0 + b, r, col] = w[r, col]
+
+
+@_jit
+def _place(caps, boxes, i, j, b, cap_world, box_world):
+    """Capsule ``i`` and box ``j`` of configuration ``b`` of the block, as the scalar kernels
+    take them: ``cap_world[0]`` (6,), ``box_world`` (12,)."""
+    for r in range(6):
+        cap_world[0, r] = caps[(6 * i + r) * BLOCK + b]
+    if boxes.shape[0] >= 12 * (j + 1) * BLOCK:
+        for r in range(12):
+            box_world[r] = boxes[(12 * j + r) * BLOCK + b]
