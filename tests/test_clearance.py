@@ -239,7 +239,7 @@ def test_bad_input_is_refused_in_one_line():
     arm = jl.load_robot("halt7")
     with pytest.raises(ConfigurationError, match=r"margin must be a finite real number >= 0 and <= 1e\+06 \[m\]; got -0.1"):
         clearance(arm, np.zeros(7), margin=-0.1)
-    with pytest.raises(ModelError, match=r"keep_out: shapes\[0\] must be a Capsule, Sphere or Box"):
+    with pytest.raises(ModelError, match=r"keep_out: shapes\[0\] must be a Capsule, Sphere, Box or Convex"):
         clearance(arm, np.zeros(7), keep_out=["box"])
     with pytest.raises(ModelError, match="radius must be finite, >= 0"):
         Capsule([0, 0, 0], [1, 0, 0], -0.1)
@@ -567,7 +567,7 @@ def test_urdf_collision_elements_are_refused_in_one_line(tmp_path, collision, er
     assert "link 'arm' <collision> 1" in str(info.value) and "\n" not in str(info.value)
 
 
-def test_urdf_collision_primitives_are_read_and_meshes_counted(tmp_path):
+def test_urdf_collision_primitives_are_read_and_meshes_skipped_when_asked(tmp_path):
     path = tmp_path / "probe.urdf"
     path.write_text(
         URDF_TWO_LINKS.replace(
@@ -576,11 +576,15 @@ def test_urdf_collision_primitives_are_read_and_meshes_counted(tmp_path):
             "<collision><geometry><mesh filename='arm.stl'/></geometry></collision>",
         )
     )
-    arm = jl.read_urdf(path)
+    # a mesh that is not there is refused (a link left geometry-blind is not a safe default)
+    with pytest.raises(ModelError, match=r"link 'arm' <collision> 2: mesh file 'arm.stl' not found .*meshes='skip'") as info:
+        jl.read_urdf(path)
+    assert "\n" not in str(info.value)
+    arm = jl.read_urdf(path, meshes="skip")
     (capsule,) = arm.bodies[0].shapes
     assert isinstance(capsule, Capsule) and np.allclose([capsule.a, capsule.b], [[0, 0, 0], [0, 0, 2]])
     assert [type(s).__name__ for s in arm.root_body.shapes] == ["Box"]
-    assert "1 <collision> mesh(es) not read" in arm.description
+    assert "1 <collision> mesh(es) left out (meshes='skip')" in arm.description
 
 
 def test_crossing_capsules_have_witness_points_their_depth_apart():

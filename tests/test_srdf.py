@@ -85,7 +85,7 @@ def test_a_scenario_and_the_command_line_give_it(tmp_path, capsys):
     assert main([*argv, "--srdf", str(srdf)]) == 0
     assert json.loads(capsys.readouterr().out)["solutions"]
     assert main(["ik", "puma6", "--srdf", str(srdf), "--pose", "0.4", "0.1", "0.5", "0", "180", "0"]) == 2
-    assert "(and --srdf its pairs not checked for clearance); ROBOT 'puma6' is a built-in robot" in capsys.readouterr().err
+    assert "(--srdf its pairs not checked for clearance, --meshes how its meshes are read); ROBOT 'puma6' is a built-in robot" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize(

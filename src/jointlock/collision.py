@@ -25,9 +25,11 @@ the full arm, 0 for the root body), so the pairs are the same before and after a
   SRDF's ``<disable_collisions>``, read by :func:`jointlock.io.srdf.read_srdf`) are never checked.
 
 Distances are exact for capsule-capsule (spheres included) and capsule-box pairs and are
-computed by compiled kernels (:mod:`jointlock._kernels._distance`), tested against coal
-(hpp-fcl) to 1e-12 m, penetration included.  A box on a moving link facing another box is not
-supported yet (refused in one line).
+computed by compiled kernels (:mod:`jointlock._kernels._clearance`, one pass over a batch),
+tested against coal (hpp-fcl) to 1e-12 m, penetration included.  A pair with a convex hull (a
+URDF mesh, :class:`~jointlock.shapes.Convex`) or of two boxes is computed by coal itself (GJK
+and EPA to 1e-12, :mod:`jointlock._hull_distance`; the ``mesh`` extra), about 5 us per pair and
+configuration.
 """
 
 from __future__ import annotations
@@ -41,10 +43,11 @@ from numpy.typing import ArrayLike
 
 from ._cache import cached_on
 from ._chain import link_constants
-from .bounds import MAX_LENGTH_M, as_real, shown
-from .errors import ConfigurationError, ModelError
+from .bounds import MAX_LENGTH_M, as_real
+from .errors import ConfigurationError
+from .forward import chain_state
 from .model import ArmModel, FloatArray, as_joint_array
-from .shapes import Box, Capsule, Shape, Sphere, check_shapes
+from .shapes import Box, Capsule, Convex, Shape, Sphere, check_shapes
 
 #: The link number keep-out volumes are given (checked against every link, not the root body).
 KEEP_OUT_LINK = -1
@@ -64,7 +67,8 @@ class CollisionPairs:
     box_poses, box_halves
         (B, 4, 4) box frames in the body frame; (B, 3) half extents [m].
     pairs
-        (P, 3) int64: kind (0 capsule-capsule, 1 capsule-box), index 1, index 2.
+        (P, 3) int64: kind (0 capsule-capsule, 1 capsule-box, 2 a pair with a convex hull:
+        indices into ``shapes``), index 1, index 2.
     names
         (P,) ``"link3 - bus"``: the two shapes' names.
     links
@@ -74,6 +78,10 @@ class CollisionPairs:
         it is measured; 0 for the others.
     keys
         (P,) each pair's shapes as ``(link, name, link, name)``.
+    shape_body, shapes
+        Every shape with its body (-1: the root body and keep-outs): capsules and spheres, then
+        boxes, then convex hulls, so that index ``i`` of a capsule or box is its index here too
+        plus ``C`` for a box (kind-2 pairs index them).
     """
 
     capsule_body: np.ndarray
@@ -87,6 +95,8 @@ class CollisionPairs:
     links: np.ndarray
     offsets: FloatArray = field(default_factory=lambda: np.zeros(0))
     keys: tuple[tuple[int, str, int, str], ...] = ()
+    shape_body: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=np.int64))
+    shapes: tuple[Shape, ...] = ()
 
     @property
     def mounted(self) -> tuple[str, ...]:
@@ -123,6 +133,8 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], mounted: dict[tuple[int, 
     shapes = _collect(model, keep_out)
     capsules = [(b, s) for b, s in shapes if isinstance(s, (Capsule, Sphere))]
     boxes = [(b, s) for b, s in shapes if isinstance(s, Box)]
+    hulls = [(b, s) for b, s in shapes if isinstance(s, Convex)]
+    every = capsules + boxes + hulls
     pairs: list[tuple[int, int, int]] = []
     names: list[str] = []
     links: list[tuple[int, int]] = []
@@ -153,14 +165,16 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], mounted: dict[tuple[int, 
             add(0, i, j, capsules[i], capsules[j])
         for j in range(len(boxes)):
             add(1, i, j, capsules[i], boxes[j])
+    # a pair with a convex hull (coal): indices into ``every``
+    first_hull = len(capsules) + len(boxes)
+    for h in range(len(hulls)):
+        for other in range(first_hull + h):
+            add(2, other, first_hull + h, every[other], every[first_hull + h])
+    # two boxes of which one moves: coal as well (both fixed: never checked)
     for i in range(len(boxes)):
         for j in range(i + 1, len(boxes)):
-            a, b = boxes[i], boxes[j]
-            if _checked(int(a[1].link), int(b[1].link), a[0], b[0]) and not (a[0] < 0 and b[0] < 0):  # type: ignore[arg-type]
-                raise ModelError(
-                    f"box {shown(_shape_name(a[1]))} and box {shown(_shape_name(b[1]))}: distances between two "
-                    "boxes of which one moves are not supported yet; give the link a capsule or a sphere"
-                )
+            if boxes[i][0] >= 0 or boxes[j][0] >= 0:
+                add(2, len(capsules) + i, len(capsules) + j, boxes[i], boxes[j])
 
     def points(s: Shape) -> list[float]:
         if isinstance(s, Sphere):
@@ -179,6 +193,8 @@ def _build(model: ArmModel, keep_out: Sequence[Shape], mounted: dict[tuple[int, 
         links=np.array(links, dtype=np.int64).reshape(-1, 2),
         offsets=np.array(offsets, dtype=float),
         keys=tuple(keys),
+        shape_body=np.array([b for b, _ in every], dtype=np.int64),
+        shapes=tuple(s for _, s in every),
     )
 
 
@@ -271,7 +287,50 @@ def _distances(
             closest,
             points,
         )
+    hulls = np.flatnonzero(pairs.pairs[:, 0] == 2)
+    if hulls.size and count:
+        _hull_rows(model, pairs, q, hulls, witness, by_pair, lowest, closest, points)
     return by_pair.T, lowest, closest, points
+
+
+def _hull_rows(
+    model: ArmModel,
+    pairs: CollisionPairs,
+    q: FloatArray,
+    rows: np.ndarray,
+    witness: bool,
+    by_pair: FloatArray,
+    lowest: FloatArray,
+    closest: np.ndarray,
+    points: FloatArray,
+) -> None:
+    """The pairs with a convex hull (``rows``, computed by coal), written into the kernel's
+    results in place: their distances, and the closest pair and its witness points where one
+    of them is closer."""
+    from ._hull_distance import hull_pair_distances
+
+    state = chain_state(model, q) if model.dof else None
+    distance, hull_witness = hull_pair_distances(
+        pairs.shapes,
+        pairs.shape_body,
+        pairs.pairs[rows, 1:],
+        None if state is None else state.rotations,
+        None if state is None else state.positions,
+        with_witness=witness,
+    )
+    if distance.shape[1] != q.shape[0]:  # no movable body: one placement for every configuration
+        distance = np.broadcast_to(distance, (len(rows), q.shape[0]))
+        hull_witness = np.broadcast_to(hull_witness, (len(rows), q.shape[0], 2, 3))
+    offsets = pairs.offsets[rows]
+    distance = distance - offsets[:, None]
+    by_pair[rows] = distance
+    rank = np.where((offsets[:, None] < 0) & (distance >= 0.0), np.inf, distance)
+    best = np.argmin(rank, axis=0)
+    nearer = rank[best, np.arange(q.shape[0])] < lowest
+    lowest[nearer] = rank[best[nearer], np.flatnonzero(nearer)]
+    closest[nearer] = rows[best[nearer]]
+    if witness:
+        points[nearer] = hull_witness[best[nearer], np.flatnonzero(nearer)]
 
 
 @dataclass(frozen=True, eq=False)

@@ -16,8 +16,8 @@ What the file holds:
   (jointlock's own dynamics take gravity per call: :func:`jointlock.dynamics.rnea`);
 - one ``motor`` per healthy joint (gear 1: the control is the joint torque [N m]), its control
   range the joint's effort limit when the model has one;
-- the collision geometry (issue 27) as geoms: capsules (``fromto``), spheres and boxes, in the
-  body that carries them; every body and its parent (adjacent links, never checked by jointlock;
+- the collision geometry (issue 27) as geoms: capsules (``fromto``), spheres, boxes and convex
+  hulls (a ``<mesh>`` asset of the hull's vertices), in the body that carries them; every body and its parent (adjacent links, never checked by jointlock;
   MuJoCo would filter them itself except under a body welded to the world) and the pairs jointlock
   measures from their zero-pose contact ("mounted": :mod:`jointlock.collision`) are excluded
   from MuJoCo's contacts.  Geoms carry no mass (``inertiafromgeom="false"``: the inertia is the
@@ -49,7 +49,7 @@ from .errors import ModelError
 from .io.files import atomic_write_text
 from .io.urdf_export import BASE_LINK, TOOL_LINK
 from .model import ArmModel, Body, FloatArray
-from .shapes import Box, Capsule, Shape, Sphere
+from .shapes import Box, Capsule, Convex, Shape, Sphere
 
 __all__ = ["mjcf_text", "quaternion_from_matrix", "write_mjcf"]
 
@@ -127,11 +127,17 @@ class _Names:
         return name
 
 
-def _geoms(shapes: Sequence[Shape], body_name: str, names: _Names) -> list[str]:
+def _geoms(shapes: Sequence[Shape], body_name: str, names: _Names, assets: list[str]) -> list[str]:
+    """The geoms of ``shapes``; a convex hull's vertices go to ``assets`` as a ``<mesh>``
+    (MuJoCo collides a mesh by its convex hull)."""
     out = []
     for k, shape in enumerate(shapes):
         name = quoteattr(names(shape.name, f"{body_name}/shape{k + 1}"))
-        if isinstance(shape, Box):
+        if isinstance(shape, Convex):
+            mesh = quoteattr(f"{body_name}/mesh{len(assets) + 1}")
+            assets.append(f"<mesh name={mesh} vertex=\"{_vec(shape.vertices.ravel())}\"/>")
+            out.append(f'<geom name={name} type="mesh" mesh={mesh} {_frame(shape.pose)}/>')
+        elif isinstance(shape, Box):
             out.append(f'<geom name={name} type="box" {_frame(shape.pose)} size="{_vec(shape.half_extents)}"/>')
         elif isinstance(shape, Sphere) or (isinstance(shape, Capsule) and shape.length == 0):
             center = shape.center if isinstance(shape, Sphere) else shape.a
@@ -196,6 +202,7 @@ def mjcf_text(
     locked_text = ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):.12g} deg" for lj in model.locked)
     how = "held by brakes (joint equalities)" if held else "folded into the chain, bodies merged"
     names, joint_names = _Names(), _Names()
+    assets: list[str] = []
     body_of_link: dict[int, str] = {}
     lines = [
         f"<mujoco model={quoteattr(model.name)}>",
@@ -212,7 +219,7 @@ def mjcf_text(
     root = chain.root_body
     if root.mass > 0:
         lines.append(f"      {_inertial(root)}")
-    lines += [f"      {g_}" for g_ in _geoms(root.shapes, BASE_LINK, names)]
+    lines += [f"      {g_}" for g_ in _geoms(root.shapes, BASE_LINK, names, assets)]
     for shape in root.shapes:
         body_of_link.setdefault(shape.link if shape.link is not None else 0, BASE_LINK)
     actuators, equalities = [], []
@@ -229,7 +236,7 @@ def mjcf_text(
         ]
         if body.mass > 0:
             lines.append(f"{indent}  {_inertial(body)}")
-        lines += [f"{indent}  {g_}" for g_ in _geoms(body.shapes, body_name, names)]
+        lines += [f"{indent}  {g_}" for g_ in _geoms(body.shapes, body_name, names, assets)]
         for shape in body.shapes:
             body_of_link.setdefault(shape.link if shape.link is not None else joint.number, body_name)
         if joint.number in held:
@@ -247,6 +254,9 @@ def mjcf_text(
     for k in range(len(chain.joints), -1, -1):
         lines.append(f"{'      ' + '  ' * (k - 1) if k else '    '}</body>")
     lines.append("  </worldbody>")
+    if assets:
+        at = lines.index("  <worldbody>")
+        lines[at:at] = ["  <asset>", *[f"    {a_}" for a_ in assets], "  </asset>"]
     # a body and its parent never touch in jointlock (adjacent links); MuJoCo filters that pair
     # itself except under a body welded to the world (a fixed base), so it is written out
     chain_bodies = [BASE_LINK] + [f"link{joint.number}" for joint in chain.joints]

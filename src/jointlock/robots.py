@@ -302,7 +302,7 @@ def _mentions_urdf(path: Path) -> bool:
 
 
 #: A scenario's fields naming the chain of a URDF tree (the command line's --root, --tip, --freeze).
-CHAIN_FIELDS: tuple[str, ...] = ("root_link", "tip_link", "freeze_deg", "freeze_m", "srdf")
+CHAIN_FIELDS: tuple[str, ...] = ("root_link", "tip_link", "freeze_deg", "freeze_m", "srdf", "meshes")
 
 
 @dataclass(frozen=True)
@@ -312,8 +312,9 @@ class UrdfChain:
 
     ``freeze_deg``: ``((revolute joint, value [deg]), ...)``; ``freeze_m``: ``((prismatic
     joint, value [m]), ...)``; ``srdf``: an SRDF file whose ``<disable_collisions>`` pairs the
-    clearance never checks (:func:`jointlock.io.srdf.read_srdf`).  Hashable: part of
-    :func:`load_robot`'s cache key.
+    clearance never checks (:func:`jointlock.io.srdf.read_srdf`); ``meshes``: ``"skip"`` leaves
+    the ``<collision>`` meshes out (default, None: each read as its convex hull,
+    :func:`jointlock.read_urdf`).  Hashable: part of :func:`load_robot`'s cache key.
     """
 
     root_link: str | None = None
@@ -321,6 +322,7 @@ class UrdfChain:
     freeze_deg: tuple[tuple[str, float], ...] = ()
     freeze_m: tuple[tuple[str, float], ...] = ()
     srdf: str | None = None
+    meshes: str | None = None
 
     @classmethod
     def from_fields(cls, data: Mapping[str, Any]) -> UrdfChain | None:
@@ -335,13 +337,14 @@ class UrdfChain:
             tuple((str(k), float(v)) for k, v in (data.get("freeze_deg") or {}).items()),
             tuple((str(k), float(v)) for k, v in (data.get("freeze_m") or {}).items()),
             data.get("srdf") or None,
+            data.get("meshes") or None,
         )
         return chain if chain != cls() else None
 
     def fields(self) -> dict[str, Any]:
         """The given fields as a scenario writes them (``freeze_deg = {joint = value}``)."""
         out: dict[str, Any] = {"root_link": self.root_link, "tip_link": self.tip_link}
-        out.update(freeze_deg=dict(self.freeze_deg), freeze_m=dict(self.freeze_m), srdf=self.srdf)
+        out.update(freeze_deg=dict(self.freeze_deg), freeze_m=dict(self.freeze_m), srdf=self.srdf, meshes=self.meshes)
         return {k: v for k, v in out.items() if v}
 
 
@@ -353,7 +356,7 @@ def _read_urdf_chain(path: str, base: BaseMode, chain: UrdfChain | None) -> ArmM
     if chain.srdf is not None:
         from .io.srdf import read_srdf
 
-        plain = UrdfChain(chain.root_link, chain.tip_link, chain.freeze_deg, chain.freeze_m)
+        plain = UrdfChain(chain.root_link, chain.tip_link, chain.freeze_deg, chain.freeze_m, meshes=chain.meshes)
         return with_disabled_pairs(_read_urdf_chain(path, base, plain), read_srdf(chain.srdf))
     freeze = {k: math.radians(v) for k, v in chain.freeze_deg} | dict(chain.freeze_m)
     units = {k: "deg" for k, _ in chain.freeze_deg} | {k: "m" for k, _ in chain.freeze_m}
@@ -361,8 +364,9 @@ def _read_urdf_chain(path: str, base: BaseMode, chain: UrdfChain | None) -> ArmM
         twice = sorted({k for k, _ in chain.freeze_deg} & {k for k, _ in chain.freeze_m})
         raise ModelError(f"{path}: joint {shown(twice[0])} is frozen in both degrees and metres; give it once")
     return read_urdf(
-        path, base=base, root_link=chain.root_link, tip_link=chain.tip_link, freeze=freeze, freeze_units=units
-    )
+        path, base=base, root_link=chain.root_link, tip_link=chain.tip_link, freeze=freeze, freeze_units=units,
+        meshes="skip" if chain.meshes == "skip" else "convex",
+    )  # fmt: skip
 
 
 @functools.lru_cache(maxsize=32)

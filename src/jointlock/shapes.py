@@ -7,7 +7,9 @@ root body: the spacecraft bus, or a bare mounting):
   links of the built-in arms;
 * :class:`Sphere`: a ball (a capsule of zero length);
 * :class:`Box`: a rectangular box of ``half_extents`` (3,) [m] at ``pose`` (4, 4) -- the
-  spacecraft bus, keep-out volumes.
+  spacecraft bus, keep-out volumes;
+* :class:`Convex`: the convex hull of ``vertices`` (V, 3) [m] at ``pose`` (4, 4) -- a URDF
+  ``<mesh>``, read as its convex hull (:mod:`jointlock.io.urdf`).
 
 Shapes move with their body: :meth:`jointlock.model.Body.transformed` turns them and
 :meth:`jointlock.model.Body.merged` keeps both bodies' shapes, so that :func:`jointlock.lock`
@@ -22,7 +24,7 @@ Distances between shapes are computed by :mod:`jointlock.collision`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from typing import cast
 
 import numpy as np
@@ -89,7 +91,7 @@ def _label(name: str, kind: str) -> str:
     return f"{kind} {shown(name)}" if name else kind
 
 
-def _check_identity(shape: Capsule | Sphere | Box, kind: str) -> None:
+def _check_identity(shape: Capsule | Sphere | Box | Convex, kind: str) -> None:
     """``name`` text, ``link`` None or an integer joint number (0: the root body, -1 a keep-out)."""
     if not isinstance(shape.name, str):
         raise ModelError(f"{kind}: name must be text; got {shown(shape.name)}")
@@ -223,9 +225,68 @@ class Box:
         }
 
 
+@dataclass(frozen=True, eq=False)
+class Convex:
+    """The convex hull of ``vertices`` (V, 3) [m] given in the frame ``pose`` (4, 4), itself in
+    its body's frame (``link`` as for :class:`Capsule`): a mesh's envelope.
+
+    ``source`` is the mesh file it was read from (empty when built in code) and ``scale`` (3,)
+    the scale the file's coordinates were multiplied by to give ``vertices``: what an export
+    writes back.  Distances to a convex hull are computed with coal (the ``mesh`` extra,
+    :mod:`jointlock.collision`)."""
+
+    pose: FloatArray
+    vertices: FloatArray
+    name: str = ""
+    link: int | None = None
+    source: str = ""
+    scale: FloatArray = field(default_factory=lambda: np.ones(3))
+
+    def __post_init__(self) -> None:
+        _check_identity(self, "convex")
+        label = _label(self.name, "convex")
+        object.__setattr__(self, "pose", _pose(self.pose, f"{label}: pose"))
+        vertices = _floats(self.vertices, f"{label}: vertices")
+        if vertices.ndim != 2 or vertices.shape[1] != 3 or vertices.shape[0] < 4:
+            raise ModelError(f"{label}: vertices must be (V, 3) with V >= 4 (a solid); got shape {vertices.shape}")
+        if not np.all(np.isfinite(vertices)) or np.any(np.abs(vertices) > MAX_MODEL_LENGTH_M):
+            raise ModelError(f"{label}: vertices must be finite and within +-{MAX_MODEL_LENGTH_M:g} m")
+        spread = vertices - vertices.mean(axis=0)
+        if np.linalg.matrix_rank(spread, tol=1e-9 * max(float(np.abs(spread).max()), 1e-300)) < 3:
+            raise ModelError(f"{label}: vertices are flat (all in one plane): a convex hull needs volume")
+        object.__setattr__(self, "vertices", _readonly(vertices))
+        if not isinstance(self.source, str):
+            raise ModelError(f"{label}: source must be text (a file name); got {shown(self.source)}")
+        object.__setattr__(self, "scale", _point(self.scale, f"{label}: scale"))
+
+    @property
+    def extent(self) -> float:
+        """The largest distance [m] of a vertex from the body frame's origin."""
+        placed = self.vertices @ self.pose[:3, :3].T + self.pose[:3, 3]
+        return float(np.linalg.norm(placed, axis=1).max())
+
+    def transformed(self, pose: ArrayLike) -> Convex:
+        """The same hull in another frame; ``pose`` (4, 4) is T_new_old."""
+        return replace(self, pose=np.asarray(pose, dtype=float) @ self.pose)
+
+    def to_dict(self) -> dict:
+        """Plain data: type, frame centre [m] and rotation, vertices [m], source file, scale,
+        name, link."""
+        return {
+            "type": "convex",
+            "center_m": self.pose[:3, 3].tolist(),
+            "rotation": self.pose[:3, :3].tolist(),
+            "vertices_m": self.vertices.tolist(),
+            "source": self.source,
+            "scale": self.scale.tolist(),
+            "name": self.name,
+            "link": self.link,
+        }
+
+
 #: A collision shape.
-Shape = Capsule | Sphere | Box
-SHAPE_TYPES = (Capsule, Sphere, Box)
+Shape = Capsule | Sphere | Box | Convex
+SHAPE_TYPES = (Capsule, Sphere, Box, Convex)
 
 
 def check_shapes(shapes: object, what: str) -> tuple[Shape, ...]:
@@ -236,11 +297,11 @@ def check_shapes(shapes: object, what: str) -> tuple[Shape, ...]:
     try:
         items: tuple[object, ...] = tuple(shapes)  # type: ignore[arg-type]
     except TypeError:
-        raise ModelError(f"{what}: shapes must be a sequence of Capsule, Sphere or Box; got {shown(shapes)}") from None
+        raise ModelError(f"{what}: shapes must be a sequence of Capsule, Sphere, Box or Convex; got {shown(shapes)}") from None
     for i, item in enumerate(items):
         if not isinstance(item, SHAPE_TYPES):
             raise ModelError(
-                f"{what}: shapes[{i}] must be a Capsule, Sphere or Box; got {type(item).__name__} ({shown(item)})"
+                f"{what}: shapes[{i}] must be a Capsule, Sphere, Box or Convex; got {type(item).__name__} ({shown(item)})"
             )
     return cast(tuple[Shape, ...], items)
 

@@ -45,7 +45,7 @@ from ._cache import cached_on
 from .collision import CollisionPairs, clearance, collision_pairs
 from .errors import ConfigurationError
 from .model import ArmModel, FloatArray
-from .shapes import Shape
+from .shapes import Convex, Shape
 
 #: How far below the distance a pair must keep its certified bound between samples may fall
 #: [m] before the interval is refined, and the most by which an accepted motion can come closer
@@ -80,13 +80,18 @@ def pair_reach(model: ArmModel, pairs: CollisionPairs | None = None) -> FloatArr
     box_extent = [
         float(np.linalg.norm(pose[:3, 3]) + np.linalg.norm(half)) for pose, half in zip(pairs.box_poses, pairs.box_halves)
     ]
+    # kind-2 pairs index every shape: capsules, boxes, then convex hulls
+    extents = cap_extent + box_extent + [s.extent for s in pairs.shapes if isinstance(s, Convex)]
     reach = np.zeros((len(pairs.pairs), model.dof))
     for p, (kind, first, second) in enumerate(pairs.pairs):
-        ends = [(int(pairs.capsule_body[first]), cap_extent[first])]
-        if kind == 0:
-            ends.append((int(pairs.capsule_body[second]), cap_extent[second]))
+        if kind == 2:
+            ends = [(int(pairs.shape_body[g]), extents[g]) for g in (first, second)]
         else:
-            ends.append((int(pairs.box_body[second]), box_extent[second]))
+            ends = [(int(pairs.capsule_body[first]), cap_extent[first])]
+            if kind == 0:
+                ends.append((int(pairs.capsule_body[second]), cap_extent[second]))
+            else:
+                ends.append((int(pairs.box_body[second]), box_extent[second]))
         (low, _), (body, extent) = sorted(ends)
         for i in range(low + 1, body + 1):
             # joint i turns the outer shape about an axis through o_i, at most this far from it

@@ -168,7 +168,8 @@ def clearance_distances(
         (B,) int64 body of each box; (B, 12) its rotation (row-major, box axes as columns) and
         centre in that frame [m]; (B, 3) half extents [m].
     pairs, offsets
-        As :func:`jointlock._kernels._distance.pair_distances`.
+        As :func:`jointlock._kernels._distance.pair_distances`; a pair of kind 2 (a convex
+        hull) is left at +inf, for the caller.
     witness
         Whether to compute the closest pair's witness points (``out_witness`` is left as it is
         otherwise).
@@ -249,6 +250,9 @@ def clearance_distances(
                         caps[o + 3 * BLOCK + b] - bx, caps[o + 4 * BLOCK + b] - by, caps[o + 5 * BLOCK + b] - bz,
                     )
                     dist[out + b] = math.sqrt(d2) - gap
+            elif kind == 2:  # a convex hull: coal, afterwards (jointlock.collision)
+                for b in range(nb):
+                    dist[out + b] = np.inf
             else:
                 o = 12 * j * BLOCK
                 hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]

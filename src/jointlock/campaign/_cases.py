@@ -144,6 +144,7 @@ def resolve_case(spec: CampaignSpec, overrides: Mapping[str, Any]) -> Scenario:
 UNKEYED_WHEN_UNSET = (
     "compiled",
     "srdf",
+    "meshes",
     "jump.on_infeasible",
     *(f"task.{name}" for name in ("dx_m", "q0_deg", "duration_s", "blend_s", "dt_s", "kp", "feedforward", "base")),
 )

@@ -25,7 +25,7 @@ CONFIRM_CASES = 100_000
 #: Most cases one campaign file may describe (the plan is held in memory).
 MAX_CASES = 2_000_000
 #: Scenario fields a campaign may not vary (they do not change a result).
-NOT_VARIED = ("title", "description", "out", "root_link", "tip_link", "freeze_deg", "freeze_m", "srdf", "check_in")
+NOT_VARIED = ("title", "description", "out", "root_link", "tip_link", "freeze_deg", "freeze_m", "srdf", "meshes", "check_in")
 
 _TOP_KEYS = (
     "title",

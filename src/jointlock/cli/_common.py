@@ -221,6 +221,10 @@ def add_robot_arguments(
     chain.add_argument(
         "--srdf", metavar="FILE", help="an SRDF file: its <disable_collisions> link pairs are never checked for clearance"
     )
+    chain.add_argument(
+        "--meshes", choices=("convex", "skip"), default=None,
+        help="the URDF's <collision> meshes: read as their convex hulls (default; needs jointlock[mesh]) or left out",
+    )  # fmt: skip
 
 
 def single_lock(args: argparse.Namespace) -> tuple[int, float]:
@@ -265,15 +269,15 @@ def chain_from_args(args: argparse.Namespace) -> UrdfChain | None:
     line for a ROBOT that is not a ``.urdf`` file.  Each ``--freeze`` value is in the unit of its
     joint's type, read from the file."""
     root, tip, freeze = getattr(args, "root", None), getattr(args, "tip", None), getattr(args, "freeze", None) or []
-    srdf = getattr(args, "srdf", None)
-    if root is None and tip is None and not freeze and srdf is None:
+    srdf, meshes = getattr(args, "srdf", None), getattr(args, "meshes", None)
+    if root is None and tip is None and not freeze and srdf is None and meshes is None:
         return None
     robot = str(args.robot)
     if robot in BUILTIN_ROBOTS or Path(robot).suffix.lower() != ".urdf":
         what = "a built-in robot" if robot in BUILTIN_ROBOTS else "not a .urdf file (a .toml model file names its chain itself)"
         raise ScenarioError(
-            f"--root, --tip and --freeze choose the chain of a URDF robot (and --srdf its pairs not checked for "
-            f"clearance); ROBOT {shorten(robot)!r} is {what}"
+            f"--root, --tip and --freeze choose the chain of a URDF robot (--srdf its pairs not checked for "
+            f"clearance, --meshes how its meshes are read); ROBOT {shorten(robot)!r} is {what}"
         )
     from ..io.urdf import urdf_joint_types
     from ..robots import UrdfChain
@@ -286,7 +290,7 @@ def chain_from_args(args: argparse.Namespace) -> UrdfChain | None:
         seen[name] = value
     prismatic = {k: v for k, v in seen.items() if types.get(k) == "prismatic"}
     degrees = {k: v for k, v in seen.items() if k not in prismatic}
-    return UrdfChain(root, tip, tuple(degrees.items()), tuple(prismatic.items()), srdf)
+    return UrdfChain(root, tip, tuple(degrees.items()), tuple(prismatic.items()), srdf, meshes)
 
 
 def model_from_args(args: argparse.Namespace) -> ArmModel:

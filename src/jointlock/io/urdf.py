@@ -18,8 +18,10 @@ Collision geometry (issue 27): each link's ``<collision>`` primitives become its
 they are, ``<cylinder>`` as its capsule envelope (the cylinder with a half-ball on each end:
 conservative, a clearance is never overstated; a cylinder and the two spheres at its ends, as
 :func:`~jointlock.io.urdf_export.urdf_text` writes a capsule, read back as the capsule exactly).
-``<mesh>`` elements are not read (meshes are not supported yet); the model's description says
-how many were left out.
+``<mesh>`` as its convex hull (:class:`~jointlock.shapes.Convex`, read by
+:mod:`jointlock.io.mesh` with the ``mesh`` extra; distances by coal): a clearance against the
+hull never exceeds the one against the mesh.  ``meshes="skip"`` leaves meshes out instead (the
+model's description then says how many).
 """
 
 from __future__ import annotations
@@ -27,7 +29,7 @@ from __future__ import annotations
 import math
 import re
 import xml.etree.ElementTree as ET
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Literal
@@ -37,10 +39,11 @@ import numpy as np
 from ..bounds import MAX_JOINT_VALUE, MAX_LENGTH_M, shown
 from ..errors import ModelError
 from ..model import ArmModel, Body, Joint
-from ..shapes import Box, Capsule, Shape, Sphere
+from ..shapes import Box, Capsule, Convex, Shape, Sphere
 from ..spatial import pose, rpy_matrix
 from ._urdf_chain import Chain, select_chain
 from .files import check_path_text, decode_text, read_input_bytes, shorten
+from .mesh import MESH_MODES
 
 
 @dataclass
@@ -141,8 +144,31 @@ def _inertial(link: ET.Element, label: str) -> Body:
     return body.transformed(frame)
 
 
-def _collisions(link: ET.Element, label: str) -> tuple[tuple[Shape, ...], int]:
-    """The link's ``<collision>`` primitives as shapes in its frame, and how many meshes were
+@dataclass(frozen=True)
+class _Meshes:
+    """How a URDF's ``<mesh>`` elements are read (see the module)."""
+
+    mode: str
+    urdf_dir: Path | None
+    package_dirs: tuple[str | Path, ...]
+
+    def shape(self, element: ET.Element, frame: np.ndarray, name: str, where: str) -> Convex:
+        from .mesh import hull_vertices, resolve_mesh
+
+        filename = element.get("filename")
+        if not filename:
+            raise ModelError(f"{where} <mesh>: needs a filename")
+        scale = _floats(element.get("scale"), 3, f"{where} <mesh scale>", [1.0, 1.0, 1.0])
+        try:
+            path = resolve_mesh(filename, self.urdf_dir, self.package_dirs)
+            vertices = hull_vertices(path, scale)
+        except ModelError as exc:
+            raise ModelError(f"{where}: {exc}") from None
+        return Convex(frame, vertices, name=name, source=str(path), scale=scale)
+
+
+def _collisions(link: ET.Element, label: str, meshes_as: _Meshes) -> tuple[tuple[Shape, ...], int]:
+    """The link's ``<collision>`` elements as shapes in its frame, and how many meshes were
     left out (see the module)."""
     name = link.get("name", "?")
     shapes: list[Shape] = []
@@ -168,7 +194,10 @@ def _collisions(link: ET.Element, label: str) -> tuple[tuple[Shape, ...], int]:
                 ends = frame[:3, 3] + np.outer([-half, half], frame[:3, 2])
                 shapes.append(Capsule(ends[0], ends[1], radius, name=label_name))
             elif element.tag == "mesh":
-                meshes += 1
+                if meshes_as.mode == "skip":
+                    meshes += 1
+                else:
+                    shapes.append(meshes_as.shape(element, frame, label_name, where))
             else:
                 raise ModelError(
                     f"{where}: <{shorten(element.tag, 40)}> is not a URDF geometry (box, cylinder, sphere, mesh)"
@@ -205,6 +234,8 @@ def read_urdf(
     tip_link: str | None = None,
     freeze: Mapping[str, float] | None = None,
     freeze_units: Mapping[str, str] | None = None,
+    meshes: Literal["convex", "skip"] = "convex",
+    package_dirs: Sequence[str | Path] = (),
 ) -> ArmModel:
     """Read a URDF file (or a string holding URDF XML) into an :class:`ArmModel`.
 
@@ -232,6 +263,14 @@ def read_urdf(
     freeze_units
         ``{joint name: "deg" | "m"}``: the unit each value was given in (a model file's
         ``freeze_deg`` / ``freeze_m``), refused for a joint of the other kind.
+    meshes
+        ``"convex"``: each ``<collision>`` ``<mesh>`` is read as its convex hull (needs the
+        ``mesh`` extra: ``pip install 'jointlock[mesh]'``); ``"skip"``: meshes are left out, and
+        the links that have only meshes have no collision geometry (the description says how
+        many were left out).
+    package_dirs
+        Folders in which ``package://`` mesh files are looked for, before ``ROS_PACKAGE_PATH``
+        and the folders above the URDF (:mod:`jointlock.io.mesh`).
 
     Notes
     -----
@@ -240,10 +279,17 @@ def read_urdf(
     source_text = str(source)
     text: str | bytes = source_text
     label = "URDF"
+    urdf_dir: Path | None = None
+    if meshes not in MESH_MODES:
+        raise ModelError(f"meshes must be one of {', '.join(MESH_MODES)}; got {shown(meshes)}")
+    if isinstance(package_dirs, (str, Path)):
+        package_dirs = (package_dirs,)
     if not source_text.lstrip().startswith("<"):
         path = check_path_text(source_text, "URDF file", ModelError)
         label = shorten(str(path))
         text = _urdf_text(path, label)
+        urdf_dir = Path(path).parent
+    meshes_as = _Meshes(meshes, urdf_dir, tuple(package_dirs))
     try:
         root = ET.fromstring(text)
     except (ET.ParseError, LookupError, ValueError) as exc:  # LookupError: an unknown declared encoding
@@ -332,13 +378,13 @@ def read_urdf(
 
     bodies = [Body(0.0, name=j.child) for j, _ in movable]
     root_body = Body(0.0, name=chain.root)
-    meshes = 0
+    skipped_meshes = 0
     for lname, link in links.items():
         if lname not in owner:  # above root_link: not part of the model
             continue
         body = _inertial(link, label)
-        shapes, skipped = _collisions(link, label)
-        meshes += skipped
+        shapes, skipped = _collisions(link, label, meshes_as)
+        skipped_meshes += skipped
         if body.mass == 0 and not np.any(body.inertia) and not shapes:
             continue
         body = replace(body, shapes=shapes)
@@ -369,7 +415,7 @@ def read_urdf(
         root_body=root_body,
         floating=base == "floating",
         description=f"read from {label}" + _selection_text(chain)
-        + (f"; {meshes} <collision> mesh(es) not read (meshes are not supported yet)" if meshes else ""),
+        + (f"; {skipped_meshes} <collision> mesh(es) left out (meshes='skip')" if skipped_meshes else ""),
     )
 
 

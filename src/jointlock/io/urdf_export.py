@@ -26,8 +26,9 @@ Conventions a reader of the file needs:
   sphere as ``<sphere>``, a box as ``<box>``, and a capsule, which URDF lacks, as a
   ``<cylinder>`` and a ``<sphere>`` at each end (their union is the capsule, so any reader's
   distances are the capsule's; :func:`~jointlock.io.urdf.read_urdf` reads the three back as the
-  capsule).  Each element is named after the shape (a capsule's end spheres ``NAME/end1``,
-  ``NAME/end2``).
+  capsule), and a convex hull read from a mesh as the ``<mesh>`` it came from (its file and
+  scale; a reader takes that mesh's convex hull, as jointlock does, or the mesh itself).  Each
+  element is named after the shape (a capsule's end spheres ``NAME/end1``, ``NAME/end2``).
 """
 
 from __future__ import annotations
@@ -38,8 +39,9 @@ from xml.sax.saxutils import quoteattr
 
 import numpy as np
 
+from ..errors import ModelError
 from ..model import ArmModel, Body, FloatArray
-from ..shapes import Box, Sphere
+from ..shapes import Box, Convex, Sphere
 from ..spatial import pose
 from .files import atomic_write_text
 
@@ -83,6 +85,15 @@ def _collisions(body: Body) -> str:
     out = []
     for shape in body.shapes:
         name = quoteattr(shape.name or body.name or "shape")
+        if isinstance(shape, Convex):
+            if not shape.source:
+                raise ModelError(
+                    f"convex shape {shape.name!r}: URDF has no inline mesh; a hull built in code has no file to "
+                    "refer to (export to MJCF, which writes the vertices, or give the shape its mesh file as source)"
+                )
+            mesh = f'<mesh filename={quoteattr(shape.source)} scale="{_vec(shape.scale)}"/>'
+            out.append(f"<collision name={name}>{_origin(shape.pose)}<geometry>{mesh}</geometry></collision>")
+            continue
         if isinstance(shape, Box):
             parts = [(shape.pose, f'<box size="{_vec(2 * shape.half_extents)}"/>')]
         elif isinstance(shape, Sphere) or shape.length == 0:

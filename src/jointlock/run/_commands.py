@@ -52,6 +52,7 @@ def _chain_args(data: Mapping[str, Any]) -> list[str]:
     for name, value in (*chain.freeze_deg, *chain.freeze_m):
         argv += ["--freeze", f"{name}={_num(value)}"]
     argv += ["--srdf", chain.srdf] if chain.srdf else []
+    argv += ["--meshes", chain.meshes] if chain.meshes else []
     return argv
 
 

@@ -144,6 +144,11 @@ TOP_FIELDS: dict[str, Field] = {
         "str", None, help="URDF robot only: an SRDF file (relative to the scenario's folder) whose "
         "<disable_collisions> link pairs the clearance never checks",
     ),
+    "meshes": Field(
+        "choice", None, choices=("convex", "skip"),
+        help="URDF robot only: its <collision> meshes read as their convex hulls (default; needs the mesh "
+        "extra) or left out (skip: those links are then geometry-blind)",
+    ),  # fmt: skip
     "freeze_m": Field(
         "joint_values", None, lo=-MAX_LENGTH_M, hi=MAX_LENGTH_M, unit="m",
         help="URDF robot only: prismatic joints held at these positions (gripper fingers, a torso lift)",

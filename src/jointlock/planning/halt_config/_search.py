@@ -193,7 +193,8 @@ def optimal_halt_configuration(
                 f"none of the {k} samples keeps a clearance of {margin:g} m"
                 + ("" if reachable is None else f" among the {int(reachable.sum())} reachable")
                 + f" (links, spacecraft bus, keep-outs); the nearest keeps {sampled.pair_distance[near, pair]:+.3f} m "
-                f"between {sampled.names[pair]}: lower clearance_min_m, widen the ranges or raise samples"
+                f"between {sampled.names[pair]}: lower clearance_min_m, widen the ranges, raise samples, or leave "
+                "out a pair close by design (an SRDF's disable_collisions: srdf, --srdf)"
             )
         reachable = admissible
     ind = configuration_indices(
