@@ -218,9 +218,9 @@ def test_a_scenario_and_the_command_line_choose_how_meshes_are_read(tmp_path, ca
     from robot_data import robot_file
 
     from jointlock.cli import main
+    from jointlock.errors import ScenarioError
     from jointlock.robots import UrdfChain
     from jointlock.run._commands import _chain_args
-    from jointlock.errors import ScenarioError
 
     urdf = robot_file(UR5)
     path = tmp_path / "s.toml"
