@@ -97,7 +97,7 @@ OFF = jl.ClearanceSettings.off()
 def free_halt():
     # 000's q_best breaks a limit when free; the limits' behaviour is tested on 000's search
     # (the clearance reported, not required: a required one moves the halt configuration)
-    return plan_halt("halt7", base="floating", samples=4000, clearance=OFF)
+    return plan_halt("halt7", base="floating", clearance=OFF, search=jl.HaltSearch(samples=4000))
 
 
 @pytest.fixture
@@ -120,7 +120,7 @@ def test_every_halt_reports_motor_and_brake_torques(free_halt):
 def test_a_brake_limit_moves_k_and_is_kept_on_every_sample(free_halt, _halt):
     peak = free_halt.actuator_loads().peak_brake[0]
     limit = 0.97 * peak
-    plan = _halt(brake_max_Nm=limit)
+    plan = _halt(limits=jl.HaltLimits(brake_max_Nm=limit))
     assert plan.feasible and plan.motion.k != free_halt.motion.k
     fine = plan.problem.times(20001)
     q, dq, ddq = plan.motion.trajectory(fine)
@@ -143,7 +143,13 @@ def test_a_margin_keeps_a_share_of_the_torque_limits(free_halt):
     s = free_halt.problem  # 000's state has joint 6 at its speed limit: a slower one leaves room for a margin
     state = jl.FailureState(s.q0, 0.9 * s.dq0, s.ddq0)
     plan = plan_halt(
-        s.model, state, T=10.0, base="floating", samples=4000, torque_max_Nm=limit, margin=0.02, clearance=OFF
+        s.model,
+        state,
+        T=10.0,
+        base="floating",
+        clearance=OFF,
+        search=jl.HaltSearch(samples=4000),
+        limits=jl.HaltLimits(torque_max_Nm=limit, margin=0.02),
     )
     assert plan.feasible
     assert plan.actuator_loads().peak_motor.max() <= 0.98 * limit * (1 + 1e-6)
@@ -152,7 +158,7 @@ def test_a_margin_keeps_a_share_of_the_torque_limits(free_halt):
 
 def test_a_torque_limit_no_k_keeps_is_reported_as_the_binding_one(free_halt, _halt):
     limit = 0.5 * free_halt.actuator_loads().peak_motor.max()
-    plan = _halt(torque_max_Nm=limit)
+    plan = _halt(limits=jl.HaltLimits(torque_max_Nm=limit))
     assert not plan.feasible
     worst = plan.motion.violations[0]
     assert worst.kind == "torque" and worst.limit == pytest.approx(limit)
@@ -164,12 +170,18 @@ def test_a_torque_limit_no_k_keeps_is_reported_as_the_binding_one(free_halt, _ha
 
 def test_a_state_at_failure_beyond_a_torque_limit_is_refused_up_front():
     with pytest.raises(jl.InfeasibleError, match=r"already needs more torque than a limit allows.*joint 1 motor torque"):
-        plan_halt("halt7", paper_qf=True, base="fixed", torque_max_Nm=1000.0)
+        plan_halt("halt7", paper_qf=True, base="fixed", limits=jl.HaltLimits(torque_max_Nm=1000.0))
 
 
 def test_torque_limits_need_the_scan_solver():
     with pytest.raises(jl.ScenarioError, match="torque limits need solver 'scan'"):
-        plan_halt("halt7", paper_qf=True, base="floating", brake_max_Nm=1e6, solver="ga")
+        plan_halt(
+            "halt7",
+            paper_qf=True,
+            base="floating",
+            limits=jl.HaltLimits(brake_max_Nm=1e6),
+            motion=jl.HaltMotionSettings(solver="ga"),
+        )
 
 
 def test_a_model_effort_limit_is_the_default_motor_limit():
@@ -194,8 +206,8 @@ def test_prefer_margin_trades_a_little_objective_for_clear_limits(free_halt, _ha
     from jointlock.planning.halt_motion._robust import limit_margins
 
     limit = 0.97 * free_halt.actuator_loads().peak_brake[0]
-    tight = _halt(brake_max_Nm=limit)
-    robust = _halt(brake_max_Nm=limit, prefer_margin=0.01)
+    tight = _halt(limits=jl.HaltLimits(brake_max_Nm=limit))
+    robust = _halt(limits=jl.HaltLimits(brake_max_Nm=limit), motion=jl.HaltMotionSettings(prefer_margin=0.01))
     assert tight.motion.k_optimum is None and robust.motion.k_optimum == pytest.approx(tight.motion.k)
     assert robust.motion.global_torque <= tight.motion.global_torque * 1.01 + 1e-9
     assert robust.motion.global_torque > tight.motion.global_torque  # it did give something up
@@ -210,7 +222,7 @@ def test_prefer_margin_trades_a_little_objective_for_clear_limits(free_halt, _ha
 
 def test_prefer_margin_is_bounded_and_named():
     with pytest.raises(jl.ScenarioError, match="prefer_margin"):
-        plan_halt("halt7", paper_qf=True, prefer_margin=-0.1)
+        plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(prefer_margin=-0.1))
 
 
 # -- review regressions ----------------------------------------------------------------------------
@@ -222,24 +234,42 @@ def test_a_urdfs_own_effort_limits_are_reported_not_refused_by_the_ga():
     arm = jl.lock(jl.read_urdf(DATA / "arm5.urdf"), 2, 0.0)
     assert jl.halt_limits(arm).torque.tolist() == [100.0, np.inf, 10.0, 10.0]  # <limit effort> (none on one)
     state = jl.FailureState.from_degrees(arm, [0, 0, 0, 0], [5, 5, 5, 5], [0, 0, 0, 0])
-    plan = plan_halt(arm, state, T=10.0, samples=50, solver="ga", ga=jl.jobs.halt._strategy.GASettings(n_pop=4, n_gen=2))
+    plan = plan_halt(
+        arm,
+        state,
+        T=10.0,
+        search=jl.HaltSearch(samples=50),
+        motion=jl.HaltMotionSettings(solver="ga", ga=jl.jobs.halt._strategy.GASettings(n_pop=4, n_gen=2)),
+    )
     assert not plan.problem.has_torque_limits and plan.limits.torque is not None
     assert any("the model's motor torque limits are reported, not kept: solver 'ga'" in line for line in plan.summary())
     assert np.isfinite(plan.margins()["torque"]).tolist() == [True, False, True, True]  # NaN: no limit
     with pytest.raises(jl.ScenarioError, match="torque limits need solver 'scan'"):
-        plan_halt(arm, state, T=10.0, samples=50, solver="ga", torque_max_Nm=50.0)
+        plan_halt(
+            arm,
+            state,
+            T=10.0,
+            search=jl.HaltSearch(samples=50),
+            motion=jl.HaltMotionSettings(solver="ga"),
+            limits=jl.HaltLimits(torque_max_Nm=50.0),
+        )
 
 
 def test_a_kinematically_infeasible_halt_with_torque_limits_searches_t_with_them():
-    res = plan_halt("halt7", paper_qf=True, torque_max_Nm=1e5, brake_max_Nm=900.0)  # kinematics break at 10 s
+    res = plan_halt("halt7", paper_qf=True, limits=jl.HaltLimits(torque_max_Nm=1e5, brake_max_Nm=900.0))  # kinematics break at 10 s
     kinds = {v.kind for v in res.motion.violations}
     assert not res.feasible and "velocity" in kinds and "brake" in kinds
     t_min = res.motion.minimum_T
-    assert t_min is None or plan_halt("halt7", paper_qf=True, T=t_min + 0.01, torque_max_Nm=1e5, brake_max_Nm=900.0).feasible
+    assert t_min is None or plan_halt(
+        "halt7",
+        paper_qf=True,
+        T=t_min + 0.01,
+        limits=jl.HaltLimits(torque_max_Nm=1e5, brake_max_Nm=900.0),
+    ).feasible
 
 
 def test_fragile_looks_at_the_stretch_that_keeps_the_torques_too(free_halt, _halt):
-    seg_plan = _halt(brake_max_Nm=0.97 * free_halt.actuator_loads().peak_brake[0])
+    seg_plan = _halt(limits=jl.HaltLimits(brake_max_Nm=0.97 * free_halt.actuator_loads().peak_brake[0]))
     a, b = seg_plan.motion.feasible_stretch
     assert (a, b) in seg_plan.motion.k_segments
     assert seg_plan.fragile == bool(b - a < 0.01 * abs(seg_plan.motion.k))
@@ -248,9 +278,14 @@ def test_fragile_looks_at_the_stretch_that_keeps_the_torques_too(free_halt, _hal
 
 def test_prefer_margin_with_one_k_per_joint_is_refused():
     with pytest.raises(jl.ScenarioError, match="prefer_margin needs one shared k"):
-        plan_halt("halt7", paper_qf=True, T=12.0, solver="vector", prefer_margin=0.05)
+        plan_halt(
+            "halt7",
+            paper_qf=True,
+            T=12.0,
+            motion=jl.HaltMotionSettings(solver="vector", prefer_margin=0.05),
+        )
 
 
 def test_a_margin_the_start_state_leaves_no_room_for_is_said_so():
-    with pytest.raises(jl.InfeasibleError, match="no margin can be kept: the state starts at a limit"):
-        plan_halt("halt7", margin=0.001)
+    with pytest.raises(jl.InfeasibleError, match="no limits.margin can be kept: the state starts at a limit"):
+        plan_halt("halt7", limits=jl.HaltLimits(margin=0.001))

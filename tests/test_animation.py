@@ -128,7 +128,12 @@ def test_halt_motion_holds_the_locked_joint(base):
     """000's failure (halt7, joint 4 locked at 0 deg): joint 4 stays at 0 and is marked from
     the start; the halt ends at rest at the halt configuration; the spacecraft is held for
     000's fixed-base torque and moves when the base is free."""
-    plan = plan_halt("halt7", samples=500, n_samples=101, base=base)
+    plan = plan_halt(
+        "halt7",
+        base=base,
+        search=jl.HaltSearch(samples=500),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     model, (m,) = plan.arm_motions()
     assert model.dof == 7 and m.locks == ((4, 0.0),) and m.moving_base == (base == "floating")
     assert np.all(m.q[:, 3] == 0.0)

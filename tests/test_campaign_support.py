@@ -36,7 +36,11 @@ def test_a_model_file_is_read_again_when_it_changes(tmp_path):
 
 
 def test_the_halt_finds_its_smallest_time_on_request():
-    plan = jl.plan_halt("halt7", samples=2000, minimum_T=True)
+    plan = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(minimum_T=True),
+    )
     assert plan.feasible
     t_min = plan.motion.minimum_T
     assert t_min is not None and t_min < 10.0
@@ -48,7 +52,7 @@ def test_the_halt_finds_its_smallest_time_on_request():
     assert lo > hi  # infeasible just below
     assert plan.to_dict()["minimum_T_s"] == t_min
     assert any("smallest halt time with a feasible k" in line for line in plan.summary())
-    assert jl.plan_halt("halt7", samples=2000).motion.minimum_T is None  # the default: not searched
+    assert jl.plan_halt("halt7", search=jl.HaltSearch(samples=2000)).motion.minimum_T is None  # the default: not searched
 
 
 def test_the_minimum_T_field_reaches_the_halt_and_its_equivalent_command(tmp_path):

@@ -303,9 +303,14 @@ def test_the_search_excludes_configurations_closer_than_required_and_refines_wit
 def test_a_given_halt_configuration_closer_than_required_is_refused_naming_the_pair():
     arm = jl.load_robot("halt7", base="floating")
     with pytest.raises(jl.ScenarioError, match=r"qf: the halt configuration keeps -\d\.\d{3} m between link3 - bus"):
-        jl.plan_halt("halt7", qf=np.radians(KNOWN_COLLIDING_DEG), n_samples=101)
+        jl.plan_halt("halt7", qf=np.radians(KNOWN_COLLIDING_DEG), motion=jl.HaltMotionSettings(n_samples=101))
     # reported, not refused, when the clearance is not required
-    plan = jl.plan_halt("halt7", qf=np.radians(KNOWN_COLLIDING_DEG), n_samples=101, clearance=jl.ClearanceSettings.off())
+    plan = jl.plan_halt(
+        "halt7",
+        qf=np.radians(KNOWN_COLLIDING_DEG),
+        clearance=jl.ClearanceSettings.off(),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     data = plan.to_dict()["clearance"]
     assert data["halt_configuration_m"] < 0 and data["halt_configuration_pair"] == "link3 - bus"
     assert plan.collision_free is False and plan.summary()[0].startswith("COLLIDES")
@@ -328,7 +333,11 @@ def test_000s_scenario_halts_clear_of_the_bus_and_says_where_it_starts():
     from jointlock.papers import p000
 
     sc = p000.SCENARIO
-    plan = jl.plan_halt("halt7", samples=4000, n_samples=201)
+    plan = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=4000),
+        motion=jl.HaltMotionSettings(n_samples=201),
+    )
     motion = plan.clearance()
     assert motion is not None and motion.distance[-1] >= 0.05 - 1e-9
     assert motion.distance[0] == pytest.approx(-0.0510, abs=5e-4)
@@ -357,10 +366,24 @@ def test_the_halt_motion_moves_k_to_keep_the_clearance():
     to the stretch of k whose motions come no closer, and says so."""
     from jointlock.planning.halt_motion import clear_k_segments, clearance_shortfall
 
-    off = jl.plan_halt("halt7", samples=2000, n_samples=101, clearance=jl.ClearanceSettings.off())
-    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    off = jl.plan_halt(
+        "halt7",
+        clearance=jl.ClearanceSettings.off(),
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
+    kept = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     assert not np.allclose(off.problem.qf, kept.problem.qf)  # the search moved too
-    same_qf = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, clearance=jl.ClearanceSettings.off())
+    same_qf = jl.plan_halt(
+        "halt7",
+        qf=kept.problem.qf,
+        clearance=jl.ClearanceSettings.off(),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     assert same_qf.collision_free is False  # the limits' optimum on this configuration comes closer
     assert kept.collision_free is True and kept.feasible
     assert any(note.startswith("k moved from 0.000770194 to") for note in kept.notes)
@@ -419,7 +442,11 @@ def test_the_3d_view_marks_the_deepest_overlap_frame_by_frame():
     empty once the arm is clear."""
     from jointlock.plots.animation import animation_figure
 
-    plan = jl.plan_halt("halt7", samples=500, n_samples=101)
+    plan = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=500),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     model, (motion,) = plan.arm_motions()
     fig = animation_figure(model, motion, max_frames=30)
     names = [d.get("name") for d in fig["data"]]
@@ -626,11 +653,24 @@ def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance(
     comes closer too, so the halt is the best shared k that keeps the clearance, and says so."""
     from jointlock.planning.halt_motion import clearance_shortfall
 
-    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
-    alone = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, solver="vector", clearance=jl.ClearanceSettings.off())
+    kept = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
+    alone = jl.plan_halt(
+        "halt7",
+        qf=kept.problem.qf,
+        clearance=jl.ClearanceSettings.off(),
+        motion=jl.HaltMotionSettings(n_samples=101, solver="vector"),
+    )
     assert alone.motion.per_joint
     assert clearance_shortfall(alone.problem, np.asarray(alone.motion.k), 0.05, per_joint=True) > 0
-    vector = jl.plan_halt("halt7", qf=kept.problem.qf, n_samples=101, solver="vector")
+    vector = jl.plan_halt(
+        "halt7",
+        qf=kept.problem.qf,
+        motion=jl.HaltMotionSettings(n_samples=101, solver="vector"),
+    )
     assert not vector.motion.per_joint and vector.motion.solver == "scan"
     assert vector.collision_free is True and vector.feasible
     assert vector.notes[0].startswith("solver 'vector': the per-joint optimum comes closer than allowed (0.05 m)")

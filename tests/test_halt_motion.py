@@ -608,8 +608,12 @@ def test_moment_about_gives_both_readings_on_000s_scenario():
     reading of an independent reproduction of 000); recorded in the result."""
     import jointlock as jl
 
-    about_com = jl.plan_halt("halt7", paper_qf=True, n_samples=501)
-    about_joint1 = jl.plan_halt("halt7", paper_qf=True, n_samples=501, moment_about="joint1")
+    about_com = jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=501))
+    about_joint1 = jl.plan_halt(
+        "halt7",
+        paper_qf=True,
+        motion=jl.HaltMotionSettings(n_samples=501, moment_about="joint1"),
+    )
     assert about_com.motion.global_torque_k0 == pytest.approx(2142.3, abs=0.05)
     assert about_joint1.motion.global_torque_k0 == pytest.approx(2340.5, abs=0.05)
     assert about_com.to_dict()["moment_about"] == "spacecraft_com"
@@ -635,7 +639,7 @@ def test_moment_about_is_checked():
     import jointlock as jl
 
     with pytest.raises(jl.ScenarioError, match="moment_about must be one of spacecraft_com, joint1"):
-        jl.plan_halt("halt7", paper_qf=True, moment_about="tip")
+        jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(moment_about="tip"))
 
 
 def test_moment_about_reaches_the_scenario_run_and_its_equivalent_command():
@@ -674,10 +678,16 @@ def test_a_margin_is_kept_on_every_sample_and_margins_are_reported():
         jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0),
         [-180, -180, -100, -10, 20, 20], [20, 30, 15, 25, 30, 30], [8, 10, 12, 10, -8, 6],
     )  # fmt: skip
-    plain = jl.plan_halt("halt7", samples=3000)
+    plain = jl.plan_halt("halt7", search=jl.HaltSearch(samples=3000))
     assert plain.feasible and plain.to_dict()["smallest_margin"] < 0.01
     assert any("(40, at the limit)" in line for line in plain.summary())
-    kept = jl.plan_halt("halt7", state, T=10.0, samples=3000, margin=0.05)
+    kept = jl.plan_halt(
+        "halt7",
+        state,
+        T=10.0,
+        search=jl.HaltSearch(samples=3000),
+        limits=jl.HaltLimits(margin=0.05),
+    )
     assert kept.feasible
     m = kept.margins()
     assert min(m["velocity"].min(), m["acceleration"].min()) >= 0.05 - 1e-9
@@ -690,9 +700,9 @@ def test_a_margin_the_start_state_already_eats_into_is_refused():
     import jointlock as jl
 
     with pytest.raises(jl.InfeasibleError, match="already within the 5 % margin of a limit.*joint 6 starts with velocity 40"):
-        jl.plan_halt("halt7", samples=1000, margin=0.05)  # 000's state: joint 6 at 40 deg/s, the limit
+        jl.plan_halt("halt7", search=jl.HaltSearch(samples=1000), limits=jl.HaltLimits(margin=0.05))  # 000's state: joint 6 at 40 deg/s, the limit
     with pytest.raises(jl.ScenarioError, match="margin must be a finite real number >= 0 and <= 0.5"):
-        jl.plan_halt("halt7", samples=1000, margin=0.7)
+        jl.plan_halt("halt7", search=jl.HaltSearch(samples=1000), limits=jl.HaltLimits(margin=0.7))
 
 
 def test_a_narrow_feasible_interval_is_flagged_fragile():
@@ -702,9 +712,19 @@ def test_a_narrow_feasible_interval_is_flagged_fragile():
     import jointlock as jl
 
     off = jl.ClearanceSettings.off()
-    wide = jl.plan_halt("halt7", samples=3000, n_samples=101, clearance=off)
+    wide = jl.plan_halt(
+        "halt7",
+        clearance=off,
+        search=jl.HaltSearch(samples=3000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     assert wide.feasible and not wide.fragile and not wide.to_dict()["fragile"]
-    narrow = jl.plan_halt("halt7", samples=1000, n_samples=101, clearance=off)
+    narrow = jl.plan_halt(
+        "halt7",
+        clearance=off,
+        search=jl.HaltSearch(samples=1000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     lo, hi = narrow.motion.k_interval
     assert narrow.feasible and (hi - lo) < 0.01 * abs(float(narrow.motion.k))
     assert narrow.fragile and narrow.to_dict()["fragile"]
@@ -827,7 +847,11 @@ def test_the_clearance_screen_gives_the_full_checks_answer():
     from jointlock.planning.halt_motion import clearance_shortfall
     from jointlock.planning.halt_motion._clearance_limits import keeps_clearance
 
-    kept = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    kept = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     p = kept.problem
     lo, hi = (float(v) for v in kept.motion.k_interval)
     k = np.linspace(lo, hi, 61)

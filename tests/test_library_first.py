@@ -86,7 +86,7 @@ def test_run_result_pickles(tmp_path):
 def test_plan_halt_is_jointlock_halt():
     """000's scenario: the same halt configuration, k* and torques from Python and the CLI."""
     printed = cli_json("halt", "halt7", "--samples", "6000", "--json")
-    plan = jl.plan_halt("halt7", samples=6000)
+    plan = jl.plan_halt("halt7", search=jl.HaltSearch(samples=6000))
     assert to_plain(plan.to_dict()) == printed
     assert plan.feasible and printed["feasible"]
     np.testing.assert_array_equal(np.degrees(plan.problem.qf), printed["q_final_deg"])
@@ -95,14 +95,14 @@ def test_plan_halt_is_jointlock_halt():
     model = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
     state = jl.FailureState.from_degrees(model, [-180, -180, -100, -10, 20, 20], [20, 30, 15, 25, 40, 35],
                                          [8, 10, 12, 10, -8, 6])  # fmt: skip
-    same = jl.plan_halt(model, state, T=10.0, base="fixed", samples=6000)  # limits: halt7's 40 deg/s, 000's 20
+    same = jl.plan_halt(model, state, T=10.0, base="fixed", search=jl.HaltSearch(samples=6000))  # limits: halt7's 40 deg/s, 000's 20
     assert to_plain(same.to_dict()) == printed
 
 
 def test_plan_halt_text_is_the_cli_text(capsys):
     assert main(["halt", "halt7", "--paper-qf", "--n-samples", "101"]) == 0
     printed = capsys.readouterr().out.splitlines()
-    assert jl.plan_halt("halt7", paper_qf=True, n_samples=101).summary() == printed
+    assert jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=101)).summary() == printed
 
 
 def test_plan_halt_needs_a_state_for_other_robots():
@@ -119,13 +119,13 @@ def test_plan_halt_errors_name_its_own_inputs():
         jl.plan_halt("halt7", T=-1.0)
     assert "--" not in str(err.value)  # a keyword, not a CLI option
     with pytest.raises(jl.ScenarioError, match="ga.n_pop must be >= 2"):
-        jl.plan_halt("halt7", solver="ga", ga=GASettings(n_pop=1))
+        jl.plan_halt("halt7", motion=jl.HaltMotionSettings(solver="ga", ga=GASettings(n_pop=1)))
 
 
 def test_plan_halt_base_follows_the_model_given():
     model = jl.lock(jl.load_robot("halt7", base="floating"), 4, 0.0)
-    assert jl.plan_halt(model, paper_qf=True, n_samples=101).problem.base == "floating"
-    assert jl.plan_halt("halt7", paper_qf=True, n_samples=101).problem.base == "fixed"  # 000's, by name
+    assert jl.plan_halt(model, paper_qf=True, motion=jl.HaltMotionSettings(n_samples=101)).problem.base == "floating"
+    assert jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=101)).problem.base == "fixed"  # 000's, by name
 
 
 def test_run_scenario_takes_a_path_and_names_missing_jobs():
@@ -158,7 +158,7 @@ def test_the_library_never_chooses_a_backend(tmp_path, monkeypatch):
 def test_plot_functions_draw_on_the_axes_given(tmp_path):
     from matplotlib.figure import Figure
 
-    plan = jl.plan_halt("halt7", paper_qf=True, n_samples=101)
+    plan = jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=101))
     fig = Figure()
     ax = fig.add_subplot()
     assert jl.plots.halt.plot_global_torque_vs_k(plan.motion, ax=ax) is ax
@@ -231,7 +231,7 @@ def test_results_print_in_one_line_and_show_their_summary_in_a_notebook():
 
     puma = jl.load_robot("puma6")
     results = [
-        jl.plan_halt("halt7", paper_qf=True, n_samples=101),
+        jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=101)),
         describe_configuration(puma, [0.1] * 6),
         inverse_kinematics(puma, jl.ee_pose(puma, [0.1] * 6)),
         study_workspace(puma, (2, 1.0), samples=1000),

@@ -207,7 +207,13 @@ def test_the_reach_bound_holds_for_hulls_and_a_ur5_halt_keeps_its_clearance_betw
     model = jl.load_robot(str(robot_file(UR5)), chain=jl.UrdfChain(srdf=str(srdf)))
     locked = jl.lock(model, 3, np.radians(30))
     state = jl.FailureState(np.radians([0, -60, 0, -60, 0]), np.radians([10.0] * 5), np.zeros(5))
-    plan = jl.plan_halt(locked, state, T=3.0, samples=400, n_samples=101)
+    plan = jl.plan_halt(
+        locked,
+        state,
+        T=3.0,
+        search=jl.HaltSearch(samples=400),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     report = plan.to_dict()["clearance"]
     assert plan.feasible and plan.collision_free
     assert report["between_samples_clear"] and report["collides"] is False

@@ -52,6 +52,11 @@ def test_no_clear_halt_time_is_said_with_the_range_looked_at():
 
 
 def test_not_computed_without_the_clearance_required():
-    plan = jl.plan_halt("halt7", samples=2000, n_samples=101, minimum_T=True, clearance=jl.ClearanceSettings.off())
+    plan = jl.plan_halt(
+        "halt7",
+        clearance=jl.ClearanceSettings.off(),
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101, minimum_T=True),
+    )
     assert plan.motion.minimum_T is not None and not plan.clearance_checked_for_T
     assert plan.minimum_T_clear is None and "keeping the clearance" not in "\n".join(plan.summary())

@@ -14,7 +14,7 @@ from jointlock.analysis.spacecraft import _prefix_products, _rotvec_quaternions,
 
 @pytest.fixture(scope="module")
 def paper_halt():
-    return jl.plan_halt("halt7", paper_qf=True, n_samples=201)
+    return jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=201))
 
 
 def test_the_spacecraft_keeps_zero_momentum_along_a_halt(paper_halt):
@@ -105,7 +105,7 @@ def test_the_whole_systems_centre_of_mass_stays_put(paper_halt, n, tol_m):
 
 def test_the_attitude_needs_no_fine_objective_grid():
     """The halt's objective may use few samples; the attitude keeps its own 0.02 s step."""
-    coarse = jl.plan_halt("halt7", paper_qf=True, n_samples=11).spacecraft_response()
+    coarse = jl.plan_halt("halt7", paper_qf=True, motion=jl.HaltMotionSettings(n_samples=11)).spacecraft_response()
     assert coarse.final_attitude_change_deg == pytest.approx(123.89, abs=0.01)
     assert coarse.rotation_path_deg >= coarse.final_attitude_change_deg
 
@@ -182,7 +182,12 @@ def test_a_free_floating_replan_reports_the_spacecraft_and_keeps_the_system_stil
 
 @pytest.fixture(scope="module")
 def free_problem():
-    plan = jl.plan_halt("halt7", base="floating", samples=4000, n_samples=201)
+    plan = jl.plan_halt(
+        "halt7",
+        base="floating",
+        search=jl.HaltSearch(samples=4000),
+        motion=jl.HaltMotionSettings(n_samples=201),
+    )
     return plan.problem
 
 
@@ -225,4 +230,10 @@ def test_the_attitude_objective_needs_a_spacecraft():
     model = jl.lock(jl.load_robot("halt7"), 4, 0.0)
     state = jl.FailureState.from_degrees(model, [0.0] * 6)
     with pytest.raises(jl.ScenarioError, match="objective 'attitude_change' needs a model with a spacecraft"):
-        jl.plan_halt(model, state, T=10.0, qf=np.full(6, 0.1), objective="attitude_change")
+        jl.plan_halt(
+            model,
+            state,
+            T=10.0,
+            qf=np.full(6, 0.1),
+            motion=jl.HaltMotionSettings(objective="attitude_change"),
+        )

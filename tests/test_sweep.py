@@ -52,7 +52,11 @@ def test_reach_bounds_how_fast_each_pair_closes_per_joint(index):
 
 
 def _halt7_halt():
-    plan = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    plan = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     p = plan.problem
     return plan, p, (lambda t: p.trajectory(float(plan.motion.k), t))
 
@@ -104,7 +108,11 @@ def test_the_halt_reports_its_clearance_between_samples():
     """000's scenario (the demo): the halt is certified between its samples, its bound within
     the tunnelling tolerance of the start's depth (the boom starts 0.051 m into the bus and comes
     no closer); the to_dict keys."""
-    plan = jl.plan_halt("halt7", samples=2000, n_samples=101)
+    plan = jl.plan_halt(
+        "halt7",
+        search=jl.HaltSearch(samples=2000),
+        motion=jl.HaltMotionSettings(n_samples=101),
+    )
     data = plan.to_dict()["clearance"]
     assert plan.collision_free is True and data["between_samples_clear"] is True
     assert data["tunnelling_tolerance_m"] == TUNNEL_TOLERANCE_M

@@ -145,7 +145,10 @@ def test_the_halt_starts_from_the_tasks_state_at_the_failure(tmp_path):
     typed = jl.plan_halt(
         plan.problem.model,
         jl.FailureState.from_degrees(plan.problem.model, q[healthy], dq[healthy], ddq[healthy]),
-        T=12.0, qf=np.radians([-120, -100, -60, 90, 70, 30]), base="floating", samples=2000,
+        T=12.0,
+        qf=np.radians([-120, -100, -60, 90, 70, 30]),
+        base="floating",
+        search=jl.HaltSearch(samples=2000),
     )  # fmt: skip
     assert typed.motion.global_torque == pytest.approx(plan.motion.global_torque, rel=1e-12)
 

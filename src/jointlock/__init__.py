@@ -70,6 +70,7 @@ _CORE = {
     "UrdfChain": "jointlock.robots",
     "Box": "jointlock.shapes",
     "Capsule": "jointlock.shapes",
+    "Convex": "jointlock.shapes",
     "Sphere": "jointlock.shapes",
     "Clearance": "jointlock.collision",
     "clearance": "jointlock.collision",
@@ -114,6 +115,7 @@ _LAZY = {
     # jobs: one call per job, typed results with to_dict() / summary() / write()
     **{name: "jointlock.jobs" for name in (
         "plan_halt", "HaltPlan", "FailureState", "JointLimits", "halt_limits",
+        "HaltLimits", "HaltSearch", "HaltMotionSettings",
         "study_halt_configuration", "HaltConfigurationStudy",
         "run_jump_study", "JumpJobResult",
         "find_tolerance_angle", "ToleranceAngleResult",
@@ -166,6 +168,7 @@ __all__ = [
     "Body",
     "Box",
     "Capsule",
+    "Convex",
     "ChainState",
     "Clearance",
     "ClearanceSettings",

@@ -31,7 +31,10 @@ from ._common import JobResult
 
 #: Public names of each job module (imported on first use).
 _NAMES: dict[str, tuple[str, ...]] = {
-    "halt": ("plan_halt", "HaltPlan", "FailureState", "JointLimits", "halt_limits", "halt_model"),
+    "halt": (
+        "plan_halt", "HaltPlan", "FailureState", "JointLimits", "halt_limits", "halt_model",
+        "HaltLimits", "HaltSearch", "HaltMotionSettings",
+    ),  # fmt: skip
     "halt_config": ("study_halt_configuration", "HaltConfigurationStudy", "ReachabilitySettings"),
     "jump": ("run_jump_study", "JumpJobResult"),
     "tolerance_angle": ("find_tolerance_angle", "ToleranceAngleResult"),

@@ -42,6 +42,7 @@ from ._inputs import (
     resolve_limits,
 )
 from ._result import HaltPlan
+from ._settings import FORMER_KEYWORDS, HaltLimits, HaltMotionSettings, HaltSearch
 from ._strategy import (
     HCOM_JACOBIAN,
     Solver,
@@ -59,8 +60,12 @@ __all__ = [
     "DEFAULT_VMAX_DEG",
     "HCOM_JACOBIAN",
     "MIN_N_SAMPLES",
+    "FORMER_KEYWORDS",
     "FailureState",
+    "HaltLimits",
+    "HaltMotionSettings",
     "HaltPlan",
+    "HaltSearch",
     "JointLimits",
     "Solver",
     "check_halt_settings",

@@ -113,10 +113,11 @@ def _check_start_torques(
 
 
 #: How :func:`check_halt_settings` names the settings: plan_halt's keywords, or the CLI's options.
-LIBRARY_NAMES = {"T": "T", "n_samples": "n_samples", "samples": "samples", "population": "ga.n_pop",
-                 "generations": "ga.n_gen", "qf": "qf", "state": "state", "limits": ("vmax_deg", "amax_deg"),
-                 "margin": "margin", "torques": ("torque_max_Nm", "brake_max_Nm"),
-                 "prefer_margin": "prefer_margin"}  # fmt: skip
+LIBRARY_NAMES = {"T": "T", "n_samples": "motion.n_samples", "samples": "search.samples",
+                 "population": "motion.ga.n_pop", "generations": "motion.ga.n_gen", "qf": "qf", "state": "state",
+                 "limits": ("limits.vmax_deg", "limits.amax_deg"), "margin": "limits.margin",
+                 "torques": ("limits.torque_max_Nm", "limits.brake_max_Nm"),
+                 "prefer_margin": "motion.prefer_margin"}  # fmt: skip
 
 
 CLI_NAMES = {"T": "--T", "n_samples": "--n-samples", "samples": "--samples", "population": "--population",

@@ -28,7 +28,6 @@ from ...planning.halt_config import HaltConfiguration, HaltReachability, optimal
 from ...planning.halt_motion import (
     HaltMotion,
     HaltProblem,
-    MomentAbout,
     clear_k_segments,
     clearance_shortfall,
     minimum_clear_halt_time,
@@ -53,13 +52,11 @@ from ._inputs import (
     is_000_failure,
 )
 from ._result import HaltPlan
+from ._settings import HaltLimits, HaltMotionSettings, HaltSearch, Solver, settings_from_keywords
 
 #: Jacobian of the halt-configuration search (CP): 000 §3.1.2's generalized Jacobian J_F of
 #: the free-floating arm, whatever the base of the disturbance torque.
 HCOM_JACOBIAN: Literal["generalized"] = "generalized"
-
-Solver = Literal["scan", "ga", "vector"]
-
 
 #: Largest margin kept free on each limit (half of it: beyond, the "limits" are others).
 MAX_MARGIN = 0.5
@@ -199,29 +196,18 @@ def plan_halt(
     T: float | None = None,
     qf: ArrayLike | None = None,
     paper_qf: bool = False,
-    vmax_deg: ArrayLike | None = None,
-    amax_deg: ArrayLike | None = None,
-    torque_max_Nm: ArrayLike | None = None,
-    brake_max_Nm: ArrayLike | None = None,
-    limits: JointLimits | None = None,
+    limits: HaltLimits | JointLimits | None = None,
+    clearance: ClearanceSettings | None = None,
+    search: HaltSearch | None = None,
+    motion: HaltMotionSettings | None = None,
     base: Literal["fixed", "floating"] | None = None,
-    solver: Solver = "scan",
     rng: int | np.random.Generator | None = 0,
-    samples: int = p000.SAMPLES,
-    reachable: bool = True,
-    n_samples: int = 501,
-    ga: GASettings | None = None,
-    minimum_T: bool = False,
+    wheels: WheelCapacity | None = None,
     progress: bool = False,
     state_source: str | None = None,
-    moment_about: MomentAbout = "spacecraft_com",
-    margin: float = 0.0,
-    objective: str = "mean_torque",
-    prefer_margin: float = 0.0,
-    clearance: ClearanceSettings | None = None,
-    wheels: WheelCapacity | None = None,
     _names: Mapping[str, Any] = LIBRARY_NAMES,
     _state_names: tuple[str, str, str] = ("state.q", "state.dq", "state.ddq"),
+    **former: Any,
 ) -> HaltPlan:
     """000's halt strategy: optimal halt configuration, then optimal halt motion (000 §3-§4).
 
@@ -243,72 +229,50 @@ def plan_halt(
     qf
         (n,) halt configuration [rad]; None = search it (HCOM), unless ``paper_qf`` (000's
         printed q_best, on 000's failure only).
-    vmax_deg, amax_deg, torque_max_Nm, brake_max_Nm, limits
-        The limits by :func:`halt_limits`'s rule from ``vmax_deg`` [deg/s], ``amax_deg``
-        [deg/s^2], the healthy joints' motor torque limits ``torque_max_Nm`` [N m] (capped by
-        the model's effort limits) and the locked joints' brake torque limits ``brake_max_Nm``
-        [N m], or ``limits`` as they are.  Torque limits are kept on every sample of the
-        constraint grid; they need ``solver="scan"``.
+    limits
+        The limits the halt keeps (:class:`HaltLimits`: speed, acceleration, motor and brake
+        torque limits as given, resolved on the arm by :func:`halt_limits`'s rule, and the
+        margin kept free), or resolved :class:`JointLimits` used as they are.  Default: the
+        rule's defaults, no margin.
+    clearance
+        Beyond 000 (issue 27): the clearance required between the arm's links, its spacecraft
+        bus and keep-out volumes (:class:`~jointlock.collision.ClearanceSettings`; default:
+        0.05 m).  The search excludes configurations closer than that; a given ``qf`` closer
+        than that is refused; ``k`` keeps to the halts that keep it; a halt motion that still
+        comes closer is reported (:attr:`HaltPlan.collision_free` False, the first line of the
+        summary: which pair, when and by how much; ``feasible`` is the limits' verdict).
+        ``ClearanceSettings.off()``: reported only (000's way; ``paper_qf`` is 000's
+        configuration and is only reported).
+    search
+        How the halt configuration is searched (:class:`HaltSearch`: Monte Carlo samples,
+        reachable configurations only); unused when ``qf`` or ``paper_qf`` gives it.
+    motion
+        How the halt motion is chosen (:class:`HaltMotionSettings`: solver, GA settings, time
+        samples, smallest halt time, objective, preference for margin, moment point).
     base
         Base of the disturbance torque: ``"fixed"`` (000) or ``"floating"``; None: ``"fixed"``
         for a robot given by name (000's), the model's own base for a model.  The halt
         configuration is searched on J_F either way (000 §3.1.2).
-    solver
-        ``"scan"`` (exact), ``"ga"`` (000's adaptive GA, ``ga`` settings: default population
-        50, 100 generations) or ``"vector"`` (one k per joint).
     rng
         Seed of the Monte Carlo search and the GA (:mod:`jointlock._random`: ``None`` draws a
         fresh seed; the seed used is :attr:`HaltPlan.seed`).
-    samples
-        Monte Carlo samples of the halt configuration (000's K, :data:`jointlock.papers.p000.SAMPLES`).
-    reachable
-        Search only configurations the halt polynomial reaches (exact; default) or the whole
-        ranges (000's way).
-    n_samples
-        Time samples of the objective (odd, Simpson's rule).
-    minimum_T
-        Also find the smallest halt time with a feasible ``k`` when the halt is feasible
-        (:func:`~jointlock.planning.halt_motion.minimum_halt_time`, for the same halt
-        configuration); an infeasible halt always reports it.  With the clearance required, also
-        the smallest whose halt keeps it (:attr:`HaltPlan.minimum_T_clear`,
-        :func:`~jointlock.planning.halt_motion.minimum_clear_halt_time`).
-    progress
-        Show progress bars on stderr.
-    margin
-        Fraction of each speed and acceleration limit kept free (0 <= margin <=
-        :data:`MAX_MARGIN`): the halt configuration and ``k`` are chosen under the limits
-        scaled by ``1 - margin``; the result reports each limit's margin against the limit
-        itself (:attr:`HaltPlan.margins`).
-    moment_about
-        Point of the base torque: ``"spacecraft_com"`` (default: the spacecraft's centre of mass)
-        or ``"joint1"`` (joint 1's origin, the reading of an independent reproduction of 000);
-        see :class:`~jointlock.planning.halt_motion.HaltProblem`.
-    objective
-        What ``k`` minimises: ``"mean_torque"`` (000 eq. 32, the time-averaged base torque),
-        ``"peak_torque"`` (the largest base torque) or ``"attitude_change"`` (the free
-        spacecraft's attitude change at the end of the halt; a model with a spacecraft).  The
-        halt configuration is 000's HCOM whatever the objective.
-    prefer_margin
-        A share of the best objective (0 .. :data:`MAX_MARGIN`): among the ``k`` within it,
-        the one whose halt keeps the largest smallest margin to every limit (0: the optimum
-        itself, 000's choice).
-    state_source
-        Where ``state`` comes from, in words, recorded in the result and printed with it
-        (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
-    clearance
-        Beyond 000 (issue 27): the clearance required between the arm's links, its spacecraft
-        bus and keep-out volumes (:class:`~jointlock.collision.ClearanceSettings`; default: no
-        overlap, 0 m).  The search excludes configurations closer than that; a given ``qf``
-        closer than that is refused; ``k`` keeps to the halts that keep it; a halt motion that
-        still comes closer is reported (:attr:`HaltPlan.collision_free` False, the first line
-        of the summary: which pair, when and by how much; ``feasible`` is the limits' verdict).  ``ClearanceSettings.off()``: reported only (000's
-        way; ``paper_qf`` is 000's configuration and is only reported).
     wheels
         Beyond 000 (issue 28): what the spacecraft's attitude control can absorb
         (:class:`~jointlock.analysis.attitude_control.WheelCapacity`: torque [N m], stored
         momentum [N m s]); the halt's peak base moment and the momentum it hands the wheels are
         judged against them (:meth:`HaltPlan.attitude_control`; over capacity: the summary's
         first line).  Default: reported, not judged.
+    progress
+        Show progress bars on stderr.
+    state_source
+        Where ``state`` comes from, in words, recorded in the result and printed with it
+        (default: "000 §5.2" when ``state`` is None or is 000's on 000's scenario, else "given").
+    **former
+        The keywords these settings replaced (``vmax_deg``, ``amax_deg``, ``torque_max_Nm``,
+        ``brake_max_Nm``, ``margin``; ``samples``, ``reachable``; ``solver``, ``ga``,
+        ``n_samples``, ``minimum_T``, ``objective``, ``prefer_margin``, ``moment_about``): still
+        accepted, each warning once (``FutureWarning``) with its new place
+        (:mod:`jointlock.jobs.halt._settings`); one given both ways is a ``TypeError``.
 
     Raises
     ------
@@ -318,26 +282,40 @@ def plan_halt(
         The state at failure itself breaks a limit (no halt can help), or (with
         ``reachable=False``) nothing sampled satisfies the search's constraints.
     """
-    ga = ga if ga is not None else GASettings(n_pop=50, n_gen=100)
+    settings = settings_from_keywords("plan_halt", former, {"limits": limits, "search": search, "motion": motion})
+    spec, search, halting = settings["limits"], settings["search"], settings["motion"]
     clearance = clearance if clearance is not None else ClearanceSettings()
-    if not isinstance(clearance, ClearanceSettings):
-        raise ScenarioError(f"clearance must be a ClearanceSettings; got {type(clearance).__name__}")
+    for name, value, kind in (
+        ("limits", spec, (HaltLimits, JointLimits)), ("clearance", clearance, (ClearanceSettings,)),
+        ("search", search, (HaltSearch,)), ("motion", halting, (HaltMotionSettings,)),
+    ):  # fmt: skip
+        if not isinstance(value, kind):
+            allowed = " or ".join(k.__name__ for k in kind)
+            raise ScenarioError(f"{name} must be a {allowed}; got {type(value).__name__}")
+    solver, ga, n_samples, minimum_T = halting.solver, halting.ga, halting.n_samples, halting.minimum_T
+    objective, prefer_margin, moment_about = halting.objective, halting.prefer_margin, halting.moment_about
+    samples, reachable = search.samples, search.reachable
     check_halt_settings(T, n_samples, samples, solver, ga, _names)
     state_given = state is not None
     model, state, T, base, paper = _arm_state_and_time(robot, state, locks, T, base, _state_names)
-    if limits is None:
-        limits = halt_limits(
-            model, vmax_deg, amax_deg, torque_max_Nm=torque_max_Nm, brake_max_Nm=brake_max_Nm,
+    model_torques = True  # the model's effort limits, not limits given: kept by the scan only
+    if isinstance(spec, HaltLimits):
+        joint_limits = halt_limits(
+            model, spec.vmax_deg, spec.amax_deg, torque_max_Nm=spec.torque_max_Nm, brake_max_Nm=spec.brake_max_Nm,
             names=_names["limits"], torque_names=_names["torques"],
         )  # fmt: skip
-    paper_scenario = _is_paper_state(model, state, T, limits)
+        margin = spec.margin
+        model_torques = spec.torque_max_Nm is None and spec.brake_max_Nm is None
+    else:
+        joint_limits, margin = spec, settings["margin"] if settings["margin"] is not None else 0.0
+    paper_scenario = _is_paper_state(model, state, T, joint_limits)
     margin = as_real(margin, _names.get("margin", "margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError)
     prefer_margin = as_real(
         prefer_margin, _names.get("prefer_margin", "prefer_margin"), lo=0.0, hi=MAX_MARGIN, error=ScenarioError
     )
-    kept = limits.scaled(1 - margin)
+    kept = joint_limits.scaled(1 - margin)
     notes: tuple[str, ...] = ()
-    if solver != "scan" and kept.torque is not None and torque_max_Nm is None and brake_max_Nm is None:
+    if solver != "scan" and kept.torque is not None and model_torques:
         # the model's own effort limits: kept by the exact scan only; reported, not kept, by the others
         kept = replace(kept, torque=None)
         notes = (f"the model's motor torque limits are reported, not kept: solver {solver!r} keeps speed and "
@@ -359,7 +337,7 @@ def plan_halt(
             "000's printed q_best",
         )
     else:
-        _check_start(model, state, T, limits, _names["state"])
+        _check_start(model, state, T, joint_limits, _names["state"])
         if margin:
             _check_start_margin(model, state, T, kept, margin, _names)
         configuration, reach_note = _search_halt_configuration(
@@ -384,17 +362,17 @@ def plan_halt(
             k_bounds=k_bounds,
         )  # fmt: skip
 
-    motion = solve()
+    chosen = solve()
     if bar is not None:
         bar.close()
-    motion, clear_note = _keep_clear(motion, clearance, solve)
+    chosen, clear_note = _keep_clear(chosen, clearance, solve)
     notes += clear_note
     minimum_T_clear = None
-    if motion.minimum_T is not None and _keeps_clearance_as_constraint(motion, clearance):
-        minimum_T_clear = minimum_clear_halt_time(problem, clearance.margin, clearance.keep_out, start=motion.minimum_T)
+    if chosen.minimum_T is not None and _keeps_clearance_as_constraint(chosen, clearance):
+        minimum_T_clear = minimum_clear_halt_time(problem, clearance.margin, clearance.keep_out, start=chosen.minimum_T)
     return HaltPlan(
-        motion=motion,
-        limits=limits,
+        motion=chosen,
+        limits=joint_limits,
         qf_source=qf_source,
         paper_scenario=paper_scenario,
         configuration=configuration,
@@ -509,22 +487,19 @@ def halt_from_scenario(
         T=float(t["T"]),
         qf=qf,
         paper_qf=bool(t["paper_qf"]) and qf is None,
-        vmax_deg=lim["vmax_deg"],
-        amax_deg=lim["amax_deg"],
-        torque_max_Nm=lim["torque_max_Nm"],
-        brake_max_Nm=lim["brake_max_Nm"],
+        limits=HaltLimits(
+            vmax_deg=lim["vmax_deg"], amax_deg=lim["amax_deg"], torque_max_Nm=lim["torque_max_Nm"],
+            brake_max_Nm=lim["brake_max_Nm"], margin=float(t["margin"]),
+        ),
+        search=HaltSearch(samples=int(t["samples"])),
+        motion=HaltMotionSettings(
+            solver=t["solver"], ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
+            n_samples=int(t["n_samples"]), minimum_T=bool(t["minimum_T"]), objective=t["objective"],
+            prefer_margin=float(t["prefer_margin"]), moment_about=t["moment_about"],
+        ),
         base=base,
-        solver=t["solver"],
         rng=data["seed"],
-        samples=int(t["samples"]),
-        n_samples=int(t["n_samples"]),
-        ga=GASettings(n_pop=int(t["population"]), n_gen=int(t["generations"])),
-        minimum_T=bool(t["minimum_T"]),
         progress=progress,
-        moment_about=t["moment_about"],
-        margin=float(t["margin"]),
-        objective=t["objective"],
-        prefer_margin=float(t["prefer_margin"]),
         clearance=scenario_clearance(data),
         wheels=WheelCapacity(
             data["spacecraft"]["wheel_torque_max_Nm"], data["spacecraft"]["wheel_momentum_max_Nms"]
