@@ -5,6 +5,7 @@ population colliding)."""
 
 from __future__ import annotations
 
+import json
 import math
 from dataclasses import replace
 
@@ -790,3 +791,41 @@ def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
         quick = clearance(arm, q, keep_out=keep, witness=False)
         assert np.array_equal(quick.pair_distance, ours.pair_distance) and np.all(np.isnan(quick.witness))
         assert quick.to_dict()["witness_points_m"] is None
+
+
+def test_the_singularity_search_may_leave_out_colliding_configurations(tmp_path, capsys):
+    """Issue 27: the search's singular configurations closer than the clearance required are
+    left out before clustering (each one kept is clear, each one left out is not); reported only,
+    the overlapping ones are counted per family; unset, nothing changes (004's way)."""
+    from jointlock.cli import main
+    from jointlock.jobs.singular import search_singularities
+
+    arm = jl.load_robot("canadarm7")
+    plain = search_singularities(arm, samples=96)
+    screened = search_singularities(arm, samples=96, clearance=jl.ClearanceSettings(min_m=0.05))
+    reported = search_singularities(arm, samples=96, clearance=jl.ClearanceSettings.off())
+    assert plain.clearance is None and "clearance" not in plain.to_dict()
+    measured = clearance(arm, plain.search.q, margin=0.05)
+    closer = measured.colliding()
+    report = screened.to_dict()["clearance"]
+    assert report["checked"] == len(plain.search.q) and report["left_out"] == report["closer_than_allowed"] == int(closer.sum())
+    assert 0 < report["left_out"] < report["checked"]
+    np.testing.assert_array_equal(screened.search.q, plain.search.q[~closer])
+    assert not clearance(arm, screened.search.q, margin=0.05).colliding().any()
+    assert sorted(i for f in screened.search.families for i in f.members) == list(range(len(screened.search.q)))
+    assert screened.summary()[0].startswith(f"clearance: {report['left_out']} of {report['checked']} singular configurations")
+    overlap = clearance(arm, plain.search.q).colliding()
+    kept_all = reported.to_dict()
+    assert kept_all["found"] == len(plain.search.q) and kept_all["clearance"]["left_out"] == 0
+    assert sum(f["closer_than_allowed"] for f in kept_all["families"]) == int(overlap.sum())
+    # the scenario's [singular] skip_colliding, and the command line
+    path = tmp_path / "s.toml"
+    path.write_text('robot = "canadarm7"\n[singular]\nsearch = true\nsamples = 96\nskip_colliding = true\n')
+    from jointlock.jobs.singular import singular_from_scenario
+
+    scenario = jl.load_scenario(path)
+    assert singular_from_scenario(scenario.data, {}).to_dict() == screened.to_dict()
+    assert main(["singular", "canadarm7", "--search", "--samples", "96", "--skip-colliding", "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["clearance"]["left_out"] == report["left_out"]
+    assert main(["singular", "canadarm7", "--keep-out", "x.toml"]) == 2
+    assert "--keep-out: with --search --skip-colliding only" in capsys.readouterr().err

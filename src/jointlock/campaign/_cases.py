@@ -146,6 +146,7 @@ UNKEYED_WHEN_UNSET = (
     "srdf",
     "meshes",
     "jump.on_infeasible",
+    "singular.skip_colliding",
     *(f"task.{name}" for name in ("dx_m", "q0_deg", "duration_s", "blend_s", "dt_s", "kp", "feedforward", "base")),
 )
 

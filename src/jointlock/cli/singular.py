@@ -15,9 +15,11 @@ from typing import TYPE_CHECKING
 
 from ..errors import ScenarioError
 from ._common import (
+    add_clearance_options,
     add_robot_arguments,
     chain_from_args,
     check_out_dir,
+    clearance_from_args,
     deg_arg,
     field_arg,
     lock_map,
@@ -89,6 +91,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--out", type=Path, default=None, metavar="DIR", help="--search: write search.json and plots here"
     )
+    p.add_argument(
+        "--skip-colliding",
+        action="store_true",
+        help="--search: leave out the singular configurations closer than --clearance-min-m (default 0.05) to the "
+        "arm itself, the spacecraft bus or --keep-out volumes, before clustering (--no-clearance: count them only)",
+    )
+    add_clearance_options(p)
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.add_argument("--json", action="store_true", help="print one JSON object")
     p.set_defaults(func=run)
@@ -119,6 +128,12 @@ def run(args: argparse.Namespace) -> int:
     )
 
     check_out_dir(args.out)
+    given = [o for o, v in (("--clearance-min-m", args.clearance_min_m), ("--no-clearance", args.no_clearance),
+                            ("--keep-out", args.keep_out)) if v]  # fmt: skip
+    if given and not (args.search and args.skip_colliding):
+        raise ScenarioError(f"{', '.join(given)}: with --search --skip-colliding only (the search's clearance)")
+    if args.skip_colliding and not args.search:
+        raise ScenarioError("--skip-colliding: with --search only (it screens the singular configurations found)")
     if args.out is not None and not args.search:
         warnings.warn("--out: nothing written (only --search writes files: search.json and plots)", UserWarning, stacklevel=1)
     if args.verify_conditions:
@@ -138,6 +153,7 @@ def run(args: argparse.Namespace) -> int:
         )
     elif args.search:
         base = args.base or "fixed"
+        clearance = clearance_from_args(args) if args.skip_colliding else None
         result = search_singularities(
             _model(args, base),
             samples=args.samples or SEARCH_SAMPLES,
@@ -145,6 +161,7 @@ def run(args: argparse.Namespace) -> int:
             jacobian=base,
             weighting=args.weighting,
             characteristic_length=args.length,
+            clearance=clearance,
             progress=_progress(args),
         )
     else:

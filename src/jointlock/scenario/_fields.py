@@ -492,6 +492,11 @@ JOB_TABLES: dict[str, dict[str, Field]] = {
         "tol": _pos("", "rank tolerance on singular values", 1e-8, hi=1e3),
         "length": _length("characteristic length"),
         "samples": Field("int", None, lo=1, hi=1_000_000, help="samples per condition / search starts"),
+        "skip_colliding": Field(
+            "bool", None,
+            help="search: leave out the singular configurations closer than limits.clearance_min_m to the arm, "
+            "its bus or the keep-outs, before clustering (false: count them only; default: not checked)",
+        ),  # fmt: skip
     },
 }
 

@@ -6,8 +6,9 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
+from ...collision import ClearanceSettings
 from ...robots import UrdfChain
-from .._common import JobResult, joint_vector_deg, scenario_locks
+from .._common import JobResult, joint_vector_deg, scenario_clearance, scenario_locks
 from ._search import SingularitySearchResult, search_singularities
 from ._shared import SEARCH_SAMPLES, VERIFY_SAMPLES, singular_model
 from ._study import SingularityResult, study_singularity
@@ -15,6 +16,17 @@ from ._verify import ConditionVerificationResult, verify_singularity_conditions
 
 #: What :func:`singular_from_scenario` returns, by mode.
 SingularJobResult = SingularityResult | ConditionVerificationResult | SingularitySearchResult
+
+
+def _search_clearance(data: Mapping[str, Any]) -> ClearanceSettings | None:
+    """``[singular] skip_colliding``: true -> the scenario's clearance (``[limits]
+    clearance_min_m``, ``[[keep_out]]``) screens the singular configurations found; false ->
+    they are counted only; unset -> not checked."""
+    skip = data["singular"].get("skip_colliding")
+    if skip is None:
+        return None
+    settings = scenario_clearance(data)
+    return settings if skip else ClearanceSettings.off(settings.keep_out)
 
 
 def singular_from_scenario(
@@ -56,6 +68,7 @@ def singular_from_scenario(
             jacobian=base,
             weighting=weighting,
             characteristic_length=length,
+            clearance=_search_clearance(data),
             progress=progress,
         )
     q = joint_vector_deg(model, t["q_deg"], "singular.q_deg")

@@ -4,8 +4,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-from dataclasses import dataclass
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -14,6 +14,9 @@ import numpy as np
 from ..._deprecate import renamed_keyword
 from ..._random import resolve_seed
 from ...analysis import singularity as sg
+from ...collision import ClearanceSettings, collision_pairs
+from ...collision import clearance as clearance_of
+from ...errors import ScenarioError
 from ...io.files import atomic_write_json, with_svg, write_figure
 from ...kinematics import VMWeighting
 from ...model import ArmModel
@@ -54,6 +57,13 @@ class SingularitySearchResult(JobResult):
     family_conditions
         For a full Canadarm2-structure arm (fixed or virtual Jacobian): per family,
         ``{condition: members satisfying it}`` over Cond1-Cond5 and cond1f; else ``None``.
+    clearance
+        The clearance check of the singular configurations found, when one was asked
+        (:func:`search_singularities`'s ``clearance``): ``required_m`` (None: reported only),
+        ``checked`` configurations, ``closer_than_allowed`` among them, ``left_out`` (those
+        dropped before clustering: all of them when required, else 0), ``closest_m`` and its
+        ``closest_pair``, and per family ``family_colliding`` (members closer than allowed, of
+        the families kept); None when not asked.
     """
 
     job: ClassVar[str] = "singular"
@@ -61,6 +71,7 @@ class SingularitySearchResult(JobResult):
     model: ArmModel
     search: sg.SingularitySearch
     family_conditions: tuple[dict[str, int], ...] | None
+    clearance: dict[str, Any] | None = None
 
     def _families(self) -> list[dict[str, Any]]:
         families = []
@@ -77,6 +88,8 @@ class SingularitySearchResult(JobResult):
             }
             if self.family_conditions is not None:
                 entry["conditions"] = dict(self.family_conditions[i])
+            if self.clearance is not None:
+                entry["closer_than_allowed"] = self.clearance["family_colliding"][i]
             families.append(entry)
         return families
 
@@ -97,7 +110,7 @@ class SingularitySearchResult(JobResult):
             "families": self._families(),
             "q_deg": np.degrees(res.q),
             "sigma_min": res.sigma_min,
-        }
+        } | ({} if self.clearance is None else {"clearance": self.clearance})
 
     def to_dict(self, files: Sequence[str | Path] | None = None) -> dict[str, Any]:
         """The JSON of ``jointlock singular --search --json``.  ``files``: the paths
@@ -116,6 +129,8 @@ class SingularitySearchResult(JobResult):
             f"{len(res.q_start)} starts (seed {res.seed}): {int(res.converged.sum())} converged to "
             f"sigma_min < {res.tol:g} in {res.iterations} iterations; {len(families)} families",
         ]
+        if self.clearance is not None:
+            lines.insert(0, _clearance_line(self.clearance))
         for i, fam in enumerate(families, 1):
             lines += [
                 "",
@@ -157,6 +172,48 @@ class SingularitySearchResult(JobResult):
         return self.file_names()
 
 
+def _clearance_line(report: Mapping[str, Any]) -> str:
+    """The summary's first line about the clearance of the singular configurations found."""
+    required = report["required_m"]
+    closer, checked = report["closer_than_allowed"], report["checked"]
+    if not checked:
+        return "clearance: no singular configuration found to check"
+    what = f"closer than {required:g} m" if required is not None else "overlapping"
+    head = f"clearance: {closer} of {checked} singular configurations found are {what} (links, spacecraft bus, keep-outs)"
+    if required is not None:
+        return head + (": left out before clustering" if closer else ": none left out")
+    return head + f"; closest {report['closest_m']:+.3f} m ({report['closest_pair']}): reported, none left out"
+
+
+def _screen(
+    model: ArmModel, res: sg.SingularitySearch, settings: ClearanceSettings, cluster: Any
+) -> tuple[sg.SingularitySearch, dict[str, Any]]:
+    """``res`` without the configurations closer than the clearance required (re-clustered by
+    ``cluster``), or as it is when the clearance is reported only; and the report."""
+    if not collision_pairs(model, settings.keep_out).names:
+        raise ScenarioError(
+            f"clearance: {model.name!r} has no collision shapes to check (give it link radii or collision "
+            "geometry, or leave the clearance out)"
+        )
+    report: dict[str, Any] = {"required_m": settings.min_m, "checked": len(res.q), "closer_than_allowed": 0,
+                              "left_out": 0, "closest_m": None, "closest_pair": None}  # fmt: skip
+    if not len(res.q):
+        return res, report | {"family_colliding": []}
+    measured = clearance_of(model, res.q, keep_out=settings.keep_out, margin=settings.margin, witness=False)
+    colliding = measured.colliding()
+    at = measured.worst()
+    report.update(
+        closer_than_allowed=int(colliding.sum()), closest_m=float(measured.distance[at]), closest_pair=measured.pair_at(at)
+    )
+    if settings.required and colliding.any():
+        keep = ~colliding
+        res = replace(res, q=res.q[keep], sigma_min=res.sigma_min[keep], families=cluster(res.q[keep]))
+        report["left_out"] = int(colliding.sum())
+        colliding = colliding[keep]
+    report["family_colliding"] = [int(colliding[list(f.members)].sum()) for f in res.families]
+    return res, report
+
+
 @renamed_keyword(old="base", new="jacobian")
 @renamed_keyword(old="length", new="characteristic_length")
 def search_singularities(
@@ -169,6 +226,7 @@ def search_singularities(
     characteristic_length: float | None = None,
     tol: float = sg.SEARCH_TOL,
     max_iter: int = SEARCH_MAX_ITER,
+    clearance: ClearanceSettings | None = None,
     progress: bool = False,
 ) -> SingularitySearchResult:
     """Search ``model`` for singular configurations and cluster them into families
@@ -191,6 +249,13 @@ def search_singularities(
         default, :data:`jointlock.analysis.singularity.SEARCH_TOL`, whatever ``--tol`` says).
     max_iter
         Gauss-Newton iterations.
+    clearance
+        Beyond 004 (issue 27): check the singular configurations found against the arm's
+        collision shapes and ``keep_out`` volumes.  With the clearance required
+        (``ClearanceSettings(min_m=...)``), those closer than ``min_m`` are left out before
+        clustering (a singularity the arm cannot reach without a collision is not one to plan
+        around), and counted; with ``ClearanceSettings.off()``, the overlapping ones are counted
+        per family, none left out.  Default None: not checked (004's way).
     progress
         Show a progress bar on stderr.
 
@@ -216,6 +281,17 @@ def search_singularities(
             characteristic_length=characteristic_length,
             progress=bar,
         )
+    report = None
+    if clearance is not None:
+        if not isinstance(clearance, ClearanceSettings):
+            raise ScenarioError(f"clearance must be a ClearanceSettings; got {type(clearance).__name__}")
+
+        def cluster(q: np.ndarray) -> tuple[sg.SingularFamily, ...]:
+            return sg.cluster_singularities(
+                model, q, jacobian=jacobian, weighting=weighting, characteristic_length=characteristic_length
+            )
+
+        res, report = _screen(model, res, clearance, cluster)
     lengths = _condition_lengths(model, jacobian, weighting)
     family_conditions = None
     if lengths is not None:
@@ -226,4 +302,4 @@ def search_singularities(
             }
             for fam in res.families
         )
-    return SingularitySearchResult(model=model, search=res, family_conditions=family_conditions)
+    return SingularitySearchResult(model=model, search=res, family_conditions=family_conditions, clearance=report)
