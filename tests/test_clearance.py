@@ -648,10 +648,12 @@ def test_a_report_opens_with_the_clearance_verdict(tmp_path):
     assert page.index("Clearance: read this first</h2>") < page.index("Scenario</h2>")
 
 
-def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance():
+def test_the_per_joint_solver_searches_within_the_halts_that_keep_the_clearance():
     """000's scenario on the configuration whose limits' optimum comes closer (as in
     test_the_halt_motion_moves_k_to_keep_the_clearance): the vector solver's per-joint optimum
-    comes closer too, so the halt is the best shared k that keeps the clearance, and says so."""
+    comes closer too, so the halt is the best per-joint k found among the clear halts, from the
+    best shared k that keeps the clearance: clear (samples and between them), within each joint's
+    interval, no worse than that shared k and no better than the unconstrained per-joint optimum."""
     from jointlock.planning.halt_motion import clearance_shortfall
 
     kept = jl.plan_halt(
@@ -672,10 +674,19 @@ def test_the_per_joint_solver_falls_back_to_a_shared_k_that_keeps_the_clearance(
         qf=kept.problem.qf,
         motion=jl.HaltMotionSettings(n_samples=101, solver="vector"),
     )
-    assert not vector.motion.per_joint and vector.motion.solver == "scan"
+    assert vector.motion.per_joint and vector.motion.solver == "vector"
     assert vector.collision_free is True and vector.feasible
     assert vector.notes[0].startswith("solver 'vector': the per-joint optimum comes closer than allowed (0.05 m)")
-    assert float(vector.motion.k) == pytest.approx(float(kept.motion.k), rel=1e-9)  # the shared k kept
+    assert "the best per-joint k found among the halts that keep it" in vector.notes[0]
+    k = np.asarray(vector.motion.k)
+    assert clearance_shortfall(vector.problem, k, 0.05, per_joint=True) <= 0
+    per = vector.motion.joint_intervals
+    assert np.all((per[:, 0] <= k) & (k <= per[:, 1]))
+    shared = float(kept.motion.objective_value)
+    assert alone.motion.objective_value <= vector.motion.objective_value < shared
+    assert vector.motion.objective_value == pytest.approx(
+        float(jl.planning.halt_motion.halt_objective(vector.problem, k, per_joint=True)), rel=1e-12
+    )
     assert vector.to_dict()["notes"][0] == vector.notes[0]  # said in the JSON too
     from jointlock.errors import ConfigurationError
 

@@ -29,7 +29,11 @@ from ...planning.halt_motion import (
     HaltMotion,
     HaltProblem,
     clear_k_segments,
+    clear_per_joint_k,
     clearance_shortfall,
+    constraint_violations,
+    global_base_torque,
+    halt_objective,
     minimum_clear_halt_time,
     optimal_halt_motion,
 )
@@ -416,9 +420,15 @@ def _keep_clear(
         shared, notes = _keep_clear(solve(None, "scan"), settings, lambda segment: solve(segment, "scan"))
         head = f"solver 'vector': the per-joint optimum comes closer than allowed ({margin:g} m)"
         if shared.feasible and clearance_shortfall(problem, np.asarray(float(shared.k)), margin, keep_out) <= 0:
+            k, record = clear_per_joint_k(problem, motion.joint_intervals, float(shared.k), margin, keep_out)
+            if np.ndim(k) == 1 and not np.all(k == k[0]):
+                return _per_joint_motion(shared, k, record, motion), (
+                    f"{head}; the halt is the best per-joint k found among the halts that keep it (Powell from the "
+                    "best shared k that keeps it, on the limits the vector solver keeps)",
+                ) + notes
             return shared, (
                 f"{head}; the halt is the best shared k that keeps the clearance (solver 'scan', on the limits the "
-                "vector solver keeps)",
+                "vector solver keeps): no per-joint k that keeps it does better",
             ) + notes
         why = "no shared k keeps the clearance either" if shared.feasible else "no shared k keeps the limits"
         return motion, (f"{head}, and {why}: the halt below is the per-joint optimum over the limits alone",)
@@ -439,6 +449,27 @@ def _keep_clear(
         f"k moved from {float(motion.k) / scale:.6g} to {float(best.k) / scale:.6g} deg/s^6 to keep the clearance "
         f"({margin:g} m): the halts of k in [{stretch[0]:.6g}, {stretch[1]:.6g}] deg/s^6 keep it, the optimum "
         "over the limits alone came closer",
+    )
+
+
+def _per_joint_motion(shared: HaltMotion, k: np.ndarray, record: Mapping[str, Any], vector: HaltMotion) -> HaltMotion:
+    """The halt at the per-joint ``k`` (n,) [rad/s^6], built on the shared-``k`` halt ``shared``
+    (same problem): its torque, verdicts and objective at ``k``, the vector solver's intervals."""
+    problem = shared.problem
+    violations = constraint_violations(problem, k, per_joint=True)
+    return replace(
+        shared,
+        k=k,
+        solver="vector",
+        global_torque=float(global_base_torque(problem, k, per_joint=True)),
+        feasible=not violations,
+        violations=violations,
+        objective_value=float(halt_objective(problem, k, per_joint=True)),
+        k_interval=vector.k_interval,
+        joint_intervals=vector.joint_intervals,
+        settings={**vector.settings, "scipy": dict(record)},
+        k_segments=None,
+        k_optimum=None,
     )
 
 

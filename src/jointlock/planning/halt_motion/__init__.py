@@ -50,6 +50,7 @@ from ._batch_feasibility import (
 from ._clearance_limits import (
     clear_k_exists,
     clear_k_segments,
+    clear_per_joint_k,
     clear_T_range,
     clearance_shortfall,
     halt_swept_clearance,
@@ -104,6 +105,7 @@ __all__ = [
     "clear_T_range",
     "clear_k_exists",
     "clear_k_segments",
+    "clear_per_joint_k",
     "clearance_shortfall",
     "constraint_violations",
     "feasible_k_interval_batch",

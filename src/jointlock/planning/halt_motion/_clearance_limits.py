@@ -246,3 +246,46 @@ def minimum_clear_halt_time(
             return float(found.true_end)
         prev, t = t, t * CLEAR_T_GROWTH
     return None
+
+
+#: Powell's stopping tolerances of :func:`clear_per_joint_k` (as the vector solver's).
+PER_JOINT_XTOL = 1e-6
+PER_JOINT_FTOL = 1e-10
+
+
+def clear_per_joint_k(
+    problem: HaltProblem, intervals: FloatArray, k_start: float, margin: float, keep_out: Sequence[Shape] = ()
+) -> tuple[FloatArray, dict[str, object]]:
+    """One ``k`` per joint whose halt keeps the clearance (issue 27): Powell within each joint's
+    feasible interval ``intervals`` (n, 2) [rad/s^6] (the vector solver's), started from the
+    shared ``k_start`` [rad/s^6], whose halt keeps it.  A halt that comes closer than allowed
+    (:func:`clearance_shortfall`, between samples too) is held above every clear one: its value
+    is the start's objective times ten plus its shortfall, so Powell's line searches turn back
+    at the clear set's edge.  Returns the best clear (n,) ``k`` found (the start as (n,) when
+    Powell finds none better) and scipy's record."""
+    from scipy.optimize import minimize  # on first use (slow to import)
+
+    from ._objective import halt_objective
+
+    start = np.clip(np.full(problem.dof, float(k_start)), intervals[:, 0], intervals[:, 1])
+    scale = max(float(np.max(intervals[:, 1] - intervals[:, 0])), 1e-12)
+    floor_value = float(halt_objective(problem, start, per_joint=True))
+    barrier = 10.0 * abs(floor_value) + 1.0
+
+    def value(x: FloatArray) -> float:
+        k = np.clip(x * scale, intervals[:, 0], intervals[:, 1])
+        short = float(clearance_shortfall(problem, k, margin, keep_out, per_joint=True))
+        if short > 0.0:
+            return barrier + short
+        return float(halt_objective(problem, k, per_joint=True))
+
+    res = minimize(
+        value,
+        start / scale,
+        method="Powell",
+        bounds=[(a / scale, b / scale) for a, b in intervals],
+        options={"xtol": PER_JOINT_XTOL, "ftol": PER_JOINT_FTOL},
+    )
+    k = np.clip(res.x * scale, intervals[:, 0], intervals[:, 1])
+    best = k if value(k / scale) < floor_value else start
+    return best, {"method": "Powell", "nfev": int(res.nfev), "message": str(res.message), "clearance": True}
