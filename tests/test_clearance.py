@@ -604,9 +604,11 @@ def test_urdf_collision_primitives_are_read_and_meshes_skipped_when_asked(tmp_pa
             "<collision><geometry><mesh filename='arm.stl'/></geometry></collision>",
         )
     )
-    # a mesh that is not there is refused (a link left geometry-blind is not a safe default)
-    with pytest.raises(ModelError, match=r"link 'arm' <collision> 2: mesh file 'arm.stl' not found .*meshes='skip'") as info:
-        jl.read_urdf(path)
+    # a mesh that is not there: the model's clearance is refused (a link left geometry-blind is
+    # not a safe default), naming the mesh
+    unread = jl.read_urdf(path)
+    with pytest.raises(ModelError, match=r"link 'arm': mesh file 'arm.stl' not found .*meshes='skip'") as info:
+        clearance(unread, np.zeros(1))
     assert "\n" not in str(info.value)
     arm = jl.read_urdf(path, meshes="skip")
     (capsule,) = arm.bodies[0].shapes
@@ -764,22 +766,34 @@ def ours_offsets(model: jl.ArmModel, keep_out) -> np.ndarray:
     return collision_pairs(model, keep_out).offsets
 
 
-@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda"])
+@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda", "ur5"])
 def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
     """clearance() (frames, placements and distances in one compiled pass) against the scalar
     kernel on shapes placed by numpy: every pair, the closest one and its witness points, on
-    random configurations (most halt7 ones colliding), with keep-outs (a box, a sphere) and on
-    joints about other axes than z (the Panda's URDF)."""
-    if name == "panda":
-        from robot_data import robot_file
+    random configurations (most halt7 ones colliding), with keep-outs (a box, a sphere), and on
+    the UR5, whose joints 2-4 and 6 turn about y (the kernel's z-joint frames differ from the
+    bodies'), with capsules along its links and a box on a moving link."""
+    from robot_data import robot_file
 
+    if name == "panda":
         arm = jl.read_urdf(robot_file("panda_description/urdf/panda_collision.urdf"), tip_link="panda_hand")
+    elif name == "ur5":
+        arm = with_link_capsules(jl.read_urdf(robot_file("ur_description/urdf/ur5_robot.urdf"), meshes="skip"), 0.04)
+        housing = Box(translation([0.05, 0.02, 0.2]) @ np.diag([1.0, -1.0, -1.0, 1.0]), (0.06, 0.05, 0.08), name="housing")
+        # one box, on a moving link (two boxes, one moving, go to coal: tests/test_meshes.py)
+        bodies = [replace(b, shapes=tuple(s for s in b.shapes if not isinstance(s, Box))) for b in arm.bodies]
+        bodies[2] = replace(bodies[2], shapes=bodies[2].shapes + (housing,))
+        arm = replace(arm, bodies=tuple(bodies))
+        assert any(isinstance(s, Box) and s.link == 3 for s in arm.bodies[2].shapes)
     else:
         arm = jl.load_robot(name)
     keep_out = (
         Box(half_extents=(0.3, 0.2, 0.4), pose=translation([0.8, 0.3, 0.5]), name="dock"),
         Sphere(center=(0.2, -0.6, 0.9), radius=0.25, name="payload"),
     )
+    if name == "ur5":
+        keep_out = (keep_out[1], Capsule([0.3, 0.3, 0.0], [0.3, 0.3, 0.8], 0.1, name="mast"))
+    assert not (collision_pairs(arm, keep_out).pairs[:, 0] == 2).any()
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (700, arm.dof))  # > one block of 128
     q[0] = 0.0
     for keep in ((), keep_out):

@@ -92,3 +92,19 @@ def test_settings_are_plain_and_picklable():
         assert pickle.loads(pickle.dumps(s)).to_dict() == s.to_dict()
     assert settings[0].to_dict()["vmax_deg"] == [40.0] * 6 and settings[2].to_dict()["ga"]["n_pop"] == 8
     assert set(FORMER_KEYWORDS) >= {"vmax_deg", "samples", "solver", "ga", "moment_about"}
+
+
+def test_a_former_none_is_the_default_and_settings_refuse_wrong_kinds_in_one_line(fresh_warnings):
+    with pytest.warns(FutureWarning) as caught:
+        plan = jl.plan_halt("halt7", paper_qf=True, ga=None, motion=None, n_samples=101)
+    assert plan.motion.solver == "scan" and len(caught) == 2 and "ga=" in str(caught[0].message)
+    for build, words in (
+        (lambda: jl.HaltSearch(samples="200"), "search.samples must be an integer >= 2"),
+        (lambda: jl.HaltSearch(reachable="no"), "search.reachable must be True or False"),
+        (lambda: jl.HaltMotionSettings(solver="ga", ga={"n_pop": 4}), "motion.ga must be a GASettings"),
+        (lambda: jl.HaltMotionSettings(solver="newton"), "motion.solver must be one of scan, ga, vector"),
+        (lambda: jl.HaltLimits(vmax_deg="fast"), "limits.vmax_deg must be one number or one per joint"),
+    ):
+        with pytest.raises(jl.ScenarioError, match=words) as info:
+            build()
+        assert "\n" not in str(info.value)

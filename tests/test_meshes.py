@@ -140,22 +140,37 @@ def test_meshes_skip_and_missing_extras_are_said_in_one_line(tmp_path, monkeypat
     assert skipped.bodies[1].shapes == () and "1 <collision> mesh(es) left out" in skipped.description
     with pytest.raises(ModelError, match=r"meshes must be one of convex, skip; got 'hull'"):
         _probe(tmp_path, '<mesh filename="cube.stl"/>', meshes="hull")
-    with pytest.raises(ModelError, match=r"package 'nowhere' is not in package_dirs, ROS_PACKAGE_PATH"):
-        _probe(tmp_path, '<mesh filename="package://nowhere/cube.stl"/>')
+    # a mesh that cannot be read leaves the model usable, but its clearance refuses it in one line
+    lost = _probe(tmp_path, '<mesh filename="package://nowhere/cube.stl"/>')
+    assert "1 <collision> mesh(es) not read" in lost.description and len(lost.unread_meshes) == 1
+    jl.ee_pose(lost, np.zeros(3))  # kinematics need no mesh
+    with pytest.raises(ModelError, match=r"its clearance needs the <collision> meshes .* link 'l2': .*package 'nowhere' "
+                       r"is not in package_dirs, ROS_PACKAGE_PATH.*meshes='skip'") as info:
+        clearance(jl.lock(lost, 2, 0.3), np.zeros(2))  # a lock keeps them unread
+    assert "\n" not in str(info.value)
     (tmp_path / "pkg").mkdir()
     trimesh.creation.box(extents=(1.0, 1.0, 1.0)).export(tmp_path / "pkg" / "cube.stl")
     found = _probe(tmp_path, '<mesh filename="package://pkg/cube.stl"/>', package_dirs=[tmp_path / "pkg"])
     assert found.bodies[1].shapes[0].source.endswith("pkg/cube.stl")
     (tmp_path / "flat.obj").write_text("v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\nf 2 4 3\n")
     with pytest.raises(ModelError, match=r"flat \(no volume\)"):
-        _probe(tmp_path, '<mesh filename="flat.obj"/>')
+        clearance(_probe(tmp_path, '<mesh filename="flat.obj"/>'), np.zeros(3))
     from jointlock.io import mesh
 
     mesh._hull.cache_clear()
     monkeypatch.setitem(sys.modules, "trimesh", None)  # import trimesh raises ImportError
+    without = _probe(tmp_path, '<mesh filename="cube.stl" scale="2 2 2"/>')
     with pytest.raises(ModelError, match=r"needs trimesh: pip install 'jointlock\[mesh\]'") as info:
-        _probe(tmp_path, '<mesh filename="cube.stl" scale="2 2 2"/>')
+        clearance(without, np.zeros(3))
     assert "\n" not in str(info.value)
+    from jointlock.mjcf import mjcf_text
+
+    assert "<mujoco" in mjcf_text(without)  # exports and kinematics need no mesh
+    write_urdf(without, tmp_path / "without.urdf")
+    with pytest.raises(ModelError, match=r"<mesh scale>: must be 3 numbers, none 0"):
+        _probe(tmp_path, '<mesh filename="cube.stl" scale="1 0 1"/>')
+    with pytest.raises(ModelError, match=r"package_dirs must be a folder or a list of folders"):
+        _probe(tmp_path, '<mesh filename="cube.stl"/>', package_dirs=5)
     monkeypatch.setitem(sys.modules, "coal", None)
     with pytest.raises(ModelError, match=r"needs coal for its distances .*pip install 'jointlock\[mesh\]'"):
         clearance(found, np.zeros(3))
@@ -170,6 +185,7 @@ def test_exports_write_the_hull_back(tmp_path):
     write_urdf(arm, out)
     back = jl.read_urdf(out)
     (hull,), (again,) = arm.bodies[1].shapes, back.bodies[1].shapes
+    assert hull.source.startswith("/")  # absolute: an export elsewhere still finds it
     assert np.allclose(again.vertices, hull.vertices) and np.allclose(again.pose, hull.pose, atol=1e-12)
     q = np.random.default_rng(6).uniform(-3, 3, (50, 3))
     assert np.allclose(clearance(back, q).pair_distance, clearance(arm, q).pair_distance, atol=1e-9)
@@ -249,3 +265,23 @@ def test_a_scenario_and_the_command_line_choose_how_meshes_are_read(tmp_path, ca
         assert main(["export-urdf", str(urdf), "--meshes", mode, "--out", str(out)]) == 0
         assert out.read_text().count("<mesh ") == meshes
     assert "Traceback" not in capsys.readouterr().err
+
+
+def test_campaign_keys_say_how_a_urdfs_meshes_are_read(tmp_path):
+    """A URDF with collision meshes: unset meant "left out" before meshes were read and means
+    "convex" now, so the key holds the mode read (a ledger of the earlier reading does not
+    resume into this one); a URDF without meshes keeps its keys."""
+    from robot_data import robot_file
+
+    from jointlock.campaign._cases import case_key
+
+    def key(robot: str, extra: str = "") -> str:
+        path = tmp_path / "s.toml"
+        path.write_text(f'robot = "{robot}"\n{extra}[workspace]\nsamples = 1000\n')
+        return case_key(jl.load_scenario(path), 0)
+
+    ur5 = str(robot_file(UR5))
+    assert key(ur5) == key(ur5, 'meshes = "convex"\n') != key(ur5, 'meshes = "skip"\n')
+    bare = tmp_path / "bare.urdf"
+    bare.write_text(URDF.replace("GEOMETRY", '<box size="0.5 0.3 0.2"/>'))
+    assert key(str(bare)) != key(str(bare), 'meshes = "convex"\n')  # unset stays unset: no mesh to read

@@ -12,6 +12,7 @@ sixth digit in doubt).  Cost: a few microseconds per pair and configuration (a P
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Sequence
 from typing import Any
 
@@ -24,6 +25,10 @@ FloatArray = np.ndarray
 
 #: GJK's and EPA's stopping tolerance [m].
 HULL_TOLERANCE = 1e-12
+
+# coal's geometry of each shape, built once (a hull's Qhull and its triangles) and dropped with
+# the shape; not stored on the shape itself, which pickles (coal's objects do not)
+_GEOMETRY: weakref.WeakKeyDictionary[Any, tuple[Any, FloatArray]] = weakref.WeakKeyDictionary()
 
 
 def import_coal(what: str) -> Any:
@@ -95,7 +100,11 @@ def hull_pair_distances(
     first = shapes[int(pairs[0][1])] if len(pairs) else None
     coal = import_coal(f"{type(first).__name__.lower()} {getattr(first, 'name', '')!r} (a mesh's hull, or a box facing a box)")
     count = 1 if rotations is None else rotations.shape[0]
-    geometry = [_geometry(coal, s) for s in shapes]
+    geometry = []
+    for shape in shapes:
+        if shape not in _GEOMETRY:
+            _GEOMETRY[shape] = _geometry(coal, shape)
+        geometry.append(_GEOMETRY[shape])
     request = coal.DistanceRequest()
     request.enable_signed_distance = True
     request.gjk_tolerance = HULL_TOLERANCE

@@ -44,8 +44,8 @@ from numpy.typing import ArrayLike
 from ._cache import cached_on
 from ._chain import link_constants
 from .bounds import MAX_LENGTH_M, as_real
-from .errors import ConfigurationError
-from .forward import chain_state
+from .errors import ConfigurationError, ModelError
+from .forward import DEFAULT_CHUNK, chain_state
 from .model import ArmModel, FloatArray, as_joint_array
 from .shapes import Box, Capsule, Convex, Shape, Sphere, check_shapes
 
@@ -213,6 +213,14 @@ def collision_pairs(model: ArmModel, keep_out: Sequence[Shape] = ()) -> Collisio
     """The shapes and the pairs :func:`clearance` checks on ``model`` with ``keep_out`` volumes
     (shapes in the root frame); see the module for the rules."""
     keep = check_shapes(keep_out, "keep_out")
+    if model.unread_meshes:
+        more = f" (and {len(model.unread_meshes) - 1} more)" if len(model.unread_meshes) > 1 else ""
+        raise ModelError(
+            f"model {model.name!r}: its clearance needs the <collision> meshes its URDF names, and "
+            f"{len(model.unread_meshes)} could not be read: {model.unread_meshes[0]}{more}; read them (the mesh extra, "
+            "package_dirs), or leave them out on purpose (meshes='skip', --meshes skip: those links are then "
+            "geometry-blind)"
+        )
     mounted = cached_on(model, "zero_pose_contacts", lambda: _zero_pose_contacts(model))
     if not keep:
         return cached_on(model, "collision_pairs", lambda: _build(model, (), mounted))
@@ -309,18 +317,22 @@ def _hull_rows(
     of them is closer."""
     from ._hull_distance import hull_pair_distances
 
-    state = chain_state(model, q) if model.dof else None
-    distance, hull_witness = hull_pair_distances(
-        pairs.shapes,
-        pairs.shape_body,
-        pairs.pairs[rows, 1:],
-        None if state is None else state.rotations,
-        None if state is None else state.positions,
-        with_witness=witness,
-    )
-    if distance.shape[1] != q.shape[0]:  # no movable body: one placement for every configuration
-        distance = np.broadcast_to(distance, (len(rows), q.shape[0]))
-        hull_witness = np.broadcast_to(hull_witness, (len(rows), q.shape[0], 2, 3))
+    count = q.shape[0]
+    distance = np.empty((len(rows), count))
+    hull_witness = np.empty((len(rows), count, 2, 3))
+    for start in range(0, count, DEFAULT_CHUNK):  # bounded memory: frames of a chunk at a time
+        stop = min(start + DEFAULT_CHUNK, count)
+        state = chain_state(model, q[start:stop]) if model.dof else None
+        part, points_part = hull_pair_distances(
+            pairs.shapes,
+            pairs.shape_body,
+            pairs.pairs[rows, 1:],
+            None if state is None else state.rotations,
+            None if state is None else state.positions,
+            with_witness=witness,
+        )
+        distance[:, start:stop] = part
+        hull_witness[:, start:stop] = points_part
     offsets = pairs.offsets[rows]
     distance = distance - offsets[:, None]
     by_pair[rows] = distance
@@ -471,6 +483,8 @@ def clearance(
     """
     q = as_joint_array(model, q)
     margin = check_clearance_m(margin, "margin")
+    if not isinstance(witness, (bool, np.bool_)):
+        raise ConfigurationError(f"witness must be True or False; got {witness!r}")
     pairs = collision_pairs(model, keep_out)
     batch = q.shape[:-1]
     distance, smallest, closest, points = _distances(model, pairs, q.reshape(-1, model.dof), witness)

@@ -36,6 +36,7 @@ inverse dynamics to round-off (``tests/test_mjcf.py``: ``mj_inverse`` against
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -275,8 +276,9 @@ def mjcf_text(
 
 
 def _mounted_body_pairs(model: ArmModel, body_of_link: dict[int, str]) -> list[tuple[str, str]]:
-    """The body pairs holding a pair that jointlock measures from its zero-pose contact."""
-    pairs = collision_pairs(model)
+    """The body pairs holding a pair that jointlock measures from its zero-pose contact (among
+    the shapes read: a mesh that could not be read is not in the file either)."""
+    pairs = collision_pairs(dataclasses.replace(model, unread_meshes=()) if model.unread_meshes else model)
     out: list[tuple[str, str]] = []
     for (link_a, _, link_b, _), offset in zip(pairs.keys, pairs.offsets):
         a, b = body_of_link.get(link_a), body_of_link.get(link_b)

@@ -266,6 +266,12 @@ class ArmModel:
         Pairs of shape names (URDF link names) whose clearance is never checked: an SRDF's
         ``<disable_collisions>`` (:func:`jointlock.io.srdf.read_srdf`,
         :func:`jointlock.geometry.with_disabled_pairs`), each pair sorted.  Not compared.
+    unread_meshes
+        The URDF ``<collision>`` meshes that could not be read (each ``"link: why"``: the
+        ``mesh`` extra missing, a file not found or not readable).  The model is usable for
+        everything but its clearance, which it refuses in one line naming them
+        (:func:`jointlock.collision.collision_pairs`) until they are read or left out on purpose
+        (``meshes="skip"``).  Not compared.
     """
 
     name: str
@@ -278,6 +284,7 @@ class ArmModel:
     description: str = ""
     unlocked: ArmModel | None = field(default=None, compare=False, repr=False)
     disabled_pairs: tuple[tuple[str, str], ...] = field(default=(), compare=False, repr=False)
+    unread_meshes: tuple[str, ...] = field(default=(), compare=False, repr=False)
 
     def __post_init__(self) -> None:
         joints = tuple(self.joints)

@@ -324,6 +324,10 @@ class UrdfChain:
     srdf: str | None = None
     meshes: str | None = None
 
+    def __post_init__(self) -> None:
+        if self.meshes is not None and self.meshes not in ("convex", "skip"):
+            raise ModelError(f"meshes must be 'convex' or 'skip' (or None: convex); got {shown(self.meshes)}")
+
     @classmethod
     def from_fields(cls, data: Mapping[str, Any]) -> UrdfChain | None:
         """The chain named by :data:`CHAIN_FIELDS` of ``data`` (a validated scenario); None

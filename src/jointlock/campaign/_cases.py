@@ -16,6 +16,7 @@ import inspect
 import itertools
 import json
 import math
+import re
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -168,6 +169,9 @@ def case_key(scenario: Scenario, campaign_seed: int) -> str:
             data[table] = {k: v for k, v in data[table].items() if k != field}
     data["jobs"] = list(scenario.jobs)
     robot = Path(str(data["robot"]))
+    if robot.suffix.lower() == ".urdf" and data.get("meshes") is None and _has_collision_meshes(str(robot)):
+        # unset meant "left out" before meshes were read (and "convex" since): the key says which
+        data["meshes"] = "convex"
     if robot.suffix.lower() in (".toml", ".urdf"):
         data["robot"] = {"file": robot.name, "sha256": _file_digest(str(robot))}
     if data.get("srdf"):  # as the robot: by name and content, not where the folder lies
@@ -190,6 +194,20 @@ def _file_digest(path: str) -> str:
     if stamp not in _DIGESTS:
         _DIGESTS[stamp] = hashlib.sha256(Path(path).read_bytes()).hexdigest()
     return _DIGESTS[stamp]
+
+
+_MESHES: dict[tuple[str, int, int], bool] = {}
+
+
+def _has_collision_meshes(path: str) -> bool:
+    """Whether the URDF at ``path`` has a ``<mesh>`` inside a ``<collision>`` (read once per
+    file version)."""
+    stat = Path(path).stat()
+    stamp = (path, stat.st_mtime_ns, stat.st_size)
+    if stamp not in _MESHES:
+        text = Path(path).read_bytes()
+        _MESHES[stamp] = re.search(rb"<collision\b(?:(?!</collision>).)*?<mesh\b", text, re.S) is not None
+    return _MESHES[stamp]
 
 
 def case_seed(key: str) -> int:

@@ -65,12 +65,13 @@ def resolve_mesh(filename: str, urdf_dir: Path | None, package_dirs: Sequence[st
 
 def hull_vertices(path: Path, scale: ArrayLike = (1.0, 1.0, 1.0)) -> np.ndarray:
     """(V, 3) the vertices of the convex hull of the mesh in ``path`` [m] after ``scale`` (3,)."""
-    key = (str(path.resolve()), path.stat().st_mtime_ns, tuple(float(s) for s in np.asarray(scale, dtype=float).reshape(3)))
+    stat = path.stat()
+    key = (str(path.resolve()), (stat.st_mtime_ns, stat.st_size), tuple(float(s) for s in np.asarray(scale, dtype=float).reshape(3)))
     return _hull(*key).copy()
 
 
 @functools.lru_cache(maxsize=256)
-def _hull(path: str, stamp: int, scale: tuple[float, ...]) -> np.ndarray:
+def _hull(path: str, stamp: tuple[int, int], scale: tuple[float, ...]) -> np.ndarray:
     del stamp  # part of the key: an edited file is read again
     try:
         import trimesh

@@ -46,6 +46,8 @@ Or the chain of a URDF tree (:func:`jointlock.read_urdf`), which every command t
     tip_link = "panda_hand_tcp"         # optional when the tree has one movable path
     freeze_deg = { panda_joint7 = 45.0 }            # revolute joints held [deg]
     freeze_m = { panda_finger_joint1 = 0.02 }       # prismatic joints held [m]
+    meshes = "skip"                     # optional: <collision> meshes left out (default "convex":
+                                        # each read as its convex hull, the mesh extra)
 
 Every joint off the chain is held at 0 unless frozen here (a ``<mimic>`` joint follows the
 joint it mimics).  The root link's inertial is the spacecraft: with a mass, the model can be
@@ -265,7 +267,7 @@ def read_model_toml(path: str | Path) -> ArmModel:
     return model_from_dict(data, shorten(str(path)), Path(path).parent)
 
 
-_URDF_KEYS = {"name", "description", "urdf", "root_link", "tip_link", "freeze_deg", "freeze_m"}
+_URDF_KEYS = {"name", "description", "urdf", "root_link", "tip_link", "freeze_deg", "freeze_m", "meshes"}
 
 
 def _urdf_model(data: dict[str, Any], where: str, folder: Path) -> ArmModel:
@@ -273,7 +275,7 @@ def _urdf_model(data: dict[str, Any], where: str, folder: Path) -> ArmModel:
     from .urdf import read_urdf
 
     _check_keys(data, _URDF_KEYS, where)
-    texts = {k: data.get(k) for k in ("urdf", "root_link", "tip_link", "name", "description")}
+    texts = {k: data.get(k) for k in ("urdf", "root_link", "tip_link", "name", "description", "meshes")}
     for key, value in texts.items():
         if value is not None and (not isinstance(value, str) or not value):
             raise ModelError(f"{where}: field {shown(key)} must be a non-empty string; got {shown(value)}")
@@ -306,4 +308,5 @@ def _read_urdf_of(read_urdf: Any, folder: Path, texts: dict[str, Any], freeze: d
         tip_link=texts["tip_link"],
         freeze=freeze,
         freeze_units=units,
+        meshes=texts["meshes"] or "convex",
     )

@@ -20,8 +20,9 @@ conservative, a clearance is never overstated; a cylinder and the two spheres at
 :func:`~jointlock.io.urdf_export.urdf_text` writes a capsule, read back as the capsule exactly).
 ``<mesh>`` as its convex hull (:class:`~jointlock.shapes.Convex`, read by
 :mod:`jointlock.io.mesh` with the ``mesh`` extra; distances by coal): a clearance against the
-hull never exceeds the one against the mesh.  ``meshes="skip"`` leaves meshes out instead (the
-model's description then says how many).
+hull never exceeds the one against the mesh.  A mesh that cannot be read (the extra missing, a
+file not found) does not stop the reading: the model's clearance refuses it, naming the mesh.
+``meshes="skip"`` leaves meshes out on purpose (the model's description then says how many).
 """
 
 from __future__ import annotations
@@ -30,7 +31,7 @@ import math
 import re
 import xml.etree.ElementTree as ET
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Literal
 
@@ -151,20 +152,28 @@ class _Meshes:
     mode: str
     urdf_dir: Path | None
     package_dirs: tuple[str | Path, ...]
+    unread: list[str] = field(default_factory=list)
 
-    def shape(self, element: ET.Element, frame: np.ndarray, name: str, where: str) -> Convex:
+    def shape(self, element: ET.Element, frame: np.ndarray, name: str, where: str) -> Convex | None:
+        """The mesh's convex hull, or None when it cannot be read (the reason kept in
+        ``unread``: the model's clearance refuses it, everything else works)."""
         from .mesh import hull_vertices, resolve_mesh
 
         filename = element.get("filename")
         if not filename:
             raise ModelError(f"{where} <mesh>: needs a filename")
         scale = _floats(element.get("scale"), 3, f"{where} <mesh scale>", [1.0, 1.0, 1.0])
+        if not np.all(scale != 0) or np.any(np.abs(scale) > MAX_LENGTH_M):  # negative: a mirrored mesh
+            raise ModelError(
+                f"{where} <mesh scale>: must be 3 numbers, none 0, each within +-{MAX_LENGTH_M:g}; got {shown(scale.tolist())}"
+            )
         try:
             path = resolve_mesh(filename, self.urdf_dir, self.package_dirs)
             vertices = hull_vertices(path, scale)
         except ModelError as exc:
-            raise ModelError(f"{where}: {exc}") from None
-        return Convex(frame, vertices, name=name, source=str(path), scale=scale)
+            self.unread.append(f"link {shorten(name, 40)!r}: {exc}")
+            return None
+        return Convex(frame, vertices, name=name, source=str(path.resolve()), scale=scale)
 
 
 def _collisions(link: ET.Element, label: str, meshes_as: _Meshes) -> tuple[tuple[Shape, ...], int]:
@@ -196,8 +205,8 @@ def _collisions(link: ET.Element, label: str, meshes_as: _Meshes) -> tuple[tuple
             elif element.tag == "mesh":
                 if meshes_as.mode == "skip":
                     meshes += 1
-                else:
-                    shapes.append(meshes_as.shape(element, frame, label_name, where))
+                elif (hull := meshes_as.shape(element, frame, label_name, where)) is not None:
+                    shapes.append(hull)
             else:
                 raise ModelError(
                     f"{where}: <{shorten(element.tag, 40)}> is not a URDF geometry (box, cylinder, sphere, mesh)"
@@ -265,9 +274,12 @@ def read_urdf(
         ``freeze_deg`` / ``freeze_m``), refused for a joint of the other kind.
     meshes
         ``"convex"``: each ``<collision>`` ``<mesh>`` is read as its convex hull (needs the
-        ``mesh`` extra: ``pip install 'jointlock[mesh]'``); ``"skip"``: meshes are left out, and
-        the links that have only meshes have no collision geometry (the description says how
-        many were left out).
+        ``mesh`` extra: ``pip install 'jointlock[mesh]'``); a mesh that cannot be read (the extra
+        missing, a file not found or unreadable) leaves the model usable for everything but its
+        clearance, which refuses it in one line naming the mesh
+        (:attr:`~jointlock.model.ArmModel.unread_meshes`).  ``"skip"``: meshes are left out on
+        purpose, and the links that have only meshes have no collision geometry (the description
+        says how many were left out).
     package_dirs
         Folders in which ``package://`` mesh files are looked for, before ``ROS_PACKAGE_PATH``
         and the folders above the URDF (:mod:`jointlock.io.mesh`).
@@ -280,10 +292,12 @@ def read_urdf(
     text: str | bytes = source_text
     label = "URDF"
     urdf_dir: Path | None = None
-    if meshes not in MESH_MODES:
+    if not isinstance(meshes, str) or meshes not in MESH_MODES:
         raise ModelError(f"meshes must be one of {', '.join(MESH_MODES)}; got {shown(meshes)}")
     if isinstance(package_dirs, (str, Path)):
         package_dirs = (package_dirs,)
+    if not isinstance(package_dirs, (list, tuple)) or not all(isinstance(p, (str, Path)) for p in package_dirs):
+        raise ModelError(f"package_dirs must be a folder or a list of folders (text or Path); got {shown(package_dirs)}")
     if not source_text.lstrip().startswith("<"):
         path = check_path_text(source_text, "URDF file", ModelError)
         label = shorten(str(path))
@@ -415,7 +429,9 @@ def read_urdf(
         root_body=root_body,
         floating=base == "floating",
         description=f"read from {label}" + _selection_text(chain)
-        + (f"; {skipped_meshes} <collision> mesh(es) left out (meshes='skip')" if skipped_meshes else ""),
+        + (f"; {skipped_meshes} <collision> mesh(es) left out (meshes='skip')" if skipped_meshes else "")
+        + (f"; {len(meshes_as.unread)} <collision> mesh(es) not read: no clearance until they are" if meshes_as.unread else ""),
+        unread_meshes=tuple(meshes_as.unread),
     )
 
 

@@ -227,8 +227,9 @@ def _on_full_arm(model: ArmModel, arm: ArmModel, motion: ArmMotion) -> ArmMotion
 def _overlaps(arm: ArmModel, motion: ArmMotion, points: dict[str, Any], times: np.ndarray) -> list[tuple[np.ndarray, str]] | None:
     """Per frame, the witness points (2, 3) of the deepest overlap of the arm with its bus or
     itself, in the motion's first frame, and a hover text; (0, 3) when it overlaps nothing.
-    None for an arm without collision shapes."""
-    if not collision_pairs(arm).names:
+    None for an arm without collision shapes, or whose meshes could not be read (its clearance is
+    refused where it is asked for)."""
+    if arm.unread_meshes or not collision_pairs(arm).names:
         return None
     result = clearance(arm, motion.q[_nearest(motion.t, times)])
     world = points["base"][:, None, :] + np.einsum("fij,fkj->fki", points["base_rotation"], result.witness)

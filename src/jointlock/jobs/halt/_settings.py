@@ -21,11 +21,31 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._deprecate import warn_once
+from ...bounds import shown
+from ...errors import ScenarioError
 from ...papers import p000
 from ...planning.ga import GASettings
 from ...planning.halt_motion import MomentAbout
 
 Solver = Literal["scan", "ga", "vector"]
+SOLVERS = ("scan", "ga", "vector")
+MOMENT_POINTS = ("spacecraft_com", "joint1")
+
+
+def _refuse(where: str, value: Any, what: str) -> None:
+    raise ScenarioError(f"{where} must be {what}; got {shown(value)}")
+
+
+def _is_int(value: Any) -> bool:
+    return isinstance(value, (int, np.integer)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_real(value: Any) -> bool:
+    return isinstance(value, (int, float, np.integer, np.floating)) and not isinstance(value, (bool, np.bool_))
+
+
+def _is_bool(value: Any) -> bool:
+    return isinstance(value, (bool, np.bool_))
 
 
 def _plain(value: Any) -> Any:
@@ -60,6 +80,21 @@ class HaltLimits:
     brake_max_Nm: ArrayLike | None = None
     margin: float = 0.0
 
+    def __post_init__(self) -> None:
+        # the values are checked against the arm by halt_limits; their kind here, in one line
+        for name in ("vmax_deg", "amax_deg", "torque_max_Nm", "brake_max_Nm"):
+            value = getattr(self, name)
+            if value is None:
+                continue
+            try:
+                ok = np.asarray(value).dtype.kind in "iuf" and np.asarray(value).ndim <= 1
+            except (TypeError, ValueError):
+                ok = False
+            if not ok:
+                _refuse(f"limits.{name}", value, "one number or one per joint (None: the default)")
+        if not _is_real(self.margin):
+            _refuse("limits.margin", self.margin, "a number (share of each limit kept free, 0 .. 0.5)")
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data: each limit as given (None: the rule's default) and the margin."""
         return {f.name: _plain(getattr(self, f.name)) for f in fields(self)}
@@ -80,6 +115,12 @@ class HaltSearch:
 
     samples: int = p000.SAMPLES
     reachable: bool = True
+
+    def __post_init__(self) -> None:
+        if not _is_int(self.samples):
+            _refuse("search.samples", self.samples, "an integer >= 2 (Monte Carlo samples)")
+        if not _is_bool(self.reachable):
+            _refuse("search.reachable", self.reachable, "True or False")
 
     def to_dict(self) -> dict[str, Any]:
         """Plain data: samples and whether only reachable configurations are searched."""
@@ -120,6 +161,22 @@ class HaltMotionSettings:
     prefer_margin: float = 0.0
     moment_about: MomentAbout = "spacecraft_com"
 
+    def __post_init__(self) -> None:
+        if self.solver not in SOLVERS:
+            _refuse("motion.solver", self.solver, f"one of {', '.join(SOLVERS)}")
+        if not isinstance(self.ga, GASettings):
+            _refuse("motion.ga", self.ga, "a GASettings")
+        if not _is_int(self.n_samples):
+            _refuse("motion.n_samples", self.n_samples, "an odd integer (time samples of the objective)")
+        if not _is_bool(self.minimum_T):
+            _refuse("motion.minimum_T", self.minimum_T, "True or False")
+        if not isinstance(self.objective, str):
+            _refuse("motion.objective", self.objective, "the name of an objective (mean_torque, ...)")
+        if not _is_real(self.prefer_margin):
+            _refuse("motion.prefer_margin", self.prefer_margin, "a number (share of the best objective)")
+        if self.moment_about not in MOMENT_POINTS:
+            _refuse("motion.moment_about", self.moment_about, f"one of {', '.join(MOMENT_POINTS)}")
+
     def to_dict(self) -> dict[str, Any]:
         """Plain data: every setting, the GA's as a table."""
         out = {f.name: getattr(self, f.name) for f in fields(self)}
@@ -159,21 +216,24 @@ def settings_from_keywords(
     for name, value in former.items():
         group, attribute = FORMER_KEYWORDS[name]
         resolved = group == "limits" and given.get("limits") is not None and not isinstance(given["limits"], HaltLimits)
-        if resolved and name == "margin":
-            out["margin"] = value
-        elif given.get(group) is not None:
+        with_resolved = resolved and name == "margin"
+        if given.get(group) is not None and not with_resolved and value is not None:
             raise TypeError(
                 f"{function}() got {name}= and {group}=: {name}= is the former way to give {group}.{attribute}; "
                 f"give it once, in {group}={_CLASSES[group].__name__}({attribute}=...)"
                 + (" (a JointLimits is used as it is)" if resolved else "")
             )
-        else:
-            moved.setdefault(group, {})[attribute] = value
         warn_once(
             f"keyword {function}:{name}",
             f"{function}(): the keyword {name}= is deprecated: use {group}={_CLASSES[group].__name__}({attribute}=...) "
             f"(the same setting); {name}= still works for now",
         )
+        if value is None:  # the former keywords' None meant their default
+            continue
+        if with_resolved:
+            out["margin"] = value
+        else:
+            moved.setdefault(group, {})[attribute] = value
     for group, values in moved.items():
         out[group] = replace(_CLASSES[group](), **values)
     for group, cls in _CLASSES.items():
