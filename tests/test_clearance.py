@@ -854,3 +854,6 @@ def test_the_singularity_search_may_leave_out_colliding_configurations(tmp_path,
     assert json.loads(capsys.readouterr().out)["clearance"]["left_out"] == report["left_out"]
     assert main(["singular", "canadarm7", "--keep-out", "x.toml"]) == 2
     assert "--keep-out: with --search --skip-colliding only" in capsys.readouterr().err
+    path.write_text('robot = "canadarm7"\n[singular]\nskip_colliding = true\n')
+    with pytest.raises(jl.ScenarioError, match="singular.skip_colliding: with singular.search = true only"):
+        singular_from_scenario(jl.load_scenario(path).data, {})

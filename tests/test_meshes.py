@@ -165,8 +165,11 @@ def test_meshes_skip_and_missing_extras_are_said_in_one_line(tmp_path, monkeypat
     assert "\n" not in str(info.value)
     from jointlock.mjcf import mjcf_text
 
-    assert "<mujoco" in mjcf_text(without)  # exports and kinematics need no mesh
-    write_urdf(without, tmp_path / "without.urdf")
+    # an export would silently lack the mesh (and read back complete): refused in one line
+    for export in (lambda: mjcf_text(without), lambda: write_urdf(without, tmp_path / "without.urdf")):
+        with pytest.raises(ModelError, match=r"export of 'probe': 1 <collision> mesh\(es\) could not be read"):
+            export()
+    jl.ee_pose(without, np.zeros(3))  # kinematics need no mesh
     with pytest.raises(ModelError, match=r"<mesh scale>: must be 3 numbers, none 0"):
         _probe(tmp_path, '<mesh filename="cube.stl" scale="1 0 1"/>')
     with pytest.raises(ModelError, match=r"package_dirs must be a folder or a list of folders"):
@@ -285,3 +288,32 @@ def test_campaign_keys_say_how_a_urdfs_meshes_are_read(tmp_path):
     bare = tmp_path / "bare.urdf"
     bare.write_text(URDF.replace("GEOMETRY", '<box size="0.5 0.3 0.2"/>'))
     assert key(str(bare)) != key(str(bare), 'meshes = "convex"\n')  # unset stays unset: no mesh to read
+
+
+def test_unread_meshes_are_said_where_the_clearance_is_reported_and_refused_where_required(monkeypatch):
+    """Without the mesh extra: a halt with the clearance reported only runs and says first that
+    the clearance was not checked; one that requires it is refused; once the extra is back,
+    load_robot reads the meshes (no stale model from its cache)."""
+    from robot_data import robot_file
+
+    from jointlock.io import mesh
+
+    from jointlock import robots
+
+    path = str(robot_file(UR5))
+    mesh._hull.cache_clear()
+    robots._read_model_file.cache_clear()  # read in this test, not by an earlier one
+    monkeypatch.setitem(sys.modules, "trimesh", None)
+    arm = jl.load_robot(path)
+    assert len(arm.unread_meshes) == 7
+    locked = jl.lock(arm, 3, np.radians(30))
+    state = jl.FailureState(np.radians([0, -60, 0, -60, 0]), np.radians([10.0] * 5), np.zeros(5))
+    settings = {"T": 3.0, "search": jl.HaltSearch(samples=200), "motion": jl.HaltMotionSettings(n_samples=101)}
+    plan = jl.plan_halt(locked, state, clearance=jl.ClearanceSettings.off(), **settings)
+    assert plan.summary()[0].startswith("CLEARANCE NOT CHECKED: 7 <collision> mesh(es) of the URDF could not be read")
+    assert plan.clearance() is None
+    with pytest.raises(ModelError, match=r"its clearance needs the <collision> meshes .*needs trimesh") as info:
+        jl.plan_halt(locked, state, **settings)
+    assert "\n" not in str(info.value) and "'base.stl'" in str(info.value)
+    monkeypatch.delitem(sys.modules, "trimesh")
+    assert not jl.load_robot(path).unread_meshes

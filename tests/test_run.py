@@ -210,6 +210,16 @@ def test_singular_report_verdicts_and_no_failure(tmp_path):
     assert "no locked joint" in failure
 
 
+def test_a_singular_study_of_canadarm7_writes_its_report(tmp_path):
+    """A [singular] study (no verification) of a Canadarm2-structure arm: its conditions are the
+    study's, not the verification's figure (the report once asked them for its sigma_tol)."""
+    path = tmp_path / "s.toml"
+    path.write_text('robot = "canadarm7"\n[singular]\nq_deg = [0, 30, 0, 45, 0, 20, 0]\n')
+    code, stdout, _ = cli("run", str(path), "--out", str(tmp_path / "out"))
+    assert code == 0 and "singular: sigma_min" in stdout
+    assert (tmp_path / "out" / "report.html").is_file()
+
+
 def test_singular_job_inherits_the_scenarios_base(tmp_path):
     path = tmp_path / "s.toml"
     path.write_text(

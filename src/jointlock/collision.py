@@ -260,6 +260,26 @@ def _kernel_shapes(model: ArmModel, pairs: CollisionPairs) -> _KernelShapes:
     )
 
 
+def unread_meshes_line(model: ArmModel) -> list[str]:
+    """A summary's first line when the model's clearance could not be reported because meshes
+    were not read (none otherwise)."""
+    if not model.unread_meshes:
+        return []
+    return [
+        f"CLEARANCE NOT CHECKED: {len(model.unread_meshes)} <collision> mesh(es) of the URDF could not be read "
+        f"({model.unread_meshes[0]}); read them (the mesh extra, package_dirs) or leave them out on purpose "
+        "(--meshes skip)"
+    ]
+
+
+def reports_clearance(model: ArmModel, keep_out: Sequence[Shape] = ()) -> bool:
+    """Whether a result that only *reports* the clearance (an IK branch's, a re-plan's, a jump
+    run's, a halt's with the clearance off) has one to report: the model has pairs to check and
+    its meshes were read.  A model whose meshes could not be read reports none (the results say
+    so); where the clearance is *required*, :func:`collision_pairs` refuses it naming them."""
+    return not model.unread_meshes and bool(collision_pairs(model, keep_out).names)
+
+
 def _distances(
     model: ArmModel, pairs: CollisionPairs, q: FloatArray, witness: bool = True
 ) -> tuple[FloatArray, FloatArray, np.ndarray, FloatArray]:

@@ -36,7 +36,6 @@ inverse dynamics to round-off (``tests/test_mjcf.py``: ``mj_inverse`` against
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from pathlib import Path
@@ -48,7 +47,7 @@ from numpy.typing import ArrayLike
 from .collision import collision_pairs
 from .errors import ModelError
 from .io.files import atomic_write_text
-from .io.urdf_export import BASE_LINK, TOOL_LINK
+from .io.urdf_export import BASE_LINK, TOOL_LINK, refuse_unread_meshes
 from .model import ArmModel, Body, FloatArray
 from .shapes import Box, Capsule, Convex, Shape, Sphere
 
@@ -189,6 +188,7 @@ def mjcf_text(
     if base not in (None, "fixed", "floating"):
         raise ModelError(f"base must be 'fixed' or 'floating'; got {base!r}")
     floating = model.floating if base is None else base == "floating"
+    refuse_unread_meshes(model, "MJCF")
     if floating and not model.root_body.mass > 0:
         raise ModelError(
             f"{model.name!r} is free-floating but its spacecraft has no mass: MuJoCo cannot float a massless body "
@@ -276,9 +276,8 @@ def mjcf_text(
 
 
 def _mounted_body_pairs(model: ArmModel, body_of_link: dict[int, str]) -> list[tuple[str, str]]:
-    """The body pairs holding a pair that jointlock measures from its zero-pose contact (among
-    the shapes read: a mesh that could not be read is not in the file either)."""
-    pairs = collision_pairs(dataclasses.replace(model, unread_meshes=()) if model.unread_meshes else model)
+    """The body pairs holding a pair that jointlock measures from its zero-pose contact."""
+    pairs = collision_pairs(model)
     out: list[tuple[str, str]] = []
     for (link_a, _, link_b, _), offset in zip(pairs.keys, pairs.offsets):
         a, b = body_of_link.get(link_a), body_of_link.get(link_b)

@@ -440,7 +440,10 @@ def load_robot(name_or_path: str | Path, *, base: BaseMode = "fixed", chain: Urd
             return _read_model_file.__wrapped__(text, base, None, chain)
         if refers:  # a model file naming a URDF: the URDF may change on its own; read both afresh
             return _read_model_file.__wrapped__(text, base, None, chain)
-        return _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size), chain)
+        model = _read_model_file(text, base, (str(Path(text).resolve()), stat.st_mtime_ns, stat.st_size), chain)
+        if model.unread_meshes:  # read afresh next time: the mesh extra installed, a file added since
+            _read_model_file.cache_clear()
+        return model
     close = difflib.get_close_matches(text, list(factories), n=1)
     hint = f" (did you mean {close[0]!r}?)" if close else ""
     raise ModelError(

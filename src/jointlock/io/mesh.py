@@ -30,7 +30,10 @@ from ..errors import ModelError
 #: description says how many were left out).
 MESH_MODES = ("convex", "skip")
 
-_SKIP_HINT = "or read the URDF with meshes='skip' (--meshes skip) to leave meshes out"
+def _named(path: str | Path) -> str:
+    """A mesh file in a message: its name whole, its folder shortened."""
+    path = Path(path)
+    return f"{path.name!r} (in {shown(str(path.parent))})"
 
 
 def resolve_mesh(filename: str, urdf_dir: Path | None, package_dirs: Sequence[str | Path] = ()) -> Path:
@@ -40,7 +43,7 @@ def resolve_mesh(filename: str, urdf_dir: Path | None, package_dirs: Sequence[st
         path = Path(filename[len("file://") :])
         if path.is_file():
             return path
-        raise ModelError(f"mesh file {shown(filename)} not found; {_SKIP_HINT}")
+        raise ModelError(f"mesh file {shown(filename)} not found")
     if filename.startswith("package://"):
         package, _, rest = filename[len("package://") :].partition("/")
         roots = [Path(p) for p in package_dirs]
@@ -53,14 +56,14 @@ def resolve_mesh(filename: str, urdf_dir: Path | None, package_dirs: Sequence[st
                     return candidate
         raise ModelError(
             f"mesh file {shown(filename)} not found: package {shown(package)} is not in package_dirs, "
-            f"ROS_PACKAGE_PATH or a folder above the URDF; give its folder in package_dirs, {_SKIP_HINT}"
+            "ROS_PACKAGE_PATH or a folder above the URDF (give its folder in package_dirs)"
         )
     path = Path(filename)
     if not path.is_absolute() and urdf_dir is not None:
         path = urdf_dir / path
     if path.is_file():
         return path
-    raise ModelError(f"mesh file {shown(filename)} not found (looked for {shown(str(path))}); {_SKIP_HINT}")
+    raise ModelError(f"mesh file {shown(filename)} not found (looked for {_named(path)})")
 
 
 def hull_vertices(path: Path, scale: ArrayLike = (1.0, 1.0, 1.0)) -> np.ndarray:
@@ -76,21 +79,21 @@ def _hull(path: str, stamp: tuple[int, int], scale: tuple[float, ...]) -> np.nda
     try:
         import trimesh
     except ImportError:
-        raise ModelError(f"reading the mesh {shown(path)} needs trimesh: pip install 'jointlock[mesh]', {_SKIP_HINT}") from None
+        raise ModelError(f"reading the mesh {_named(path)} needs trimesh: pip install 'jointlock[mesh]'") from None
     try:
         mesh = trimesh.load(path, force="mesh", process=False)
         vertices = np.asarray(getattr(mesh, "vertices", ()), dtype=float)
     except Exception as exc:  # trimesh raises many kinds (format, parser, missing plugin)
-        raise ModelError(f"mesh {shown(path)} could not be read ({type(exc).__name__}: {str(exc)[:120]}); {_SKIP_HINT}") from None
+        raise ModelError(f"mesh {_named(path)} could not be read ({type(exc).__name__}: {str(exc)[:120]})") from None
     if vertices.ndim != 2 or vertices.shape[0] < 4 or not np.all(np.isfinite(vertices)):
-        raise ModelError(f"mesh {shown(path)} has no solid to read (fewer than 4 finite vertices); {_SKIP_HINT}")
+        raise ModelError(f"mesh {_named(path)} has no solid to read (fewer than 4 finite vertices)")
     vertices = vertices * np.asarray(scale)
     from scipy.spatial import ConvexHull, QhullError
 
     try:
         hull = ConvexHull(vertices)
     except QhullError:
-        raise ModelError(f"mesh {shown(path)} is flat (no volume): it has no convex hull to collide with; {_SKIP_HINT}") from None
+        raise ModelError(f"mesh {_named(path)} is flat (no volume): it has no convex hull to collide with") from None
     out = vertices[np.sort(hull.vertices)]
     out.setflags(write=False)
     return out

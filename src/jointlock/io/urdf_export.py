@@ -110,8 +110,20 @@ def _collisions(body: Body) -> str:
     return "".join(out)
 
 
+def refuse_unread_meshes(model: ArmModel, what: str) -> None:
+    """Refuse, in one line, to export a model whose URDF meshes could not be read: the file
+    would lack them, and a model read back from it would look complete."""
+    if model.unread_meshes:
+        raise ModelError(
+            f"{what} export of {model.name!r}: {len(model.unread_meshes)} <collision> mesh(es) could not be read "
+            f"({model.unread_meshes[0]}), and the file would silently lack them; read them (the mesh extra, "
+            "package_dirs) or leave them out on purpose (--meshes skip)"
+        )
+
+
 def urdf_text(model: ArmModel) -> str:
     """The URDF document of ``model`` (see the module docstring)."""
+    refuse_unread_meshes(model, "URDF")
     locked = ", ".join(f"joint {lj.number} at {math.degrees(lj.angle):.12g} deg" for lj in model.locked)
     lines = [
         '<?xml version="1.0" encoding="utf-8"?>',

@@ -12,7 +12,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from .._cache import cached_on
-from ..collision import clearance, collision_pairs
+from ..collision import clearance, reports_clearance, unread_meshes_line
 from ..ik import IKResult, solve_ik, zyx_angles
 from ..io.files import atomic_write_json
 from ..model import ArmModel
@@ -57,7 +57,7 @@ class InverseKinematicsReport(JobResult):
         clearance`; negative: the arm overlaps its spacecraft bus or itself), in the solver's
         order; None for a model without collision shapes."""
         solutions = self.result.solutions
-        if not solutions or not collision_pairs(self.model).names:
+        if not solutions or not reports_clearance(self.model):
             return None
 
         def compute() -> list[tuple[float, str]]:
@@ -112,7 +112,7 @@ class InverseKinematicsReport(JobResult):
     def summary(self) -> list[str]:
         """The lines ``jointlock ik`` prints."""
         res, model = self.result, self.model
-        lines = [
+        lines = unread_meshes_line(model) + [
             f"{model.name}: {res.method}{f' ({res.family} family)' if res.family else ''} IK, "
             f"locked: {locked_text(locked_deg(model))}",
             "target T_base_ee [m]:",

@@ -19,7 +19,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ..collision import Clearance, clearance, collision_pairs
+from ..collision import Clearance, clearance, reports_clearance
 from ..errors import ScenarioError
 from ..io.files import atomic_write_json, atomic_write_text, with_svg, write_figure
 from ..kinematics import ee_pose
@@ -88,7 +88,7 @@ class ReplanJobResult(JobResult):
         """Clearance of the plan's waypoints (K,) (:func:`jointlock.collision.clearance`;
         negative: the arm overlaps its spacecraft bus or itself); None without the model or its
         collision shapes."""
-        if self.model is None or not collision_pairs(self.model).names:
+        if self.model is None or not reports_clearance(self.model):
             return None
         return clearance(self.model, self.plan.q)
 

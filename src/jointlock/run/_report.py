@@ -420,7 +420,9 @@ def _figure_sections(scenario: Scenario, jobs: dict[str, Any], full: Any, locked
         )
         fig.tight_layout()  # else the x label reaches past the edge (a costlier crop)
         images.append(("base disturbance torque during the halt", save_figure(fig, figdir, "base_torque")))
-    if "singular" in jobs and isinstance(jobs["singular"]["result"].get("conditions"), dict):
+    if "singular" in jobs and isinstance(jobs["singular"]["result"].get("conditions"), dict) and (
+        "sigma_tol" in jobs["singular"]["result"]  # the verification's (a study's conditions are others)
+    ):
         r = jobs["singular"]["result"]
         fig = offscreen_figure((7, 4))
         plot_condition_checks({**r["conditions"], **r.get("refined_conditions", {})}, r["sigma_tol"], ax=fig.add_subplot())

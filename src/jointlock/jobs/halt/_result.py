@@ -15,7 +15,7 @@ from ..._cache import cached_on
 from ...analysis.actuators import ActuatorLoads, actuator_loads
 from ...analysis.attitude_control import AttitudeControlCheck, WheelCapacity, attitude_control_check
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ...collision import Clearance, ClearanceSettings, clearance, collision_pairs
+from ...collision import Clearance, ClearanceSettings, clearance, reports_clearance, unread_meshes_line
 from ...kinematics import generalized_jacobian, jacobian
 from ...model import ArmModel
 from ...papers import p000
@@ -284,7 +284,7 @@ class HaltPlan(JobResult):
         spacecraft bus or itself."""
         p = self.problem
         settings = self.clearance_settings
-        if not collision_pairs(p.model, settings.keep_out).names:
+        if not reports_clearance(p.model, settings.keep_out):
             return None
 
         def compute() -> Clearance:
@@ -427,7 +427,7 @@ class HaltPlan(JobResult):
         """The lines ``jointlock halt`` prints."""
         res, p = self.motion, self.problem
         nums = list(p.model.joint_numbers)
-        lines = self._collision_line() + self._attitude_line() + [
+        lines = unread_meshes_line(p.model) + self._collision_line() + self._attitude_line() + [
             f"{p.model.name}: healthy joints {nums}, locked: {locked_text(locked_deg(p.model))}, "
             f"base torque with {p.base} base about {MOMENT_TEXT[p.moment_about]}",
             f"halt configuration ({self.qf_source}): "

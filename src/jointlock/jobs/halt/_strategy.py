@@ -395,8 +395,8 @@ def plan_halt(
 
 def _keeps_clearance_as_constraint(motion: HaltMotion, settings: ClearanceSettings) -> bool:
     """Whether the halt's smallest clear halt time applies: the clearance required, shapes to
-    check, and a shared ``k`` (the per-joint solver keeps the clearance by falling back to a
-    shared ``k``, ``_keep_clear``)."""
+    check, and a shared ``k`` (the smallest clear halt time is a shared ``k``'s: not computed
+    for a per-joint halt, whose ``minimum_T`` is the limits' alone)."""
     return settings.required and not motion.per_joint and bool(collision_pairs(motion.problem.model, settings.keep_out).names)
 
 
@@ -422,10 +422,12 @@ def _keep_clear(
         if shared.feasible and clearance_shortfall(problem, np.asarray(float(shared.k)), margin, keep_out) <= 0:
             k, record = clear_per_joint_k(problem, motion.joint_intervals, float(shared.k), margin, keep_out)
             if np.ndim(k) == 1 and not np.all(k == k[0]):
+                # the shared solve's own notes describe the shared k, not this halt: not repeated
                 return _per_joint_motion(shared, k, record, motion), (
                     f"{head}; the halt is the best per-joint k found among the halts that keep it (Powell from the "
-                    "best shared k that keeps it, on the limits the vector solver keeps)",
-                ) + notes
+                    f"best shared k that keeps it, {float(shared.k) * 180.0 / math.pi:.6g} deg/s^6, on the limits the "
+                    "vector solver keeps)",
+                )
             return shared, (
                 f"{head}; the halt is the best shared k that keeps the clearance (solver 'scan', on the limits the "
                 "vector solver keeps): no per-joint k that keeps it does better",

@@ -12,7 +12,7 @@ from typing import Any, ClassVar, Literal
 import numpy as np
 
 from ...analysis.spacecraft import SpacecraftResponse, spacecraft_response
-from ...collision import clearance, collision_pairs
+from ...collision import clearance, reports_clearance, unread_meshes_line
 from ...errors import JointlockError
 from ...io.files import atomic_write_json, atomic_write_text, csv_text, write_figure
 from ...model import ArmModel
@@ -118,7 +118,7 @@ class JumpJobResult(JobResult):
         """The lines ``jointlock jump`` prints (jumps in deg/s)."""
         lines = summary_lines(self.to_dict(), kappa_given=self.kappa_given)
         clear = clearance_lines(self.clearance())
-        lines = [line for line in clear if line.startswith("COLLIDES")] + lines
+        lines = unread_meshes_line(self.model) + [line for line in clear if line.startswith("COLLIDES")] + lines
         lines += [line for line in clear if not line.startswith("COLLIDES")]
         responses = self.spacecraft_responses()
         if responses is not None:
@@ -151,7 +151,7 @@ class JumpJobResult(JobResult):
         joints move linearly between them).  ``collides``: a pair overlaps that did not at the
         start, or one overlapping at the start goes deeper.  None for a model without shapes,
         or when a run diverges (a kappa far too large)."""
-        if not collision_pairs(self.model).names:
+        if not reports_clearance(self.model):
             return None
         if "clearance" not in self._cache:
             try:

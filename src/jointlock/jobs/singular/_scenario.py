@@ -7,6 +7,7 @@ from collections.abc import Mapping
 from typing import Any
 
 from ...collision import ClearanceSettings
+from ...errors import ScenarioError
 from ...robots import UrdfChain
 from .._common import JobResult, joint_vector_deg, scenario_clearance, scenario_locks
 from ._search import SingularitySearchResult, search_singularities
@@ -44,6 +45,9 @@ def singular_from_scenario(
     not used.
     """
     t = data["singular"]
+    if t.get("skip_colliding") is not None and not t["search"]:
+        raise ScenarioError("singular.skip_colliding: with singular.search = true only (it screens the singular "
+                            "configurations the search finds)")  # fmt: skip
     locks = scenario_locks(data)
     verify = bool(t["verify_conditions"])
     base: Any = t["base"] or ("virtual" if verify else "fixed")  # checked by the scenario reader

@@ -22,7 +22,7 @@ from ...analysis.ability import (
     configuration_indices,
     fit_ability_model,
 )
-from ...collision import check_clearance_m, clearance, collision_pairs
+from ...collision import check_clearance_m, clearance, collision_pairs, reports_clearance
 from ...compiled import use_compiled
 from ...errors import ConfigurationError, InfeasibleError
 from ...forward import COMPILED_MIN_BATCH
@@ -177,7 +177,10 @@ def optimal_halt_configuration(
             f"[{', '.join(f'{v:.4g}' for v in np.degrees(hi))}] deg (a thin set): increase samples or T"
         )
     n_reachable = None if reachable is None else int(np.count_nonzero(reachable))
-    checked = bool(collision_pairs(model_locked, keep_out).names)
+    # required: refused for a model whose meshes were not read; reported only: None then
+    checked = bool(collision_pairs(model_locked, keep_out).names) if clearance_min_m is not None else reports_clearance(
+        model_locked, keep_out
+    )
     clear = None
     if clearance_min_m is not None and checked:
         sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin, witness=False)
