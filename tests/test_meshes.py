@@ -296,9 +296,8 @@ def test_unread_meshes_are_said_where_the_clearance_is_reported_and_refused_wher
     load_robot reads the meshes (no stale model from its cache)."""
     from robot_data import robot_file
 
-    from jointlock.io import mesh
-
     from jointlock import robots
+    from jointlock.io import mesh
 
     path = str(robot_file(UR5))
     mesh._hull.cache_clear()
