@@ -19,9 +19,7 @@ from typing import Any
 import numpy as np
 
 from .errors import ModelError
-from .shapes import Box, Capsule, Convex, Shape, Sphere
-
-FloatArray = np.ndarray
+from .shapes import Box, Capsule, Convex, FloatArray, Shape, Sphere
 
 #: GJK's and EPA's stopping tolerance [m].
 HULL_TOLERANCE = 1e-12

@@ -80,18 +80,13 @@ def pair_reach(model: ArmModel, pairs: CollisionPairs | None = None) -> FloatArr
     box_extent = [
         float(np.linalg.norm(pose[:3, 3]) + np.linalg.norm(half)) for pose, half in zip(pairs.box_poses, pairs.box_halves)
     ]
-    # kind-2 pairs index every shape: capsules, boxes, then convex hulls
+    # in the order of pairs.shapes: capsules, boxes, then convex hulls (a kind-2 pair's indices;
+    # a capsule-box pair's box is its index after the capsules)
     extents = cap_extent + box_extent + [s.extent for s in pairs.shapes if isinstance(s, Convex)]
     reach = np.zeros((len(pairs.pairs), model.dof))
     for p, (kind, first, second) in enumerate(pairs.pairs):
-        if kind == 2:
-            ends = [(int(pairs.shape_body[g]), extents[g]) for g in (first, second)]
-        else:
-            ends = [(int(pairs.capsule_body[first]), cap_extent[first])]
-            if kind == 0:
-                ends.append((int(pairs.capsule_body[second]), cap_extent[second]))
-            else:
-                ends.append((int(pairs.box_body[second]), box_extent[second]))
+        shapes = (first, second + len(cap_extent) if kind == 1 else second)
+        ends = [(int(pairs.shape_body[g]), extents[g]) for g in shapes]
         (low, _), (body, extent) = sorted(ends)
         for i in range(low + 1, body + 1):
             # joint i turns the outer shape about an axis through o_i, at most this far from it

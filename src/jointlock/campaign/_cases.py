@@ -185,29 +185,27 @@ def case_key(scenario: Scenario, campaign_seed: int) -> str:
     return hashlib.sha256(payload.encode()).hexdigest()[:24]
 
 
-_DIGESTS: dict[tuple[str, int, int], str] = {}
+#: What a key needs of a file, read once per file version (path, mtime, size): its SHA-256, and
+#: whether it has a ``<mesh>`` inside a ``<collision>`` (a URDF's).
+_FILES: dict[tuple[str, int, int], tuple[str, bool]] = {}
+
+
+def _file_facts(path: str) -> tuple[str, bool]:
+    stat = Path(path).stat()
+    stamp = (path, stat.st_mtime_ns, stat.st_size)
+    if stamp not in _FILES:
+        text = Path(path).read_bytes()
+        meshes = re.search(rb"<collision\b(?:(?!</collision>).)*?<mesh\b", text, re.S) is not None
+        _FILES[stamp] = (hashlib.sha256(text).hexdigest(), meshes)
+    return _FILES[stamp]
 
 
 def _file_digest(path: str) -> str:
-    stat = Path(path).stat()
-    stamp = (path, stat.st_mtime_ns, stat.st_size)
-    if stamp not in _DIGESTS:
-        _DIGESTS[stamp] = hashlib.sha256(Path(path).read_bytes()).hexdigest()
-    return _DIGESTS[stamp]
-
-
-_MESHES: dict[tuple[str, int, int], bool] = {}
+    return _file_facts(path)[0]
 
 
 def _has_collision_meshes(path: str) -> bool:
-    """Whether the URDF at ``path`` has a ``<mesh>`` inside a ``<collision>`` (read once per
-    file version)."""
-    stat = Path(path).stat()
-    stamp = (path, stat.st_mtime_ns, stat.st_size)
-    if stamp not in _MESHES:
-        text = Path(path).read_bytes()
-        _MESHES[stamp] = re.search(rb"<collision\b(?:(?!</collision>).)*?<mesh\b", text, re.S) is not None
-    return _MESHES[stamp]
+    return _file_facts(path)[1]
 
 
 def case_seed(key: str) -> int:

@@ -29,6 +29,7 @@ from ...sweep import SweptClearance, swept_clearance
 from ._actuator_limits import torque_violations
 from ._constants import CHUNK_SAMPLES
 from ._feasibility import shared_k_interval
+from ._powell import powell_per_joint
 from ._problem import HaltProblem
 
 #: Relative width of the refined boundaries of the clear set of ``k`` [-].
@@ -248,11 +249,6 @@ def minimum_clear_halt_time(
     return None
 
 
-#: Powell's stopping tolerances of :func:`clear_per_joint_k` (as the vector solver's).
-PER_JOINT_XTOL = 1e-6
-PER_JOINT_FTOL = 1e-10
-
-
 def clear_per_joint_k(
     problem: HaltProblem, intervals: FloatArray, k_start: float, margin: float, keep_out: Sequence[Shape] = ()
 ) -> tuple[FloatArray, dict[str, object]]:
@@ -263,8 +259,6 @@ def clear_per_joint_k(
     is the start's objective times ten plus its shortfall, so Powell's line searches turn back
     at the clear set's edge.  Returns the best clear (n,) ``k`` found (the start as (n,) when
     Powell finds none better) and scipy's record."""
-    from scipy.optimize import minimize  # on first use (slow to import)
-
     from ._objective import halt_objective
 
     start = np.clip(np.full(problem.dof, float(k_start)), intervals[:, 0], intervals[:, 1])
@@ -272,20 +266,13 @@ def clear_per_joint_k(
     floor_value = float(halt_objective(problem, start, per_joint=True))
     barrier = 10.0 * abs(floor_value) + 1.0
 
-    def value(x: FloatArray) -> float:
-        k = np.clip(x * scale, intervals[:, 0], intervals[:, 1])
+    def value(k: FloatArray) -> float:
+        k = np.clip(k, intervals[:, 0], intervals[:, 1])
         short = float(clearance_shortfall(problem, k, margin, keep_out, per_joint=True))
         if short > 0.0:
             return barrier + short
         return float(halt_objective(problem, k, per_joint=True))
 
-    res = minimize(
-        value,
-        start / scale,
-        method="Powell",
-        bounds=[(a / scale, b / scale) for a, b in intervals],
-        options={"xtol": PER_JOINT_XTOL, "ftol": PER_JOINT_FTOL},
-    )
-    k = np.clip(res.x * scale, intervals[:, 0], intervals[:, 1])
-    best = k if value(k / scale) < floor_value else start
-    return best, {"method": "Powell", "nfev": int(res.nfev), "message": str(res.message), "clearance": True}
+    k, record = powell_per_joint(value, start, intervals, scale)
+    best = k if value(k) < floor_value else start
+    return best, {**record, "clearance": True}

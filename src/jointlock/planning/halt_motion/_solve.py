@@ -30,6 +30,7 @@ from ._feasibility import (
     minimum_halt_time,
 )
 from ._objective import global_base_torque, halt_objective
+from ._powell import powell_per_joint
 from ._problem import HaltProblem
 from ._report import infeasibility_message
 from ._robust import prefer_margin as _prefer_margin
@@ -274,25 +275,16 @@ def _solve_vector(
     """One ``k`` per joint: Powell within each joint's interval ``per`` (n, 2), started from
     the shared optimum ``k``; the shared ``k`` (as (n,)) is kept when Powell does not beat it.
     Returns the (n,) ``k`` [rad/s^6] and scipy's record."""
-    bounds = [(float(a), float(b)) for a, b in per]
     x0 = np.clip(np.full(problem.dof, k), per[:, 0], per[:, 1])
-    scale = max(hi - lo, 1e-12)
-    from scipy.optimize import minimize  # on first use (slow to import)
-
-    res = minimize(
-        lambda x: float(halt_objective(problem, x * scale, per_joint=True)),
-        x0 / scale,
-        method="Powell",
-        bounds=[(a / scale, b / scale) for a, b in bounds],
-        options={"xtol": 1e-6, "ftol": 1e-10},
+    kv, record = powell_per_joint(
+        lambda kk: float(halt_objective(problem, kk, per_joint=True)), x0, per, max(hi - lo, 1e-12)
     )
-    kv = np.clip(res.x * scale, per[:, 0], per[:, 1])
     best = (
         kv
         if halt_objective(problem, kv, per_joint=True) <= halt_objective(problem, k)
         else np.full(problem.dof, k)
     )
-    return best, {"method": "Powell", "nfev": int(res.nfev), "message": str(res.message)}
+    return best, record
 
 
 def optimal_halt_motion(
