@@ -169,7 +169,7 @@ def _spy_jump_kernels(monkeypatch) -> list[str]:
     from jointlock import _kernels
 
     calls: list[str] = []
-    for name in ("fixed_frame", "rate_law"):
+    for name in ("fixed_frame", "rate_law", "integrate_steps"):
         real = getattr(_kernels, name)
         monkeypatch.setattr(_kernels, name, lambda *a, _real=real, _name=name: (calls.append(_name), _real(*a))[1])
     return calls
@@ -224,7 +224,99 @@ def test_a_jump_in_either_mode_gives_the_same_numbers(monkeypatch):
     calls = _spy_jump_kernels(monkeypatch)
     with jl.compiled_kernels("always"):
         compiled = jump_at_time(arm, task, 1.0)
-    assert {"fixed_frame", "rate_law"} <= set(calls)
+    assert "integrate_steps" in calls  # the whole loop compiled (its frame and law inside it)
     assert reference.jump_after < 0.5 * reference.jump_before  # the compensation works here
     for name in ("kappa", "jump_before", "jump_after", "interval", "joint_jump_after"):
         assert np.allclose(getattr(compiled, name), getattr(reference, name), rtol=1e-9, atol=1e-15), name
+
+
+def _run_out_fields(out) -> dict[str, np.ndarray]:
+    from dataclasses import fields
+
+    return {f.name: getattr(out, f.name) for f in fields(out) if getattr(out, f.name) is not None}
+
+
+def _both_loops(monkeypatch, run) -> tuple[dict, dict, list[str]]:
+    """``run()`` (-> a _RunOut) in the compiled mode "always" by the compiled loop and by the
+    reference loop (the same frame and law kernels, a Python step each); the kernels the
+    compiled loop's run called."""
+    from jointlock.planning.jump import _engine
+
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    calls = _spy_jump_kernels(monkeypatch)
+    with jl.compiled_kernels("always"):
+        compiled = _run_out_fields(run())
+        compiled_calls = list(calls)
+        with monkeypatch.context() as m:
+            m.setattr(_engine, "_compiled_steps", lambda *a: None)
+            reference = _run_out_fields(run())
+    assert len(calls) > len(compiled_calls)  # the reference loop took its steps by the kernels
+    return compiled, reference, compiled_calls
+
+
+def test_the_compiled_loop_equals_the_python_loop(monkeypatch, prob):
+    """issue 29: the integrator's whole loop compiled (jointlock._kernels.integrate_steps) gives
+    what its Python loop gives with the same kernels: runs branching off healthy runs
+    (parents, the jump column, records), the probe's null-space norm, a stop before the end."""
+    krows = np.repeat(np.array([[0.0], [4e-3], [-1e-3]]), prob.N, axis=1)
+    kidx, fsteps = np.array([1, 0, 2, 1, 2, 0]), np.array([25, 3, 0, 38, 12, 25])
+    for run in (
+        lambda: _branched_runs(prob, krows, kidx, fsteps)[0],
+        lambda: _branched_runs(prob, krows, kidx, fsteps)[1],
+        lambda: _integrate(prob, krows[:1], prob.q0[None], None, np.zeros(1, dtype=int), np.full((1, 1), prob.N + 1),
+                           [prob.lock_col], null_norm=True),  # fmt: skip
+        lambda: _healthy_runs(prob, krows, k_stop=17),
+    ):
+        compiled, reference, calls = _both_loops(monkeypatch, run)
+        assert calls.count("integrate_steps") >= 1 and "rate_law" not in calls  # the loop, not a step
+        assert compiled.keys() == reference.keys()
+        for name, ref in reference.items():
+            assert _close(compiled[name], ref), name
+
+
+def test_the_compiled_loop_leaves_singular_and_diverging_steps_to_the_reference(monkeypatch):
+    """A step the compiled loop cannot take -- a Gram matrix of rank 2 (three of arm5's five
+    joints locked in sequence: numpy's SVD) or a run whose rates diverge (zeroed, and refused
+    when every run does) -- is taken by the Python step, and the loop goes on compiled."""
+    arm = jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")
+    task = JumpScenario(q0=(0.3, -0.6, 0.9, -0.4, 0.5), duration=2.0, blend=0.5, dx=(0.05, -0.04, 0.03))
+
+    def three_locks():
+        p = _problem(arm, task)
+        steps = np.array([[5, 9, 14]])
+        return _integrate(p, np.zeros((1, p.N)), p.q0[None], None, np.zeros(1, dtype=int), steps, [0, 2, 4],
+                          record=1)  # fmt: skip
+
+    with pytest.warns(jl.SingularityWarning, match="1 of 1 runs passed within"):  # two joints left
+        compiled, reference, calls = _both_loops(monkeypatch, three_locks)
+    assert "integrate_steps" in calls and "rate_law" in calls  # steps by both
+    for name, ref in reference.items():
+        assert _close(compiled[name], ref), name
+    assert np.all(compiled["qd"][0, 14:, [0, 2, 4]] == 0.0)
+
+    canadarm = _problem(jl.load_robot("canadarm7"), TASK)
+    wild = np.repeat(np.array([[0.0], [1e9]]), canadarm.N, axis=1)  # the second run diverges
+
+    def diverging():
+        return _healthy_runs(canadarm, wild)
+
+    compiled, reference, calls = _both_loops(monkeypatch, diverging)
+    assert "rate_law" in calls
+    for name, ref in reference.items():
+        assert _close(compiled[name], ref), name
+    with jl.compiled_kernels("always"), pytest.raises(jl.InfeasibleError, match="kappa is far too large"):
+        _healthy_runs(canadarm, wild[1:])
+
+
+def test_the_compiled_loop_moves_a_progress_bar_once_per_step(monkeypatch, prob):
+    class Count:
+        done = 0
+
+        def update(self) -> None:
+            self.done += 1
+
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    bar = Count()
+    with jl.compiled_kernels("always"):
+        _healthy_runs(prob, np.zeros((2, prob.N)), progress=bar)
+    assert bar.done == prob.N

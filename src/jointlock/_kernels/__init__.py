@@ -59,7 +59,7 @@ from ._arm import (
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
 from ._dynamics import rnea_fixed, rnea_floating
-from ._jump import fixed_frame, rate_law
+from ._jump import fixed_frame, integrate_steps, rate_law
 from ._svd import singular_values
 
 __all__ = [
@@ -71,6 +71,7 @@ __all__ = [
     "fixed_singular_values",
     "generalized_jacobian",
     "generalized_singular_values",
+    "integrate_steps",
     "jacobian",
     "rate_law",
     "rnea_fixed",

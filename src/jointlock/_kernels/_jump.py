@@ -1,15 +1,20 @@
-"""One control step of 001's resolved-rate integrator, fixed base, compiled: the chain's tool
-point, joint axes and position Jacobian (:func:`fixed_frame`, the numbers of
-:meth:`jointlock.planning.jump._frames._FixedChain.frame`) and the compensated rate law with
-its closed-form gradient (:func:`rate_law`, the numbers of
+"""001's resolved-rate integrator, fixed base, compiled: the chain's tool point, joint axes
+and position Jacobian (:func:`fixed_frame`, the numbers of
+:meth:`jointlock.planning.jump._frames._FixedChain.frame`), the compensated rate law with its
+closed-form gradient (:func:`rate_law`, the numbers of
 :func:`jointlock.planning.jump._control.law` with ``axes``), for B runs, batch last as the
-numpy reference keeps them.
+numpy reference keeps them, and the integrator's whole loop over the control steps around
+them (:func:`integrate_steps`, the numbers of ``_engine._integrate``'s Python step).
 
-The integrator calls them once per control step (about 1,400 steps per jump case) on a few
-to a few hundred runs, where the numpy reference costs its ~120 calls' overhead per step.  The
-same formulas, run by run, in the same order where it is cheap to keep (the running sums of
-the gradient add joint by joint as ``np.cumsum`` does); products and sums inside a step
-associate differently, so the results agree with numpy's to round-off (``tests/test_jump.py``).
+A jump case takes about 1,400 control steps on a few to a few hundred runs; a Python step
+costs ~90 us of calls (its bookkeeping, the two kernels, the records) against ~10 us of
+arithmetic, so in a campaign's worker (compiled mode ``"always"``) the loop itself runs
+compiled, and a Python step is taken only where the loop leaves one (a singular Gram matrix,
+a diverging run).  The same formulas, run by run, in the same order where it is cheap to keep
+(the running sums of the gradient add joint by joint as ``np.cumsum`` does); products and sums
+inside a step associate differently, so the results agree with numpy's to round-off
+(``tests/test_jump.py``; the compiled loop and the Python loop over the same kernels agree to
+the bit on canadarm7, ``tests/test_jump_batched.py``).
 
 A run whose Gram matrix ``J_h J_h^T`` is (nearly) singular gets ``singular[b] = True`` and no
 rates: the caller computes those by the reference (an SVD), as the reference itself does.
@@ -140,3 +145,139 @@ def rate_law(jac, axes, healthy, xdot, kappa, rtol, qdot, w, null, singular):
             nul = grad[i] - (m[0, i] * t0 + m[1, i] * t1 + m[2, i] * t2)
             null[i, b] = nul
             qdot[i, b] = (m[0, i] * xdot[0, b] + m[1, i] * xdot[1, b] + m[2, i] * xdot[2, b]) + kappa[b] * nul
+
+
+@_jit
+def _nan_max(a, b):
+    """``np.maximum(a, b)`` on scalars: NaN when either is."""
+    if a != a or b != b:
+        return a + b
+    return a if a >= b else b
+
+
+@_jit
+def _nan_min(a, b):
+    """``np.minimum(a, b)`` on scalars: NaN when either is."""
+    if a != a or b != b:
+        return a + b
+    return a if a <= b else b
+
+
+@_jit
+def integrate_steps(
+    k_begin, k_end, link_h, tool, x_nom, xd_nom, kp, dt, kappa, first_run, parent, locks_at, fail_steps,
+    rest_transitions, jump_col, null_norm, diverged_rate, rtol,
+    q, qd_prev, max_vel, max_acc, max_dev, min_w, max_null,
+    rec_q, rec_qd, rec_dev, rec_x, rec_qd_plus, rec_task_plus, rec_task_noreplan,
+):  # fmt: skip
+    """Control steps ``k_begin .. k_end - 1`` of the fixed-base integrator
+    (:func:`jointlock.planning.jump._engine._integrate`'s loop body, the same numbers to
+    round-off): for the runs started by step ``k``, :func:`fixed_frame`, the tracking error and
+    commanded rate, :func:`rate_law` (with the first ``R`` runs again with column ``jump_col``
+    locked as well, when ``jump_col >= 0``), the running maxima, the records of the first ``R``
+    runs (``R = rec_q.shape[0]``) and the explicit-Euler step of ``q`` (B, n).
+
+    Returns the first step not taken: ``k_end``, or the step at which a run's Gram matrix is
+    (nearly) singular or a run's rate passes ``diverged_rate`` [rad/s] -- nothing of that step
+    is written, and the caller takes it by the reference (an SVD; zeroing or refusing the
+    diverged runs) before calling again from the next step.
+
+    ``first_run`` (N + 1,): the number of runs started before each step; ``parent`` (B,): the
+    run whose angles a run takes at its first step (-1: none); ``locks_at`` (B, n): the step
+    from which each joint is locked; ``fail_steps`` (B, L): the failure steps (a step at which
+    a joint locks is not an acceleration sample).  Histories: ``rec_q`` (R, N + 1, n),
+    ``rec_qd`` (R, N, n), ``rec_dev`` (R, N + 1), ``rec_x`` (R, N + 1, 3); with ``jump_col``:
+    ``rec_qd_plus`` (R, N, n), ``rec_task_plus`` and ``rec_task_noreplan`` (R, N, 3).
+    """
+    n = q.shape[1]
+    R = rec_q.shape[0]
+    n_fail = fail_steps.shape[1]
+    for k in range(k_begin, k_end):
+        m = first_run[k + 1]  # the runs started by now
+        new = first_run[k]  # runs new .. m - 1 start at this step
+        extra = R if jump_col >= 0 else 0
+        cols = m + extra
+        qs = np.empty((m, n))
+        for b in range(m):
+            src = parent[b] if b >= new and parent[b] >= 0 else b
+            for i in range(n):
+                qs[b, i] = q[src, i]
+        x = np.empty((3, m))
+        jac = np.empty((3, n, cols))
+        axes = np.empty((3, n, cols))
+        fixed_frame(qs, link_h, tool, x, jac, axes)
+        healthy = np.empty((n, cols), dtype=np.bool_)
+        xdot = np.empty((3, cols))
+        kap = np.empty(cols)
+        err = np.empty((3, m))
+        for b in range(m):
+            for i in range(n):
+                healthy[i, b] = locks_at[b, i] > k
+            for r in range(3):
+                err[r, b] = x_nom[k, r] - x[r, b]
+                xdot[r, b] = xd_nom[k, r] + kp * err[r, b]
+            kap[b] = kappa[b, k]
+        for j in range(extra):  # the first R runs again, column jump_col locked as well
+            for i in range(n):
+                healthy[i, m + j] = healthy[i, j] and i != jump_col
+                for r in range(3):
+                    jac[r, i, m + j] = jac[r, i, j]
+                    axes[r, i, m + j] = axes[r, i, j]
+            for r in range(3):
+                xdot[r, m + j] = xdot[r, j]
+            kap[m + j] = kap[j]
+        qdot, w, null = np.empty((n, cols)), np.empty(cols), np.empty((n, cols))
+        singular = np.zeros(cols, dtype=np.bool_)
+        rate_law(jac, axes, healthy, xdot, kap, rtol, qdot, w, null, singular)
+        for b in range(cols):
+            if singular[b]:
+                return k
+        for b in range(m):
+            for i in range(n):
+                if abs(qdot[i, b]) > diverged_rate:
+                    return k
+        for b in range(m):
+            dev = math.sqrt(err[0, b] * err[0, b] + err[1, b] * err[1, b] + err[2, b] * err[2, b])
+            max_dev[b] = _nan_max(max_dev[b], dev)
+            peak = 0.0
+            acc = 0.0
+            big_null = 0.0
+            for i in range(n):
+                peak = _nan_max(peak, abs(qdot[i, b]))
+                acc = _nan_max(acc, abs(qdot[i, b] - qd_prev[b, i]))
+                big_null = _nan_max(big_null, abs(null[i, b]))
+            max_vel[b] = _nan_max(max_vel[b], peak)
+            min_w[b] = _nan_min(min_w[b], w[b])
+            if null_norm:
+                max_null[b] = _nan_max(max_null[b], big_null)
+            if b >= new:  # a run's first step: a jump, or the start from rest
+                check = rest_transitions and k == 0
+            else:
+                check = True
+                for col in range(n_fail):
+                    if fail_steps[b, col] == k:
+                        check = False
+            if check:
+                max_acc[b] = _nan_max(max_acc[b], acc / dt)
+            if b < R:
+                for i in range(n):
+                    rec_qd[b, k, i] = qdot[i, b]
+                rec_dev[b, k] = dev
+                for r in range(3):
+                    rec_x[b, k, r] = x[r, b]
+                if jump_col >= 0:
+                    for i in range(n):
+                        rec_qd_plus[b, k, i] = qdot[i, m + b]
+                    for r in range(3):
+                        acc_r = 0.0
+                        for c in range(n):
+                            acc_r += jac[r, c, b] * (qdot[c, m + b] - qdot[c, b])
+                        rec_task_plus[b, k, r] = acc_r
+                        rec_task_noreplan[b, k, r] = -(jac[r, jump_col, b] * qdot[jump_col, b])
+            for i in range(n):
+                qd_prev[b, i] = qdot[i, b]
+                q[b, i] = qs[b, i] + dt * qdot[i, b]
+            if b < R:
+                for i in range(n):
+                    rec_q[b, k + 1, i] = q[b, i]
+    return k_end

@@ -61,7 +61,11 @@ def _pinv_rows(jac_h: FloatArray, gram: FloatArray) -> tuple[FloatArray, FloatAr
     if singular.any():
         # pinv(J^T) = (J^+)^T = (J J^T)^-1 J wherever the latter exists (rank 3)
         jt = np.moveaxis(jac_h[..., singular], -1, 0).swapaxes(-1, -2)  # (S, n, 3)
-        m[..., singular] = np.moveaxis(np.linalg.pinv(jt), 0, -1)
+        # a locked (zero) column of J has a zero column here: exactly, as the adjugate gives
+        # it (the SVD's rotations leave ~1e-17, and NOTES-001 property 3 wants the locked
+        # joint's rate exactly 0)
+        moving = np.any(jac_h[..., singular] != 0.0, axis=0)  # (n, S)
+        m[..., singular] = np.moveaxis(np.linalg.pinv(jt), 0, -1) * moving
     return m, det
 
 

@@ -16,11 +16,15 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._chain import kernel_input
+from ...compiled import use_compiled
 from ...derivatives import generalized_jacobian_derivatives
 from ...errors import InfeasibleError, ModelError, ScenarioError, SingularityWarning
+from ...forward import COMPILED_MIN_BATCH
 from ...kinematics import base_jacobian, chain_state, generalized_jacobian, system_com
 from ...model import ArmModel, FloatArray
 from ...spatial import axis_angle_rotation
+from ._control import SINGULAR_GRAM_RTOL
 from ._frames import _FixedChain, _Frame
 from ._path import cartesian_trapezoid
 from ._task import JumpScenario
@@ -176,6 +180,85 @@ def _stop_diverged(qd: np.ndarray, kappa: np.ndarray, t: float, limit: float) ->
     return diverged
 
 
+#: Control steps per compiled call while a progress bar is shown (it moves between calls).
+_STEPS_PER_UPDATE = 25
+
+
+def _compiled_steps(
+    prob: _Problem,
+    kappa: FloatArray,
+    q: FloatArray,
+    qd_prev: FloatArray,
+    out: _RunOut,
+    first_run: np.ndarray,
+    parent: np.ndarray | None,
+    locks_at: np.ndarray,
+    fail_steps: np.ndarray,
+    jump_col: int | None,
+    null_norm: bool,
+    diverged_rate: float,
+) -> Any:
+    """:func:`_integrate`'s steps by the compiled loop (:func:`jointlock._kernels.integrate_steps`)
+    on these runs' arrays, written in place: ``(k_begin, k_end) -> the first step not taken``
+    (one with a singular Gram matrix or a diverging run is left to the reference).  None where
+    the reference takes every step: a floating base (its frame and gradient are numpy's), or
+    the compiled kernels not in use for this batch (:func:`jointlock.compiled.use_compiled`; a
+    campaign's workers always use them)."""
+    B, n = q.shape
+    if prob.chain is None or not use_compiled(B, COMPILED_MIN_BATCH):
+        return None
+    from ... import _kernels  # numba on first use
+
+    sc, chain = prob.scenario, prob.chain
+    R = 0 if out.q is None else out.q.shape[0]
+
+    def history(a: FloatArray | None, width: int) -> FloatArray:  # unrecorded: an empty stand-in
+        return np.zeros((0, 1, width)) if a is None else a
+
+    def ints(a: np.ndarray) -> np.ndarray:
+        return np.ascontiguousarray(a, dtype=np.int64)
+
+    fixed = (
+        chain.link_h,
+        chain.tool,
+        kernel_input(prob.x_nom),
+        kernel_input(prob.xd_nom),
+        float(sc.kp),
+        float(sc.dt),
+        kernel_input(kappa),
+        ints(first_run),
+        np.full(B, -1, dtype=np.int64) if parent is None else ints(parent),
+        ints(locks_at),
+        ints(fail_steps),
+        bool(sc.rest_transitions),
+        -1 if jump_col is None or not R else int(jump_col),
+        bool(null_norm),
+        float(diverged_rate),
+        SINGULAR_GRAM_RTOL,
+    )
+    state = (
+        q,
+        qd_prev,
+        out.max_vel,
+        out.max_acc,
+        out.max_dev,
+        out.min_w,
+        out.max_null,
+        history(out.q, n),
+        history(out.qd, n),
+        np.zeros((0, 1)) if out.dev is None else out.dev,
+        history(out.x, 3),
+        history(out.qd_plus, n),
+        history(out.task_plus, 3),
+        history(out.task_noreplan, 3),
+    )
+
+    def steps(k_begin: int, k_end: int) -> int:
+        return int(_kernels.integrate_steps(k_begin, k_end, *fixed, *state))
+
+    return steps
+
+
 # Long on purpose: one explicit-Euler loop over all batched runs, whose per-step state is shared.
 def _integrate(
     prob: _Problem,
@@ -258,7 +341,11 @@ def _integrate(
     if R and np.any(k_start[:R] != k0):
         raise ValueError("_integrate: the recorded runs must all start at the first step")
     first_run = np.searchsorted(k_start, np.arange(k_stop + 1), side="left")  # first run started at k
-    for k in range(k0, k_stop):
+    compiled = _compiled_steps(prob, kappa, q, qd_prev, out, first_run, parent, locks_at, fail_steps, jump_col,
+                               null_norm, diverged_rate)  # fmt: skip
+
+    def step(k: int) -> None:
+        """Control step ``k`` of every run started by then (the reference of the kernel)."""
         m = int(first_run[k + 1])  # the runs started by now
         sl = slice(0, m)
         new = slice(int(first_run[k]), m)  # the runs starting at this step
@@ -308,6 +395,20 @@ def _integrate(
             if rb is not None:
                 assert out.rb is not None
                 out.rb[:, k + 1] = rb[:R]
+
+    k = k0
+    while k < k_stop:
+        if compiled is not None:
+            # every step in one call; with a progress bar a few at a time, so that it moves
+            end = k_stop if progress is None else min(k + _STEPS_PER_UPDATE, k_stop)
+            k_next = compiled(k, end)
+            for _ in range(k_next - k) if progress is not None else ():
+                progress.update()
+            k = k_next
+            if k == end:
+                continue
+        step(k)  # a singular Gram matrix or a diverging run: this step by the reference
+        k += 1
         if progress is not None:
             progress.update()
     if k_stop == N and B:
