@@ -732,19 +732,45 @@ def test_a_narrow_feasible_interval_is_flagged_fragile():
 
 
 @pytest.mark.parametrize("base", ["fixed", "floating"])
+@pytest.mark.parametrize("about", ["spacecraft_com", "joint1"])
+def test_the_compiled_mean_torque_equals_numpys(base, about, rng):
+    """000 eq. 32 by one compiled call (the halts sampled in the kernel, Newton-Euler, the
+    norm's Simpson average) against the numpy route: shared and per-joint k, several chunks
+    of the kernel (4,096 samples each), either base and moment point.  A k so large that the
+    torques overflow is left to the numpy route, which says so."""
+    from jointlock.planning.halt_motion import global_base_torque
+    from jointlock.planning.halt_motion._objective import _compiled_mean_torque
+
+    p = _problem(T=12.0, base=base, n_samples=101, moment_about=about)
+    shared = np.linspace(-2e-4, 2e-4, 97)  # 9,797 samples: three chunks, one candidate across two
+    per_joint = rng.uniform(-2e-4, 2e-4, (5, p.dof))
+    for k, pj in ((shared, False), (per_joint, True)):
+        reference = global_base_torque(p, k, per_joint=pj)
+        compiled = _compiled_mean_torque(dataclasses.replace(p, compiled=True), k, p.times(), pj)
+        assert compiled is not None
+        np.testing.assert_allclose(compiled, reference, rtol=1e-13)
+        assert _compiled_mean_torque(p, k, p.times(), pj) is None  # auto mode, few samples: numpy
+    huge = np.array([1e300])
+    assert _compiled_mean_torque(dataclasses.replace(p, compiled=True), huge, p.times(), False) is None
+    with pytest.raises(jl.JointlockError, match="overflow"):
+        global_base_torque(dataclasses.replace(p, compiled=True), huge)
+
+
+@pytest.mark.parametrize("base", ["fixed", "floating"])
 def test_compiled_objective_finds_the_same_halt(base, monkeypatch):
     """HaltProblem(compiled=True): the torque objectives through the compiled Newton-Euler
-    kernels (tested call by call), the same optimum and torques as numpy to round-off."""
+    kernels (tested call by call; the mean torque's in one call with the sampling and the time
+    average, jointlock._kernels._halt), the same optimum and torques as numpy to round-off."""
     from jointlock import _kernels
 
     calls = []
-    name = "rnea_fixed" if base == "fixed" else "rnea_floating"
-    kernel = getattr(_kernels, name)
-    monkeypatch.setattr(_kernels, name, lambda *a: (calls.append(1), kernel(*a))[1])
+    for name in ("rnea_fixed" if base == "fixed" else "rnea_floating", "mean_base_moment"):
+        kernel = getattr(_kernels, name)
+        monkeypatch.setattr(_kernels, name, lambda *a, _k=kernel, _n=name: (calls.append(_n), _k(*a))[1])
     ref = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101), n_scan=41)
     assert calls == []
     ours = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101, compiled=True), n_scan=41)
-    assert calls
+    assert "mean_base_moment" in calls
     assert ours.k == pytest.approx(ref.k, rel=1e-9)
     assert ours.global_torque == pytest.approx(ref.global_torque, rel=1e-12)
     assert ours.global_torque_k0 == pytest.approx(ref.global_torque_k0, rel=1e-12)
@@ -824,6 +850,8 @@ def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
         narrow = limits.within(grid[10], grid[12])
         assert narrow.count < limits.count / 20  # most limits cannot bind there
         assert np.array_equal(narrow.relative_violation(grid[10:13]), relative_violation(p, grid[10:13]))
+        nested = limits.within(grid[0], grid[-1]).within(grid[8], grid[30]).within(grid[10], grid[12])
+        assert np.array_equal(nested.relative_violation(grid[10:13]), relative_violation(p, grid[10:13]))
         assert least_violating_k(p) == _reference_least_violating_k(p)
     assert checked >= 3
 

@@ -6,21 +6,66 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._cache import cached_on
+from ..._chain import kernel_input, kernel_link_arrays, kernel_root
 from ...analysis.spacecraft import final_attitude_change_deg
+from ...compiled import use_compiled
 from ...dynamics import rnea
 from ...errors import ScenarioError
+from ...forward import COMPILED_MIN_BATCH
 from ...model import FloatArray
 from ._constants import CHUNK_SAMPLES
 from ._problem import HaltProblem
 
 
-def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
-    """Time average over the last axis of uniformly sampled values (odd count), Simpson's rule."""
-    n = values.shape[-1]
+def _simpson_weights(n: int) -> FloatArray:
+    """(n,) Simpson's weights ``1 4 2 4 ... 2 4 1`` of ``n`` (odd) uniform samples."""
     w = np.ones(n)
     w[1:-1:2] = 4.0
     w[2:-1:2] = 2.0
-    return values @ w / (3.0 * (n - 1))
+    return w
+
+
+def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
+    """Time average over the last axis of uniformly sampled values (odd count), Simpson's rule."""
+    n = values.shape[-1]
+    return values @ _simpson_weights(n) / (3.0 * (n - 1))
+
+
+def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, per_joint: bool) -> FloatArray | None:
+    """:func:`global_base_torque` of the candidates ``k`` ((m,) shared or (m, n)) by one compiled
+    call (:func:`jointlock._kernels.mean_base_moment`: the halts sampled, Newton-Euler and the
+    norm's time average, no array of samples), where :func:`~jointlock.dynamics.rnea` would run
+    the compiled kernels for these samples (``problem.compiled``, or the compiled mode); the
+    same torques to the bit, the sum over the times to round-off.  None where the numpy route
+    runs, and where a sample's torque is not finite or its system inertia singular (the
+    numpy route says which)."""
+    compiled = problem.compiled
+    if compiled is None:
+        compiled = use_compiled(k.shape[0] * t.size, COMPILED_MIN_BATCH)
+    if not compiled:
+        return None
+    from ... import _kernels  # numba on first use
+
+    model, floating = problem.model, problem.base == "floating"
+    links = cached_on(
+        model,
+        f"halt_objective_links_{problem.base}",
+        lambda: (kernel_link_arrays(model, model.root_body.com if floating else np.zeros(3)),
+                 kernel_root(model) if floating else np.zeros(13)),
+    )  # fmt: skip
+    point = model.root_body.com if problem.moment_point is None else problem.moment_point
+    kk = np.ascontiguousarray(k if per_joint else np.broadcast_to(k[:, None], (k.shape[0], problem.dof)), dtype=float)
+    base, shape = problem.base_profile(t), problem.k_shape(t)
+    out = np.empty(k.shape[0])
+    with np.errstate(over="ignore", invalid="ignore"):
+        bad = _kernels.mean_base_moment(
+            *(kernel_input(x) for x in (*base, *shape)), kk, _simpson_weights(t.size), floating, *links[0],
+            links[1], np.zeros(3), np.array(point, dtype=float), out,
+        )  # fmt: skip
+    if bad or not np.all(np.isfinite(out)):
+        return None
+    return out / (3.0 * (t.size - 1))
 
 
 def base_torque_history(
@@ -65,8 +110,12 @@ def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = 
     step = max(1, CHUNK_SAMPLES // t.size)
     out = np.empty(flat.shape[0])
     for start in range(0, flat.shape[0], step):  # chunks of candidates, not samples
-        torque = base_torque_history(problem, flat[start : start + step], t, per_joint=per_joint)
-        out[start : start + step] = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
+        part = flat[start : start + step]
+        fast = _compiled_mean_torque(problem, part, t, per_joint)
+        if fast is None:
+            torque = base_torque_history(problem, part, t, per_joint=per_joint)
+            fast = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
+        out[start : start + step] = fast
     return out.reshape(batch)
 
 
