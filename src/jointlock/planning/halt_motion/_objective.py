@@ -58,11 +58,10 @@ def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, pe
     kk = np.ascontiguousarray(k if per_joint else np.broadcast_to(k[:, None], (k.shape[0], problem.dof)), dtype=float)
     base, shape = problem.base_profile(t), problem.k_shape(t)
     out = np.empty(k.shape[0])
+    samples = tuple(kernel_input(x) for x in (*base, *shape))
+    rest = (kk, _simpson_weights(t.size), floating, *links[0], links[1], np.zeros(3), np.array(point, dtype=float), out)
     with np.errstate(over="ignore", invalid="ignore"):
-        bad = _kernels.mean_base_moment(
-            *(kernel_input(x) for x in (*base, *shape)), kk, _simpson_weights(t.size), floating, *links[0],
-            links[1], np.zeros(3), np.array(point, dtype=float), out,
-        )  # fmt: skip
+        bad = _kernels.mean_base_moment(*samples, *rest)
     if bad or not np.all(np.isfinite(out)):
         return None
     return out / (3.0 * (t.size - 1))
