@@ -733,12 +733,13 @@ def test_a_narrow_feasible_interval_is_flagged_fragile():
 
 @pytest.mark.parametrize("base", ["fixed", "floating"])
 @pytest.mark.parametrize("about", ["spacecraft_com", "joint1"])
-def test_the_compiled_mean_torque_equals_numpys(base, about, rng):
+def test_the_compiled_mean_torque_equals_numpys(base, about, rng, monkeypatch):
     """000 eq. 32 by one compiled call (the halts sampled in the kernel, Newton-Euler, the
-    norm's Simpson average) against the numpy route: shared and per-joint k, several chunks
-    of the kernel (4,096 samples each), either base and moment point.  A k so large that the
-    torques overflow is left to the numpy route, which says so."""
-    from jointlock.planning.halt_motion import global_base_torque
+    norm; then Simpson's average) against the route through rnea(compiled=True), bit for bit,
+    and the numpy route to round-off: shared and per-joint k, several chunks of the kernel
+    (4,096 samples each), either base and moment point.  A k so large that the torques
+    overflow is left to the numpy route, which says so."""
+    from jointlock.planning.halt_motion import _objective, global_base_torque
     from jointlock.planning.halt_motion._objective import _compiled_mean_torque
 
     p = _problem(T=12.0, base=base, n_samples=101, moment_about=about)
@@ -749,6 +750,10 @@ def test_the_compiled_mean_torque_equals_numpys(base, about, rng):
         compiled = _compiled_mean_torque(dataclasses.replace(p, compiled=True), k, p.times(), pj)
         assert compiled is not None
         np.testing.assert_allclose(compiled, reference, rtol=1e-13)
+        with monkeypatch.context() as m:
+            m.setattr(_objective, "_compiled_mean_torque", lambda *a: None)
+            through_rnea = global_base_torque(dataclasses.replace(p, compiled=True), k, per_joint=pj)
+        assert np.array_equal(compiled, through_rnea)
         assert _compiled_mean_torque(p, k, p.times(), pj) is None  # auto mode, few samples: numpy
     huge = np.array([1e300])
     assert _compiled_mean_torque(dataclasses.replace(p, compiled=True), huge, p.times(), False) is None
@@ -764,13 +769,13 @@ def test_compiled_objective_finds_the_same_halt(base, monkeypatch):
     from jointlock import _kernels
 
     calls = []
-    for name in ("rnea_fixed" if base == "fixed" else "rnea_floating", "mean_base_moment"):
+    for name in ("rnea_fixed" if base == "fixed" else "rnea_floating", "base_moment_norms"):
         kernel = getattr(_kernels, name)
         monkeypatch.setattr(_kernels, name, lambda *a, _k=kernel, _n=name: (calls.append(_n), _k(*a))[1])
     ref = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101), n_scan=41)
     assert calls == []
     ours = optimal_halt_motion(_problem(T=12.0, base=base, n_samples=101, compiled=True), n_scan=41)
-    assert "mean_base_moment" in calls
+    assert "base_moment_norms" in calls
     assert ours.k == pytest.approx(ref.k, rel=1e-9)
     assert ours.global_torque == pytest.approx(ref.global_torque, rel=1e-12)
     assert ours.global_torque_k0 == pytest.approx(ref.global_torque_k0, rel=1e-12)

@@ -59,7 +59,7 @@ from ._arm import (
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
 from ._dynamics import rnea_fixed, rnea_floating
-from ._halt import mean_base_moment
+from ._halt import base_moment_norms
 from ._jump import fixed_frame, integrate_steps, rate_law
 from ._svd import singular_values
 
@@ -67,6 +67,7 @@ __all__ = [
     "BLOCK",
     "MAX_SWEEPS",
     "TRIG_LIMIT",
+    "base_moment_norms",
     "ee_positions",
     "fixed_frame",
     "fixed_singular_values",
@@ -74,7 +75,6 @@ __all__ = [
     "generalized_singular_values",
     "integrate_steps",
     "jacobian",
-    "mean_base_moment",
     "rate_law",
     "rnea_fixed",
     "rnea_floating",

@@ -1,7 +1,7 @@
 """000's halt objective (eq. 32) for a batch of candidate ``k``, compiled: each candidate's halt
-(eq. 27) sampled, its base torque by the Newton-Euler kernels of
-:mod:`jointlock._kernels._dynamics`, and the time average of its norm, in one call
-(:func:`mean_base_moment`).
+(eq. 27) sampled and the norm of its base torque by the Newton-Euler kernels of
+:mod:`jointlock._kernels._dynamics`, in one call (:func:`base_moment_norms`); the caller
+takes the time average (Simpson's rule, the same ``values @ weights`` as the numpy route).
 
 Why next to :func:`~jointlock._kernels._dynamics.rnea_fixed`.  The objective's numpy route
 materialises every candidate's ``q, dq, ddq`` (the scan's 401 candidates x 501 samples x 7
@@ -10,8 +10,7 @@ the norm and Simpson's sum; at a campaign's batch sizes that costs as much as th
 pass itself, and a single candidate (the bounded search after the scan) pays ~0.8 ms of calls
 for 0.1 ms of arithmetic.  Here the samples are made a chunk at a time, exactly as
 :meth:`jointlock.planning.halt_motion.HaltProblem.trajectory` makes them (``base + k phi``,
-the same two operations), so every sample's torque is the kernels' to the bit; only the sum
-over the times associates differently from numpy's (round-off).
+the same two operations), so every sample's torque, and its norm, is the kernels' to the bit.
 """
 
 from __future__ import annotations
@@ -28,34 +27,31 @@ CHUNK = 4096
 
 
 @_jit
-def mean_base_moment(
-    base_q, base_dq, base_ddq, phi, dphi, ddphi, k, weights, floating,
+def base_moment_norms(
+    base_q, base_dq, base_ddq, phi, dphi, ddphi, k, floating,
     rot, pos, mass, com, inertia, root, base_acc, point, out,
 ):  # fmt: skip
-    """Weighted time sums of the base moment's norm, ``out[c] = sum_t weights[t] ||n_d(t; k_c)||``.
+    """The base moment's norm ``out[c, t] = ||n_d(t; k_c)||`` [N m] of every candidate's halt.
 
     Parameters
     ----------
     base_q, base_dq, base_ddq : (n_t, n) the ``k = 0`` part of the halt [rad, rad/s, rad/s^2].
     phi, dphi, ddphi : (n_t,) the ``k`` part ``t^3 (t - T)^3`` and its derivatives.
     k : (n_c, n) each candidate's ``k`` of every joint [rad/s^6].
-    weights : (n_t,) the quadrature's weights.
     floating : True: the free-floating kernel (``root``, the spacecraft); False: the fixed one
         (``base_acc``).
     rot, pos, mass, com, inertia, root, base_acc, point : as :func:`rnea_floating` /
         :func:`rnea_fixed` take them.
-    out : (n_c,) written.
+    out : (n_c, n_t) written.
 
     Returns
     -------
     Number of samples whose system inertia is not positive definite (free-floating; their
-    sums are meaningless), as :func:`rnea_floating`.
+    norms are meaningless), as :func:`rnea_floating`.
     """
     n_t, n = base_q.shape
     n_c = k.shape[0]
     total = n_c * n_t
-    for c in range(n_c):
-        out[c] = 0.0
     bad = 0
     for s0 in range(0, total, CHUNK):
         m = min(CHUNK, total - s0)
@@ -76,5 +72,5 @@ def mean_base_moment(
         for s in range(m):
             c, t = divmod(s0 + s, n_t)
             x, y, z = wrench[s, 3], wrench[s, 4], wrench[s, 5]
-            out[c] += weights[t] * math.sqrt(x * x + y * y + z * z)
+            out[c, t] = math.sqrt(x * x + y * y + z * z)  # np.linalg.norm's sum, in its order
     return bad

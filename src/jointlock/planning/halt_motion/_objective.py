@@ -18,28 +18,23 @@ from ._constants import CHUNK_SAMPLES
 from ._problem import HaltProblem
 
 
-def _simpson_weights(n: int) -> FloatArray:
-    """(n,) Simpson's weights ``1 4 2 4 ... 2 4 1`` of ``n`` (odd) uniform samples."""
-    w = np.ones(n)
-    w[1:-1:2] = 4.0
-    w[2:-1:2] = 2.0
-    return w
-
-
 def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
     """Time average over the last axis of uniformly sampled values (odd count), Simpson's rule."""
     n = values.shape[-1]
-    return values @ _simpson_weights(n) / (3.0 * (n - 1))
+    w = np.ones(n)
+    w[1:-1:2] = 4.0
+    w[2:-1:2] = 2.0
+    return values @ w / (3.0 * (n - 1))
 
 
 def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, per_joint: bool) -> FloatArray | None:
     """:func:`global_base_torque` of the candidates ``k`` ((m,) shared or (m, n)) by one compiled
-    call (:func:`jointlock._kernels.mean_base_moment`: the halts sampled, Newton-Euler and the
-    norm's time average, no array of samples), where :func:`~jointlock.dynamics.rnea` would run
-    the compiled kernels for these samples (``problem.compiled``, or the compiled mode); the
-    same torques to the bit, the sum over the times to round-off.  None where the numpy route
-    runs, and where a sample's torque is not finite or its system inertia singular (the
-    numpy route says which)."""
+    call (:func:`jointlock._kernels.base_moment_norms`: the halts sampled, Newton-Euler and the
+    norm, no array of samples) and Simpson's average, where :func:`~jointlock.dynamics.rnea`
+    would run the compiled kernels for these samples (``problem.compiled``, or the compiled
+    mode): the same numbers to the bit.  None where the numpy route runs, and where a
+    sample's torque is not finite or its system inertia singular (the numpy route says
+    which)."""
     compiled = problem.compiled
     if compiled is None:
         compiled = use_compiled(k.shape[0] * t.size, COMPILED_MIN_BATCH)
@@ -57,14 +52,14 @@ def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, pe
     point = model.root_body.com if problem.moment_point is None else problem.moment_point
     kk = np.ascontiguousarray(k if per_joint else np.broadcast_to(k[:, None], (k.shape[0], problem.dof)), dtype=float)
     base, shape = problem.base_profile(t), problem.k_shape(t)
-    out = np.empty(k.shape[0])
+    norms = np.empty((k.shape[0], t.size))
     samples = tuple(kernel_input(x) for x in (*base, *shape))
-    rest = (kk, _simpson_weights(t.size), floating, *links[0], links[1], np.zeros(3), np.array(point, dtype=float), out)
+    rest = (kk, floating, *links[0], links[1], np.zeros(3), np.array(point, dtype=float), norms)
     with np.errstate(over="ignore", invalid="ignore"):
-        bad = _kernels.mean_base_moment(*samples, *rest)
-    if bad or not np.all(np.isfinite(out)):
+        bad = _kernels.base_moment_norms(*samples, *rest)
+    if bad or not np.all(np.isfinite(norms)):
         return None
-    return out / (3.0 * (t.size - 1))
+    return _simpson_mean(norms, problem.T)
 
 
 def base_torque_history(
