@@ -861,6 +861,37 @@ def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
     assert checked >= 3
 
 
+def test_the_compiled_k_intervals_are_numpys_bit_for_bit(rng, monkeypatch):
+    """feasible_k_intervals in the compiled mode "always" (jointlock._kernels.k_intervals, one
+    pass) gives numpy's intervals bit for bit: varied problems, no angle limits (infinite
+    ends), a start that breaks a rate limit (where the k part vanishes, at t = 0), an empty
+    interval."""
+    from jointlock import _kernels
+
+    calls = []
+    kernel = _kernels.k_intervals
+    monkeypatch.setattr(_kernels, "k_intervals", lambda *a: (calls.append(1), kernel(*a))[1])
+    base = _problem()
+    problems = [
+        base,
+        *_varied_problems(rng, 6),
+        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf)),
+        dataclasses.replace(base, dq0=base.dq0 + 2.0 * VMAX),
+        dataclasses.replace(base, T=1.0),
+    ]
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    for p in problems:
+        reference = feasible_k_intervals(p)
+        with jl.compiled_kernels("always"):
+            compiled = feasible_k_intervals(p)
+        assert np.array_equal(compiled, reference)
+    assert len(calls) == len(problems)
+    assert np.any(reference[:, 0] > reference[:, 1])  # T = 1 s: empty
+    with jl.compiled_kernels("always"):
+        start_breaks = feasible_k_intervals(problems[-2])
+    assert np.all(start_breaks[np.abs(problems[-2].dq0) > VMAX * (1 + 1e-6), 0] == np.inf)
+
+
 def test_minimum_halt_time_is_the_full_scans_bit_for_bit(rng):
     from jointlock.planning.halt_motion._feasibility import _surely_infeasible
 

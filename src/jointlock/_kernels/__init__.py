@@ -59,7 +59,7 @@ from ._arm import (
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
 from ._dynamics import rnea_fixed, rnea_floating
-from ._halt import base_moment_norms
+from ._halt import base_moment_norms, k_intervals
 from ._jump import fixed_frame, integrate_steps, rate_law
 from ._svd import singular_values
 
@@ -75,6 +75,7 @@ __all__ = [
     "generalized_singular_values",
     "integrate_steps",
     "jacobian",
+    "k_intervals",
     "rate_law",
     "rnea_fixed",
     "rnea_floating",

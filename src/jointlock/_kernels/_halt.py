@@ -74,3 +74,48 @@ def base_moment_norms(
             x, y, z = wrench[s, 3], wrench[s, 4], wrench[s, 5]
             out[c, t] = math.sqrt(x * x + y * y + z * z)  # np.linalg.norm's sum, in its order
     return bad
+
+
+@_jit
+def _max_nan(a, b):
+    """``np.maximum(a, b)``: NaN when either is."""
+    return a + b if a != a or b != b else max(a, b)
+
+
+@_jit
+def _min_nan(a, b):
+    """``np.minimum(a, b)``: NaN when either is."""
+    return a + b if a != a or b != b else min(a, b)
+
+
+@_jit
+def k_intervals(base, shape, lo, hi, lo_slack, hi_slack, out):
+    """Each joint's feasible interval of ``k`` on the check grid, ``out`` (n, 2) [rad/s^6]: the
+    numbers of :func:`jointlock.planning.halt_motion.feasible_k_intervals` (the same
+    divisions, and maxima and minima, which are exact), without its 15 arrays of
+    ``3 x n_t x n``.
+
+    ``base`` (3, n_t, n): the ``k = 0`` angle, rate and acceleration; ``shape`` (3, n_t): the
+    ``k`` part and its derivatives; ``lo``, ``hi`` (3, n): the limits; ``lo_slack``,
+    ``hi_slack`` (3, n): the limits widened by the round-off slack (where the ``k`` part
+    vanishes, the value must already be within them).
+    """
+    n_t, n = base.shape[1], base.shape[2]
+    inf = np.inf
+    for j in range(n):
+        k_min, k_max = -inf, inf
+        for kind in range(3):
+            lo_j, hi_j = lo[kind, j], hi[kind, j]
+            lo_s, hi_s = lo_slack[kind, j], hi_slack[kind, j]
+            for t in range(n_t):
+                s = shape[kind, t]
+                b = base[kind, t, j]
+                if abs(s) > 0:
+                    b1, b2 = (lo_j - b) / s, (hi_j - b) / s
+                    low, high = _min_nan(b1, b2), _max_nan(b1, b2)
+                elif b < lo_s or b > hi_s:
+                    low, high = inf, -inf
+                else:
+                    low, high = -inf, inf
+                k_min, k_max = _max_nan(k_min, low), _min_nan(k_max, high)
+        out[j, 0], out[j, 1] = k_min, k_max

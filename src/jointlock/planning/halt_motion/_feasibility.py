@@ -10,6 +10,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from ..._search1d import bisect_boundary
+from ...compiled import use_compiled
+from ...forward import COMPILED_MIN_BATCH
 from ...model import FloatArray
 from ._constants import LIMIT_RTOL, LimitKind
 from ._polynomial import k_shape
@@ -76,9 +78,15 @@ def feasible_k_intervals(problem: HaltProblem) -> FloatArray:
     """
     t = problem.times(problem.n_check)
     base = np.stack(problem.base_profile(t))  # (3, n_t, n)
-    shape = np.stack(problem.k_shape(t))[:, :, None]  # (3, n_t, 1)
     lo, hi = _limits(problem)
     sl = _slack(lo, hi)
+    if use_compiled(base.size, COMPILED_MIN_BATCH):  # the same numbers, one pass (a campaign's workers)
+        from ... import _kernels
+
+        out = np.empty((problem.dof, 2))
+        _kernels.k_intervals(base, np.stack(problem.k_shape(t)), lo, hi, lo - sl, hi + sl, out)
+        return out
+    shape = np.stack(problem.k_shape(t))[:, :, None]  # (3, n_t, 1)
     lo_s, hi_s = (lo - sl)[:, None, :], (hi + sl)[:, None, :]
     nz = np.abs(shape) > 0
     safe = np.where(nz, shape, 1.0)
