@@ -511,3 +511,40 @@ def test_halt_config_cli_uses_the_models_speed_limits(capsys):
         "speed limits: 40 deg/s (model's limit)" in out
         and "acceleration limits: 10 deg/s^2 (--amax-deg)" in out
     )
+
+
+@pytest.mark.parametrize("jacobian", ["generalized", "fixed"])
+def test_cp_of_configurations_in_one_compiled_call_is_the_indices_route(result, floating4, fixed4, jacobian, rng,
+                                                                       monkeypatch):  # fmt: skip
+    """AbilityModel.of_configurations (issue 29: the refinement's 13 configurations at a time)
+    in the compiled mode "always" runs one kernel (jointlock._kernels.combined_index) and gives
+    what the model gives on configuration_indices' indices, bit for bit: both Jacobians, a
+    floating and a fixed base, a characteristic length, a batch shape, a degenerate bound (a
+    span of 0 standardises to 0).  In the mode "auto" a small batch stays on numpy's route."""
+    import dataclasses
+
+    from jointlock import _kernels
+    from jointlock.analysis.ability import configuration_indices
+
+    calls = []
+    kernel = _kernels.combined_index
+    monkeypatch.setattr(_kernels, "combined_index", lambda *a: (calls.append(1), kernel(*a))[1])
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    ability = result.ability
+    flat_w = dataclasses.replace(
+        ability, normalization=dataclasses.replace(ability.normalization, manipulability_range=(0.3, 0.3))
+    )
+    for model in (floating4, fixed4):
+        q = rng.uniform(-3.0, 3.0, (2, 13, model.dof))
+        for model_of_cp, length in ((ability, None), (ability, 2.5), (flat_w, None)):
+            with jl.compiled_kernels("always"):
+                compiled = model_of_cp.of_configurations(model, q, jacobian=jacobian, characteristic_length=length)
+                reference = model_of_cp(
+                    configuration_indices(model, q, jacobian=jacobian, characteristic_length=length)
+                )
+            assert compiled.shape == (2, 13) and np.array_equal(compiled, reference)
+    assert len(calls) == 6
+    assert ability.of_configurations(floating4, q[0, 0]).shape == ()  # auto: numpy's route, no kernel
+    assert len(calls) == 6
+    with jl.compiled_kernels("always"), pytest.raises(ConfigurationError, match="characteristic_length"):
+        ability.of_configurations(floating4, q[0], characteristic_length=-1.0)

@@ -50,6 +50,7 @@ then the column norms.  It computes every singular value to high relative accura
 13 (1992) 1204-1245), so in particular to ``~1e-15 * sigma_max`` absolute, as LAPACK's SVD.
 """
 
+from ._ability import combined_index
 from ._arm import (
     ee_positions,
     fixed_singular_values,
@@ -68,6 +69,7 @@ __all__ = [
     "MAX_SWEEPS",
     "TRIG_LIMIT",
     "base_moment_norms",
+    "combined_index",
     "ee_positions",
     "fixed_frame",
     "fixed_singular_values",

@@ -4,6 +4,7 @@ in :mod:`jointlock.analysis.ability`)."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import Literal
@@ -11,11 +12,21 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._chain import kernel_input, kernel_mass_program, kernel_program
+from ...compiled import use_compiled
 from ...errors import ConfigurationError, ScenarioError
-from ...model import FloatArray
+from ...model import ArmModel, FloatArray, as_joint_array
 from ._ahp import PAPER_JUDGMENT, AHPResult, RITable, ahp_weights
 from ._entropy import EntropyResult, entropy_weights
-from ._indices import INDEX_NAMES, KinematicIndices, Normalization, StandardizedIndices, standardize
+from ._indices import (
+    INDEX_NAMES,
+    JacobianKind,
+    KinematicIndices,
+    Normalization,
+    StandardizedIndices,
+    configuration_indices,
+    standardize,
+)
 
 Assignment = Literal["text", "equation"]
 
@@ -117,6 +128,46 @@ class AbilityModel:
         """CP (...) of ``indices`` with the frozen normalisation and weights."""
         return combined_index(self.standardize(indices), self.weights)
 
+    def of_configurations(
+        self,
+        model: ArmModel,
+        q: ArrayLike,
+        *,
+        jacobian: JacobianKind = "generalized",
+        characteristic_length: float | None = None,
+    ) -> FloatArray:
+        """CP (...) of ``model`` at configurations ``q`` (..., n) [rad]: this model applied to
+        :func:`~jointlock.analysis.ability.configuration_indices`, the same numbers bit for bit.
+        Where that would run its compiled kernel (:func:`jointlock.compiled.use_compiled`: a
+        campaign's workers, or a large batch), in one compiled call with the indices, their
+        standardisation and the sum (:func:`jointlock._kernels.combined_index`): the halt
+        configuration's refinement asks it of 13 configurations at a time."""
+        from ...forward import COMPILED_MIN_BATCH  # that module imports this package
+
+        arr = as_joint_array(model, q)
+        flat = arr.reshape(-1, model.dof)
+        length = 1.0 if characteristic_length is None else float(characteristic_length)
+        if (
+            jacobian not in ("generalized", "fixed")
+            or not (math.isfinite(length) and length > 0)
+            or not use_compiled(flat.shape[0], COMPILED_MIN_BATCH)
+        ):  # numpy's route, which also says what is wrong with the arguments
+            indices = configuration_indices(model, arr, jacobian=jacobian, characteristic_length=characteristic_length)
+            return self(indices)
+        from ... import _kernels  # numba on first use
+
+        floating = jacobian == "generalized" and model.floating
+        masses = kernel_mass_program(model) if floating else _no_masses(model.dof)
+        s_lo, s_hi = self.normalization.sigma_min_range
+        w_lo, w_hi = self.normalization.manipulability_range
+        bounds = np.array([s_lo, s_hi - s_lo, w_lo, w_hi - w_lo])
+        out = np.empty(flat.shape[0])
+        _kernels.combined_index(
+            kernel_input(flat), *kernel_program(model)[:3], *masses, floating, length, bounds,
+            np.ascontiguousarray(self.weights, dtype=float), out,
+        )  # fmt: skip
+        return out.reshape(arr.shape[:-1])
+
     def weights_dict(self) -> dict[str, dict[str, float]]:
         """``{"ahp" | "entropy" | "combined": {index name: weight}}``."""
         return {
@@ -183,3 +234,9 @@ def _flatten(indices: KinematicIndices) -> KinematicIndices:
         np.ravel(indices.manipulability),
         np.ravel(indices.inverse_condition),
     )
+
+
+def _no_masses(n: int) -> tuple[FloatArray, FloatArray, FloatArray, FloatArray]:
+    """Stand-ins for the masses of :func:`jointlock._kernels.combined_index` on a fixed base
+    (not read; the arrays of the types the floating case passes, so numba compiles it once)."""
+    return np.zeros(n), np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros(13)

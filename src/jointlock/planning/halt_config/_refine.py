@@ -17,7 +17,7 @@ REFINE_FD_STEP = 1e-6
 
 
 def _refine(
-    exact: Callable[[FloatArray], tuple[FloatArray, object]],
+    cp_of: Callable[[FloatArray], FloatArray],
     starts: FloatArray,
     lo: FloatArray,
     hi: FloatArray,
@@ -26,7 +26,7 @@ def _refine(
 ) -> tuple[list[FloatArray], list[float], int]:
     """Maximise CP from each start (m, n) [rad] inside the box ``[lo, hi]``.
 
-    ``exact(qs)`` gives CP (k,) and the indices of configurations (k, n) on the frozen scale.
+    ``cp_of(qs)`` gives CP (k,) of configurations (k, n) on the frozen scale.
     A refined point that leaves the reachable set (``reach``) is pulled back along the segment
     from its start (reachable; the set is convex).  With ``keeps_clear`` (configurations
     (k, n) -> (k,) bool, the clearance constraint, whose set is not convex) a refined point is
@@ -48,7 +48,7 @@ def _refine(
     def fun(x: FloatArray) -> tuple[float, FloatArray]:
         nonlocal evaluations
         pts = np.clip(x + steps, lo, hi)
-        val, _ = exact(pts)
+        val = cp_of(pts)
         evaluations += pts.shape[0]
         h = np.diagonal(pts[1 : n + 1]) - np.diagonal(pts[n + 1 :])  # per-joint step
         grad = np.divide(val[1 : n + 1] - val[n + 1 :], h, out=np.zeros(n), where=h > 0)
@@ -65,7 +65,7 @@ def _refine(
         if keeps_clear is not None:
             x = _pull_back_clear(keeps_clear, start, x)
         refined_q.append(x)
-        refined_cp.append(float(exact(x)[0]))
+        refined_cp.append(float(cp_of(x)))
     return refined_q, refined_cp, evaluations
 
 

@@ -239,8 +239,13 @@ def optimal_halt_configuration(
         def keeps_clear(qs: FloatArray) -> np.ndarray:
             return ~clearance(model_locked, qs, keep_out=keep_out, witness=False).colliding(margin)
 
+        def cp_of(qs: FloatArray) -> FloatArray:  # exact()'s CP, bit for bit, in one compiled call in a worker
+            return ability.of_configurations(
+                model_locked, qs, jacobian=jacobian, characteristic_length=characteristic_length
+            )
+
         refined_q, refined_cp, evaluations = _refine(
-            exact, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None
+            cp_of, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None
         )
     best = best_sample
     if refined_cp and max(refined_cp) > best_sample.cp:
