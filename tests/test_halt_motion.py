@@ -742,6 +742,7 @@ def test_the_compiled_mean_torque_equals_numpys(base, about, rng, monkeypatch):
     from jointlock.planning.halt_motion import _objective, global_base_torque
     from jointlock.planning.halt_motion._objective import _compiled_mean_torque
 
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)  # the mode auto below
     p = _problem(T=12.0, base=base, n_samples=101, moment_about=about)
     shared = np.linspace(-2e-4, 2e-4, 97)  # 9,797 samples: three chunks, one candidate across two
     per_joint = rng.uniform(-2e-4, 2e-4, (5, p.dof))
@@ -768,6 +769,7 @@ def test_compiled_objective_finds_the_same_halt(base, monkeypatch):
     average, jointlock._kernels._halt), the same optimum and torques as numpy to round-off."""
     from jointlock import _kernels
 
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)  # the reference on numpy
     calls = []
     for name in ("rnea_fixed" if base == "fixed" else "rnea_floating", "base_moment_norms"):
         kernel = getattr(_kernels, name)

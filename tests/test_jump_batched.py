@@ -4,6 +4,7 @@ in the same pass -- gives each run what stepping it alone gives (round-off only)
 
 from __future__ import annotations
 
+import dataclasses
 from pathlib import Path
 
 import numpy as np
@@ -256,28 +257,39 @@ def _both_loops(monkeypatch, run) -> tuple[dict, dict, list[str]]:
 
 def test_the_compiled_loop_equals_the_python_loop(monkeypatch, prob):
     """issue 29: the integrator's whole loop compiled (jointlock._kernels.integrate_steps) gives
-    what its Python loop gives with the same kernels: runs branching off healthy runs
-    (parents, the jump column, records), the probe's null-space norm, a stop before the end."""
+    what its Python loop gives with the same kernels, bit for bit where a step holds two runs
+    or more: runs branching off healthy runs (parents, the jump column, records), a stop
+    before the end, a task that starts and ends at rest (its first and last steps are
+    accelerations too).  With one run, numpy's einsum adds the deviation's three squares in
+    another order: the probe's run (and its null-space norm) to an ulp."""
     krows = np.repeat(np.array([[0.0], [4e-3], [-1e-3]]), prob.N, axis=1)
     kidx, fsteps = np.array([1, 0, 2, 1, 2, 0]), np.array([25, 3, 0, 38, 12, 25])
-    for run in (
-        lambda: _branched_runs(prob, krows, kidx, fsteps)[0],
-        lambda: _branched_runs(prob, krows, kidx, fsteps)[1],
-        lambda: _integrate(prob, krows[:1], prob.q0[None], None, np.zeros(1, dtype=int), np.full((1, 1), prob.N + 1),
-                           [prob.lock_col], null_norm=True),  # fmt: skip
-        lambda: _healthy_runs(prob, krows, k_stop=17),
+    at_rest = _problem(prob.model, dataclasses.replace(TASK, rest_transitions=True))
+    for run, one_run in (
+        (lambda: _branched_runs(prob, krows, kidx, fsteps)[0], False),
+        (lambda: _branched_runs(prob, krows, kidx, fsteps)[1], False),
+        (lambda: _healthy_runs(prob, krows, k_stop=17), False),
+        (lambda: _branched_runs(at_rest, krows, kidx, fsteps)[0], False),
+        (lambda: _integrate(prob, krows[:1], prob.q0[None], None, np.zeros(1, dtype=int), np.full((1, 1), prob.N + 1),
+                            [prob.lock_col], null_norm=True), True),  # fmt: skip
     ):
         compiled, reference, calls = _both_loops(monkeypatch, run)
         assert calls.count("integrate_steps") >= 1 and "rate_law" not in calls  # the loop, not a step
         assert compiled.keys() == reference.keys()
         for name, ref in reference.items():
-            assert _close(compiled[name], ref), name
+            if one_run:
+                np.testing.assert_allclose(compiled[name], ref, rtol=4e-16, atol=0, err_msg=name)
+            else:
+                assert np.array_equal(compiled[name], ref), name
+    assert at_rest.scenario.rest_transitions
 
 
 def test_the_compiled_loop_leaves_singular_and_diverging_steps_to_the_reference(monkeypatch):
     """A step the compiled loop cannot take -- a Gram matrix of rank 2 (three of arm5's five
-    joints locked in sequence: numpy's SVD) or a run whose rates diverge (zeroed, and refused
-    when every run does) -- is taken by the Python step, and the loop goes on compiled."""
+    joints locked in sequence: numpy's SVD; after 8 such steps in a row the pass goes on in
+    Python), every run diverging (refused in one line) -- is taken by the Python step.  A run
+    diverging among others is stopped in the kernel as the Python step stops it (recorded,
+    then held)."""
     arm = jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")
     task = JumpScenario(q0=(0.3, -0.6, 0.9, -0.4, 0.5), duration=2.0, blend=0.5, dx=(0.05, -0.04, 0.03))
 
@@ -301,9 +313,10 @@ def test_the_compiled_loop_leaves_singular_and_diverging_steps_to_the_reference(
         return _healthy_runs(canadarm, wild)
 
     compiled, reference, calls = _both_loops(monkeypatch, diverging)
-    assert "rate_law" in calls
+    assert calls.count("integrate_steps") == 1 and "rate_law" not in calls  # stopped in the kernel
     for name, ref in reference.items():
-        assert _close(compiled[name], ref), name
+        assert np.array_equal(compiled[name], ref), name
+    assert compiled["max_vel"][1] > 1e3 and np.all(compiled["q"][1, 2:] == compiled["q"][1, 1])  # held
     with jl.compiled_kernels("always"), pytest.raises(jl.InfeasibleError, match="kappa is far too large"):
         _healthy_runs(canadarm, wild[1:])
 
@@ -320,3 +333,10 @@ def test_the_compiled_loop_moves_a_progress_bar_once_per_step(monkeypatch, prob)
     with jl.compiled_kernels("always"):
         _healthy_runs(prob, np.zeros((2, prob.N)), progress=bar)
     assert bar.done == prob.N
+    arm = jl.load_robot(ROOT / "tests" / "data" / "arm5.urdf")  # Python steps among the compiled ones
+    p = _problem(arm, JumpScenario(q0=(0.3, -0.6, 0.9, -0.4, 0.5), duration=2.0, blend=0.5, dx=(0.05, -0.04, 0.03)))
+    bar = Count()
+    with jl.compiled_kernels("always"), pytest.warns(jl.SingularityWarning):
+        _integrate(p, np.zeros((1, p.N)), p.q0[None], None, np.zeros(1, dtype=int), np.array([[5, 9, 14]]), [0, 2, 4],
+                   progress=bar)  # fmt: skip
+    assert bar.done == p.N

@@ -34,6 +34,8 @@ Numba is imported with this package, and only the public functions that take the
 kernels import it (lazily), from :data:`jointlock.forward.COMPILED_MIN_BATCH` configurations
 on: loading numba and the cached kernels costs a process 0.4-0.7 s on an idle core (about 2 s
 on a busy one), the first compilation on a machine 5-25 s (cached afterwards, ``cache=True``;
+numba checks only the calling kernel's own file, so after editing a module whose kernels
+others call -- ``_dynamics``, ``_arm``, ``_common`` -- clear ``__pycache__`` here;
 README, "Speed").
 
 Sines and cosines.  libm's scalar ``sin``/``cos`` cost ~25 ns each and block SIMD, so

@@ -21,6 +21,23 @@ _EPS = 2.220446049250313e-16
 # error_model="numpy": x / 0 gives inf/nan (masked afterwards) instead of raising
 _jit = njit(cache=True, error_model="numpy", nogil=True)
 
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _nan_max(a, b):
+    """``np.maximum(a, b)`` on scalars, as numpy's loop: NaN when either is, ``a`` on a tie
+    (the sign of a zero kept as numpy keeps it)."""
+    if a != a or b != b:
+        return a + b
+    return a if a >= b else b
+
+
+@njit(inline="always", cache=True, error_model="numpy", nogil=True)
+def _nan_min(a, b):
+    """``np.minimum(a, b)`` on scalars, as numpy's loop: NaN when either is, ``a`` on a tie."""
+    if a != a or b != b:
+        return a + b
+    return a if a <= b else b
+
 # musl __rem_pio2: 2/pi, and pi/2 split in parts whose products with small integers are exact
 _TOINT = 6755399441055744.0  # 1.5 / eps: adding it rounds to an integer
 _INVPIO2 = 6.36619772367581382433e-01

@@ -4,8 +4,9 @@
 takes the time average (Simpson's rule, the same ``values @ weights`` as the numpy route).
 
 Why next to :func:`~jointlock._kernels._dynamics.rnea_fixed`.  The objective's numpy route
-materialises every candidate's ``q, dq, ddq`` (the scan's 401 candidates x 501 samples x 7
-joints x 3: 34 MB) and the torques, wrench, acceleration and twist of every sample, then takes
+materialises every candidate's ``q, dq, ddq`` (the scan's 401 candidates x 501 samples x 6
+joints x 3: 29 MB, in chunks of 60,000 samples) and the torques, wrench, acceleration and
+twist of every sample, then takes
 the norm and Simpson's sum; at a campaign's batch sizes that costs as much as the Newton-Euler
 pass itself, and a single candidate (the bounded search after the scan) pays ~0.8 ms of calls
 for 0.1 ms of arithmetic.  Here the samples are made a chunk at a time, exactly as
@@ -19,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._common import _jit
+from ._common import _jit, _nan_max, _nan_min
 from ._dynamics import rnea_fixed, rnea_floating
 
 #: Samples per Newton-Euler call: the work arrays of a chunk stay in L2.
@@ -77,18 +78,6 @@ def base_moment_norms(
 
 
 @_jit
-def _max_nan(a, b):
-    """``np.maximum(a, b)``: NaN when either is."""
-    return a + b if a != a or b != b else max(a, b)
-
-
-@_jit
-def _min_nan(a, b):
-    """``np.minimum(a, b)``: NaN when either is."""
-    return a + b if a != a or b != b else min(a, b)
-
-
-@_jit
 def k_intervals(base, shape, lo, hi, lo_slack, hi_slack, out):
     """Each joint's feasible interval of ``k`` on the check grid, ``out`` (n, 2) [rad/s^6]: the
     numbers of :func:`jointlock.planning.halt_motion.feasible_k_intervals` (the same
@@ -112,10 +101,10 @@ def k_intervals(base, shape, lo, hi, lo_slack, hi_slack, out):
                 b = base[kind, t, j]
                 if abs(s) > 0:
                     b1, b2 = (lo_j - b) / s, (hi_j - b) / s
-                    low, high = _min_nan(b1, b2), _max_nan(b1, b2)
+                    low, high = _nan_min(b1, b2), _nan_max(b1, b2)
                 elif b < lo_s or b > hi_s:
                     low, high = inf, -inf
                 else:
                     low, high = -inf, inf
-                k_min, k_max = _max_nan(k_min, low), _min_nan(k_max, high)
+                k_min, k_max = _nan_max(k_min, low), _nan_min(k_max, high)
         out[j, 0], out[j, 1] = k_min, k_max

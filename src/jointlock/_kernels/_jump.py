@@ -13,8 +13,9 @@ compiled, and a Python step is taken only where the loop leaves one (a singular 
 a diverging run).  The same formulas, run by run, in the same order where it is cheap to keep
 (the running sums of the gradient add joint by joint as ``np.cumsum`` does); products and sums
 inside a step associate differently, so the results agree with numpy's to round-off
-(``tests/test_jump.py``; the compiled loop and the Python loop over the same kernels agree to
-the bit on canadarm7, ``tests/test_jump_batched.py``).
+(``tests/test_jump.py``).  The compiled loop and the Python loop over the same kernels agree
+to the bit where a step holds two runs or more (``tests/test_jump_batched.py``); with a single
+run numpy's ``einsum`` adds the deviation's three squares in another order (an ulp).
 
 A run whose Gram matrix ``J_h J_h^T`` is (nearly) singular gets ``singular[b] = True`` and no
 rates: the caller computes those by the reference (an SVD), as the reference itself does.
@@ -26,7 +27,7 @@ import math
 
 import numpy as np
 
-from ._common import _jit
+from ._common import _jit, _nan_max, _nan_min
 
 
 @_jit
@@ -148,22 +149,6 @@ def rate_law(jac, axes, healthy, xdot, kappa, rtol, qdot, w, null, singular):
 
 
 @_jit
-def _nan_max(a, b):
-    """``np.maximum(a, b)`` on scalars: NaN when either is."""
-    if a != a or b != b:
-        return a + b
-    return a if a >= b else b
-
-
-@_jit
-def _nan_min(a, b):
-    """``np.minimum(a, b)`` on scalars: NaN when either is."""
-    if a != a or b != b:
-        return a + b
-    return a if a <= b else b
-
-
-@_jit
 def integrate_steps(
     k_begin, k_end, link_h, tool, x_nom, xd_nom, kp, dt, kappa, first_run, parent, locks_at, fail_steps,
     rest_transitions, jump_col, null_norm, diverged_rate, rtol,
@@ -177,10 +162,12 @@ def integrate_steps(
     locked as well, when ``jump_col >= 0``), the running maxima, the records of the first ``R``
     runs (``R = rec_q.shape[0]``) and the explicit-Euler step of ``q`` (B, n).
 
-    Returns the first step not taken: ``k_end``, or the step at which a run's Gram matrix is
-    (nearly) singular or a run's rate passes ``diverged_rate`` [rad/s] -- nothing of that step
-    is written, and the caller takes it by the reference (an SVD; zeroing or refusing the
-    diverged runs) before calling again from the next step.
+    A run whose rate passes ``diverged_rate`` [rad/s] has its maxima and records of the step
+    written, then its rates zeroed (it stays where it is), as the reference does.  Returns the
+    first step not taken: ``k_end``, or the step at which a run's Gram matrix is (nearly)
+    singular, every run diverges, or a rate is NaN -- nothing of that step is written, and the
+    caller takes it by the reference (an SVD; refusing the task) before calling again from the
+    next step.
 
     ``first_run`` (N + 1,): the number of runs started before each step; ``parent`` (B,): the
     run whose angles a run takes at its first step (-1: none); ``locks_at`` (B, n): the step
@@ -232,18 +219,25 @@ def integrate_steps(
         for b in range(cols):
             if singular[b]:
                 return k
+        peaks = np.empty(m)
+        every_run_diverges = m > 0
         for b in range(m):
+            peak = 0.0
             for i in range(n):
-                if abs(qdot[i, b]) > diverged_rate:
-                    return k
+                peak = _nan_max(peak, abs(qdot[i, b]))
+            if peak != peak:
+                return k  # NaN rates: the reference's rules (no run is stopped then)
+            peaks[b] = peak
+            every_run_diverges = every_run_diverges and peak > diverged_rate
+        if every_run_diverges:
+            return k  # the reference refuses the task in one line
         for b in range(m):
             dev = math.sqrt(err[0, b] * err[0, b] + err[1, b] * err[1, b] + err[2, b] * err[2, b])
             max_dev[b] = _nan_max(max_dev[b], dev)
-            peak = 0.0
+            peak = peaks[b]
             acc = 0.0
             big_null = 0.0
             for i in range(n):
-                peak = _nan_max(peak, abs(qdot[i, b]))
                 acc = _nan_max(acc, abs(qdot[i, b] - qd_prev[b, i]))
                 big_null = _nan_max(big_null, abs(null[i, b]))
             max_vel[b] = _nan_max(max_vel[b], peak)
@@ -274,6 +268,9 @@ def integrate_steps(
                             acc_r += jac[r, c, b] * (qdot[c, m + b] - qdot[c, b])
                         rec_task_plus[b, k, r] = acc_r
                         rec_task_noreplan[b, k, r] = -(jac[r, jump_col, b] * qdot[jump_col, b])
+            if peak > diverged_rate:  # stopped, as the reference's _stop_diverged: recorded, then held
+                for i in range(n):
+                    qdot[i, b] = 0.0
             for i in range(n):
                 qd_prev[b, i] = qdot[i, b]
                 q[b, i] = qs[b, i] + dt * qdot[i, b]

@@ -80,7 +80,7 @@ def feasible_k_intervals(problem: HaltProblem) -> FloatArray:
     base = np.stack(problem.base_profile(t))  # (3, n_t, n)
     lo, hi = _limits(problem)
     sl = _slack(lo, hi)
-    if use_compiled(base.size, COMPILED_MIN_BATCH):  # the same numbers, one pass (a campaign's workers)
+    if use_compiled(t.size, COMPILED_MIN_BATCH):  # the same numbers, one pass (a campaign's workers)
         from ... import _kernels
 
         out = np.empty((problem.dof, 2))
@@ -166,12 +166,11 @@ def least_violating_k(problem: HaltProblem) -> float:
     grid = np.linspace(-2 * span, 2 * span, 801)
     limits = _Limits.of(problem).within(float(grid[0]), float(grid[-1]))
 
-    def scan(kept: _Limits, part: FloatArray) -> FloatArray:
-        kept = kept.within(float(part[0]), float(part[-1]))
+    def scan(kept: _Limits, part: FloatArray) -> FloatArray:  # ``kept``: pruned for ``part``
         if part.size <= SCAN_STRETCH:
             return kept.relative_violation(part)
-        half = part.size // 2
-        return np.concatenate([scan(kept, part[:half]), scan(kept, part[half:])])
+        halves = part[: part.size // 2], part[part.size // 2 :]
+        return np.concatenate([scan(kept.within(float(h[0]), float(h[-1])), h) for h in halves])
 
     viol = scan(limits, grid)
     i = int(np.argmin(viol))

@@ -182,6 +182,9 @@ def _stop_diverged(qd: np.ndarray, kappa: np.ndarray, t: float, limit: float) ->
 
 #: Control steps per compiled call while a progress bar is shown (it moves between calls).
 _STEPS_PER_UPDATE = 25
+#: Steps in a row the compiled loop leaves to the reference at once (a Gram matrix that stays
+#: singular: two joints left of a 3-D task) before the rest of the pass is Python's.
+_REFUSALS_BEFORE_PYTHON = 8
 
 
 def _compiled_steps(
@@ -200,7 +203,8 @@ def _compiled_steps(
 ) -> Any:
     """:func:`_integrate`'s steps by the compiled loop (:func:`jointlock._kernels.integrate_steps`)
     on these runs' arrays, written in place: ``(k_begin, k_end) -> the first step not taken``
-    (one with a singular Gram matrix or a diverging run is left to the reference).  None where
+    (one with a singular Gram matrix, every run diverging or a NaN rate is left to the
+    reference; a run diverging alone is stopped by the kernel, as the reference stops it).  None where
     the reference takes every step: a floating base (its frame and gradient are numpy's), or
     the compiled kernels not in use for this batch (:func:`jointlock.compiled.use_compiled`; a
     campaign's workers always use them)."""
@@ -397,6 +401,7 @@ def _integrate(
                 out.rb[:, k + 1] = rb[:R]
 
     k = k0
+    refused = 0  # steps in a row the compiled loop left to the reference at once
     while k < k_stop:
         if compiled is not None:
             # every step in one call; with a progress bar a few at a time, so that it moves
@@ -404,10 +409,13 @@ def _integrate(
             k_next = compiled(k, end)
             for _ in range(k_next - k) if progress is not None else ():
                 progress.update()
+            refused = refused + 1 if k_next == k else 0
+            if refused == _REFUSALS_BEFORE_PYTHON:  # a lasting singularity: the kernel's work is wasted
+                compiled = None
             k = k_next
             if k == end:
                 continue
-        step(k)  # a singular Gram matrix or a diverging run: this step by the reference
+        step(k)  # a singular Gram matrix, every run diverging, NaN: this step by the reference
         k += 1
         if progress is not None:
             progress.update()
