@@ -534,17 +534,26 @@ def test_cp_of_configurations_in_one_compiled_call_is_the_indices_route(result, 
     flat_w = dataclasses.replace(
         ability, normalization=dataclasses.replace(ability.normalization, manipulability_range=(0.3, 0.3))
     )
+    flat_s = dataclasses.replace(
+        ability, normalization=dataclasses.replace(ability.normalization, sigma_min_range=(0.2, 0.1))
+    )
     for model in (floating4, fixed4):
         q = rng.uniform(-3.0, 3.0, (2, 13, model.dof))
-        for model_of_cp, length in ((ability, None), (ability, 2.5), (flat_w, None)):
+        for model_of_cp, length in ((ability, None), (ability, 2.5), (flat_w, None), (flat_s, None)):
             with jl.compiled_kernels("always"):
                 compiled = model_of_cp.of_configurations(model, q, jacobian=jacobian, characteristic_length=length)
                 reference = model_of_cp(
                     configuration_indices(model, q, jacobian=jacobian, characteristic_length=length)
                 )
             assert compiled.shape == (2, 13) and np.array_equal(compiled, reference)
-    assert len(calls) == 6
-    assert ability.of_configurations(floating4, q[0, 0]).shape == ()  # auto: numpy's route, no kernel
-    assert len(calls) == 6
-    with jl.compiled_kernels("always"), pytest.raises(ConfigurationError, match="characteristic_length"):
-        ability.of_configurations(floating4, q[0], characteristic_length=-1.0)
+    assert len(calls) == 8
+    one = ability.of_configurations(floating4, q[0, 0])  # auto: numpy's route, no kernel
+    assert len(calls) == 8
+    with jl.compiled_kernels("always"):
+        assert type(ability.of_configurations(floating4, q[0, 0])) is type(one)  # a numpy float either way
+        with pytest.raises(ConfigurationError, match="characteristic_length"):
+            ability.of_configurations(floating4, q[0], characteristic_length=-1.0)
+        with pytest.raises(ConfigurationError, match="jacobian"):  # named first, as numpy's route does
+            ability.of_configurations(floating4, np.full((2, 5), np.nan), jacobian="spatial")
+        with pytest.raises(ConfigurationError):  # weights are checked, not read past their end
+            dataclasses.replace(ability, weights=np.ones(2)).of_configurations(floating4, q[0])

@@ -280,7 +280,9 @@ def test_the_compiled_loop_equals_the_python_loop(monkeypatch, prob):
             if one_run:
                 np.testing.assert_allclose(compiled[name], ref, rtol=4e-16, atol=0, err_msg=name)
             else:
-                assert np.array_equal(compiled[name], ref), name
+                assert np.array_equal(compiled[name].view(np.int64), ref.view(np.int64)), name  # zeros' signs too
+        if "qd" in compiled:  # the speed maximum over every joint, the last one included
+            assert np.array_equal(compiled["max_vel"], np.abs(compiled["qd"]).max(axis=(1, 2)))
     assert at_rest.scenario.rest_transitions
 
 
@@ -301,7 +303,8 @@ def test_the_compiled_loop_leaves_singular_and_diverging_steps_to_the_reference(
 
     with pytest.warns(jl.SingularityWarning, match="1 of 1 runs passed within"):  # two joints left
         compiled, reference, calls = _both_loops(monkeypatch, three_locks)
-    assert "integrate_steps" in calls and "rate_law" in calls  # steps by both
+    # steps 0-13 compiled, then 8 refusals in a row, then Python's steps to the end (40 steps)
+    assert calls.count("integrate_steps") == 9 and "rate_law" in calls
     for name, ref in reference.items():
         assert _close(compiled[name], ref), name
     assert np.all(compiled["qd"][0, 14:, [0, 2, 4]] == 0.0)
@@ -315,7 +318,7 @@ def test_the_compiled_loop_leaves_singular_and_diverging_steps_to_the_reference(
     compiled, reference, calls = _both_loops(monkeypatch, diverging)
     assert calls.count("integrate_steps") == 1 and "rate_law" not in calls  # stopped in the kernel
     for name, ref in reference.items():
-        assert np.array_equal(compiled[name], ref), name
+        assert np.array_equal(compiled[name].view(np.int64), ref.view(np.int64)), name  # zeros' signs too
     assert compiled["max_vel"][1] > 1e3 and np.all(compiled["q"][1, 2:] == compiled["q"][1, 1])  # held
     with jl.compiled_kernels("always"), pytest.raises(jl.InfeasibleError, match="kappa is far too large"):
         _healthy_runs(canadarm, wild[1:])

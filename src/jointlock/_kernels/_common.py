@@ -24,8 +24,9 @@ _jit = njit(cache=True, error_model="numpy", nogil=True)
 
 @njit(inline="always", cache=True, error_model="numpy", nogil=True)
 def _nan_max(a, b):
-    """``np.maximum(a, b)`` on scalars, as numpy's loop: NaN when either is, ``a`` on a tie
-    (the sign of a zero kept as numpy keeps it)."""
+    """``np.maximum(a, b)`` on scalars: NaN when either is (``max`` would drop it).  Equal
+    values give ``a``: a zero's sign may differ from numpy's (which SIMD lanes decide); the
+    kernels' operands here are not signed zeros where it would show."""
     if a != a or b != b:
         return a + b
     return a if a >= b else b
@@ -33,7 +34,8 @@ def _nan_max(a, b):
 
 @njit(inline="always", cache=True, error_model="numpy", nogil=True)
 def _nan_min(a, b):
-    """``np.minimum(a, b)`` on scalars, as numpy's loop: NaN when either is, ``a`` on a tie."""
+    """``np.minimum(a, b)`` on scalars: NaN when either is; equal values give ``a``
+    (see :func:`_nan_max`)."""
     if a != a or b != b:
         return a + b
     return a if a <= b else b

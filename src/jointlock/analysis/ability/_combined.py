@@ -142,18 +142,26 @@ class AbilityModel:
         campaign's workers, or a large batch), in one compiled call with the indices, their
         standardisation and the sum (:func:`jointlock._kernels.combined_index`): the halt
         configuration's refinement asks it of 13 configurations at a time."""
-        from ...forward import COMPILED_MIN_BATCH  # that module imports this package
+        from ...forward import COMPILED_MIN_BATCH  # on first use, as configuration_indices takes it
 
-        arr = as_joint_array(model, q)
-        flat = arr.reshape(-1, model.dof)
-        length = 1.0 if characteristic_length is None else float(characteristic_length)
+        def numpy_route() -> FloatArray:  # which also says what is wrong with the arguments, first
+            indices = configuration_indices(model, q, jacobian=jacobian, characteristic_length=characteristic_length)
+            return self(indices)
+
+        try:
+            length = 1.0 if characteristic_length is None else float(characteristic_length)
+        except (TypeError, ValueError):
+            return numpy_route()
         if (
             jacobian not in ("generalized", "fixed")
             or not (math.isfinite(length) and length > 0)
-            or not use_compiled(flat.shape[0], COMPILED_MIN_BATCH)
-        ):  # numpy's route, which also says what is wrong with the arguments
-            indices = configuration_indices(model, arr, jacobian=jacobian, characteristic_length=characteristic_length)
-            return self(indices)
+            or np.shape(self.weights) != (3,)
+        ):
+            return numpy_route()
+        arr = as_joint_array(model, q)
+        flat = arr.reshape(-1, model.dof)
+        if not use_compiled(flat.shape[0], COMPILED_MIN_BATCH):
+            return numpy_route()
         from ... import _kernels  # numba on first use
 
         floating = jacobian == "generalized" and model.floating
@@ -164,9 +172,9 @@ class AbilityModel:
         out = np.empty(flat.shape[0])
         _kernels.combined_index(
             kernel_input(flat), *kernel_program(model)[:3], *masses, floating, length, bounds,
-            np.ascontiguousarray(self.weights, dtype=float), out,
+            kernel_input(np.asarray(self.weights, dtype=float)), out,
         )  # fmt: skip
-        return out.reshape(arr.shape[:-1])
+        return out.reshape(arr.shape[:-1])[()]  # one configuration: a numpy float, as numpy's route
 
     def weights_dict(self) -> dict[str, dict[str, float]]:
         """``{"ahp" | "entropy" | "combined": {index name: weight}}``."""

@@ -183,8 +183,10 @@ def _stop_diverged(qd: np.ndarray, kappa: np.ndarray, t: float, limit: float) ->
 #: Control steps per compiled call while a progress bar is shown (it moves between calls).
 _STEPS_PER_UPDATE = 25
 #: Steps in a row the compiled loop leaves to the reference at once (a Gram matrix that stays
-#: singular: two joints left of a 3-D task) before the rest of the pass is Python's.
+#: singular: two joints left of a 3-D task) before :data:`_PYTHON_STEPS_AFTER_REFUSALS` steps
+#: are Python's; then the compiled loop is tried again.
 _REFUSALS_BEFORE_PYTHON = 8
+_PYTHON_STEPS_AFTER_REFUSALS = 64
 
 
 def _compiled_steps(
@@ -402,8 +404,9 @@ def _integrate(
 
     k = k0
     refused = 0  # steps in a row the compiled loop left to the reference at once
+    python_until = k0  # after a run of refusals, Python's steps up to here
     while k < k_stop:
-        if compiled is not None:
+        if compiled is not None and k >= python_until:
             # every step in one call; with a progress bar a few at a time, so that it moves
             end = k_stop if progress is None else min(k + _STEPS_PER_UPDATE, k_stop)
             k_next = compiled(k, end)
@@ -411,7 +414,7 @@ def _integrate(
                 progress.update()
             refused = refused + 1 if k_next == k else 0
             if refused == _REFUSALS_BEFORE_PYTHON:  # a lasting singularity: the kernel's work is wasted
-                compiled = None
+                refused, python_until = 0, k_next + _PYTHON_STEPS_AFTER_REFUSALS
             k = k_next
             if k == end:
                 continue
