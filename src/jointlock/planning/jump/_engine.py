@@ -213,6 +213,8 @@ def _compiled_steps(
     B, n = q.shape
     if prob.chain is None or not use_compiled(B, COMPILED_MIN_BATCH):
         return None
+    if not all(a.dtype == np.float64 and a.flags.c_contiguous for a in (q, qd_prev)):
+        return None  # the kernel writes them in place as float64 rows: the reference's arrays else
     from ... import _kernels  # numba on first use
 
     sc, chain = prob.scenario, prob.chain
