@@ -549,6 +549,15 @@ def test_cp_of_configurations_in_one_compiled_call_is_the_indices_route(result, 
     assert len(calls) == 8
     one = ability.of_configurations(floating4, q[0, 0])  # auto: numpy's route, no kernel
     assert len(calls) == 8
+    # the kernel's batch is padded to whole SIMD lanes with copies: a configuration's CP does
+    # not depend on the batch it is in (13 -> 16, 1 -> 8, 8 not padded)
+    rows = rng.uniform(-3.0, 3.0, (13, floating4.dof))
+    with jl.compiled_kernels("always"):
+        cp = ability.evaluator(floating4, jacobian=jacobian)
+        batch = cp(rows)
+        assert np.array_equal(batch, [cp(row) for row in rows]) and np.array_equal(cp(rows[:8]), batch[:8])
+        assert np.array_equal(batch, ability(configuration_indices(floating4, rows, jacobian=jacobian)))
+    assert len(calls) == 8 + 2 + 13
     with jl.compiled_kernels("always"):
         assert type(ability.of_configurations(floating4, q[0, 0])) is type(one)  # a numpy float either way
         with pytest.raises(ConfigurationError, match="characteristic_length"):

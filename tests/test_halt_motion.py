@@ -906,6 +906,39 @@ def test_minimum_halt_time_is_the_full_scans_bit_for_bit(rng):
         assert not np.any(surely_not & feasible) and surely_not.any()
 
 
+def test_the_compiled_screen_of_halt_times_is_numpys(rng, monkeypatch):
+    """minimum_halt_time's screen in the compiled mode "always" (jointlock._kernels.
+    screen_k_bounds): the numpy route's verdicts on every halt time, including limits that are
+    infinite, a start outside a limit and halt times whose every check time is decisive; and
+    never infeasible where the exact check is feasible."""
+    from jointlock import _kernels
+    from jointlock.planning.halt_motion._feasibility import _surely_infeasible
+
+    calls = []
+    kernel = _kernels.screen_k_bounds
+    monkeypatch.setattr(_kernels, "screen_k_bounds", lambda *a: (calls.append(1), kernel(*a))[1])
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    base = _problem()
+    problems = [
+        base,
+        *_varied_problems(rng, 8),
+        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf)),
+        dataclasses.replace(base, dq0=base.dq0 + 2.0 * VMAX),
+    ]
+    times = np.r_[np.linspace(0.05, 30.0, 301), 7.25, 120.0]
+    screened = 0
+    for p in problems:
+        reference = _surely_infeasible(p, times)
+        with jl.compiled_kernels("always"):
+            compiled = _surely_infeasible(p, times)
+        assert np.array_equal(compiled, reference)
+        screened += int(compiled.sum())
+        feasible = np.array([np.subtract(*shared_k_interval(p.with_time(float(T)))) <= 0 for T in times[::10]])
+        assert not np.any(compiled[::10] & feasible)
+    assert len(calls) == len(problems)
+    assert 0 < screened < len(problems) * times.size
+
+
 def test_the_clearance_screen_gives_the_full_checks_answer():
     """000's halt to the clearance-keeping configuration: some k of the limits' interval keep
     the clearance, others do not (tests/test_clearance.py); the screened check says which,

@@ -108,3 +108,62 @@ def k_intervals(base, shape, lo, hi, lo_slack, hi_slack, out):
                     low, high = -inf, inf
                 k_min, k_max = _nan_max(k_min, low), _nan_min(k_max, high)
         out[j, 0], out[j, 1] = k_min, k_max
+
+
+@_jit
+def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol, out):
+    """For each halt time, whether no shared ``k`` keeps the limits at the check times
+    ``picked`` alone, ``out`` (m,) bool: the screen of
+    :func:`jointlock.planning.halt_motion.minimum_halt_time`, whose numpy route
+    (``_surely_infeasible``) makes ~60 arrays of ``m x picked x n`` for what is a few
+    operations per sample.
+
+    Only a screen: its bounds are the numpy route's up to round-off (powers by multiplication,
+    not numpy's ``pow``), and each is widened by ``rtol`` of the terms it comes from, far above
+    that round-off, so a halt time it calls infeasible is infeasible on the exact check too.
+
+    ``halt_times`` (m,) [s]; ``picked`` (s,) int64 indices of the check times (of
+    ``n_check``, spaced as ``np.linspace(0, T, n_check)``); ``q0, dq0, ddq0, qf`` (n,) the
+    state at failure and the halt configuration; ``lo``, ``hi`` (3, n) the angle, rate and
+    acceleration limits (infinite: none).
+    """
+    n = q0.shape[0]
+    inf = np.inf
+    for m in range(halt_times.shape[0]):
+        T = halt_times[m]
+        T2 = T * T
+        k_lo, k_hi = -inf, inf
+        for p in range(picked.shape[0]):
+            i = picked[p]
+            t = T if i == n_check - 1 else i * (T / (n_check - 1))
+            u = t - T
+            t2, u2 = t * t, u * u
+            shape = (t2 * t * u2 * u, 3.0 * t2 * u2 * (t + u), 6.0 * t * u * (t2 + 3.0 * t * u + u2))
+            for j in range(n):
+                h = qf[j] - q0[j]
+                a3 = (20.0 * h - T2 * 3.0 * ddq0[j] - T * 12.0 * dq0[j]) / (2.0 * T2 * T)
+                a4 = (T2 * 3.0 * ddq0[j] + T * 16.0 * dq0[j] - 30.0 * h) / (2.0 * T2 * T2)
+                a5 = (-ddq0[j] * T2 - 6.0 * dq0[j] * T + 12.0 * h) / (2.0 * T2 * T2 * T)
+                for kind in range(3):
+                    if kind == 0:
+                        terms = (q0[j], dq0[j] * t, ddq0[j] / 2.0 * t2, a3 * t2 * t, a4 * t2 * t2, a5 * t2 * t2 * t)
+                    elif kind == 1:
+                        terms = (dq0[j], ddq0[j] * t, 3.0 * a3 * t2, 4.0 * a4 * t2 * t, 5.0 * a5 * t2 * t2, 0.0)
+                    else:
+                        terms = (ddq0[j], 6.0 * a3 * t, 12.0 * a4 * t2, 20.0 * a5 * t2 * t, 0.0, 0.0)
+                    base, size = 0.0, 0.0
+                    for x in terms:
+                        base += x
+                        size += abs(x)
+                    phi = shape[kind]
+                    if not abs(phi) > 0:
+                        continue
+                    low_limit, high_limit = lo[kind, j], hi[kind, j]
+                    b1, b2 = (low_limit - base) / phi, (high_limit - base) / phi
+                    if not math.isfinite(b1 + b2):  # an infinite limit (or NaN): no bound
+                        continue
+                    ends = max(abs(low_limit), abs(high_limit))
+                    widen = rtol * (size + ends) / abs(phi)
+                    k_lo = _nan_max(k_lo, _nan_min(b1, b2) - widen)
+                    k_hi = _nan_min(k_hi, _nan_max(b1, b2) + widen)
+        out[m] = k_lo > k_hi

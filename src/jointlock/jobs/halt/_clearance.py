@@ -31,7 +31,7 @@ def clearance_report(motion: HaltMotion, settings: ClearanceSettings, sampled: C
     floor = np.minimum(allowed, d[0])
     shortfall = floor - d  # > 0: closer than allowed, and than at the start
     between = swept_clearance(
-        problem.model, motion.trajectory, t, floor, keep_out=settings.keep_out, sampled=(*motion.trajectory(t), d)
+        problem.model, motion.trajectory, t, floor, keep_out=settings.keep_out, sampled=(*motion.check_trajectory(), d)
     )
     collides = bool(np.any(shortfall > 0))
     at, pair = np.unravel_index(int(np.argmax(shortfall) if collides else np.argmin(d)), d.shape)

@@ -192,7 +192,7 @@ class HaltPlan(JobResult):
         """What ``jointlock halt --json`` prints: degrees, deg/s^6 for k, N m for torques."""
         res, p = self.motion, self.problem
         scale = K_UNIT_SCALE["deg/s^6"]
-        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        _, dq, ddq = res.check_trajectory()
         return {
             "robot": p.model.name,
             "base": p.base,
@@ -288,7 +288,7 @@ class HaltPlan(JobResult):
             return None
 
         def compute() -> Clearance:
-            q, _, _ = self.motion.trajectory(p.times(p.n_check))
+            q, _, _ = self.motion.check_trajectory()
             return clearance(p.model, q, keep_out=settings.keep_out, margin=settings.margin)
 
         return cached_on(self, "clearance", compute)
@@ -329,7 +329,7 @@ class HaltPlan(JobResult):
 
         def compute() -> AttitudeControlCheck:
             t = p.times(p.n_check)
-            q, dq, ddq = self.motion.trajectory(t)
+            q, dq, ddq = self.motion.check_trajectory()
             return attitude_control_check(p.model, t, q, dq, ddq, self.wheels)
 
         return cached_on(self, "attitude_control", compute)
@@ -348,7 +348,7 @@ class HaltPlan(JobResult):
         if p.model.locked and p.model.unlocked is None:
             return None
         t = p.times(p.n_check)
-        q, dq, ddq = self.motion.trajectory(t)
+        q, dq, ddq = self.motion.check_trajectory()
         return actuator_loads(p.model, t, q, dq, ddq, base=p.base)
 
     def margins(self) -> dict[str, np.ndarray]:
@@ -356,7 +356,7 @@ class HaltPlan(JobResult):
         :attr:`margin`): ``{"velocity": (n,), "acceleration": (n,), "torque": (n,), "brake":
         (n_locked,)}``, ``1 - peak / limit`` (0: at the limit; negative: broken; NaN: no limit)."""
         res, p = self.motion, self.problem
-        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        _, dq, ddq = res.check_trajectory()
         out = {
             "velocity": 1.0 - np.abs(dq).max(axis=0) / self.limits.velocity,
             "acceleration": 1.0 - np.abs(ddq).max(axis=0) / self.limits.acceleration,
@@ -510,7 +510,7 @@ class HaltPlan(JobResult):
             )
         if self.paper_scenario:  # 000's numbers belong to 000 §5's scenario on halt7 only
             lines.append(f"{_printed_text()} -- not reproduced, see docs/halt-motion.md")
-        _, dq, ddq = res.trajectory(p.times(p.n_check))
+        _, dq, ddq = res.check_trajectory()
         peak_v, peak_a = np.degrees(np.abs(dq).max(axis=0)), np.degrees(np.abs(ddq).max(axis=0))
         v_lim, a_lim = np.degrees(lim.velocity), np.degrees(lim.acceleration)
         m = self.margins()

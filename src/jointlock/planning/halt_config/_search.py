@@ -239,10 +239,8 @@ def optimal_halt_configuration(
         def keeps_clear(qs: FloatArray) -> np.ndarray:
             return ~clearance(model_locked, qs, keep_out=keep_out, witness=False).colliding(margin)
 
-        def cp_of(qs: FloatArray) -> FloatArray:  # exact()'s CP, bit for bit, in one compiled call in a worker
-            return ability.of_configurations(
-                model_locked, qs, jacobian=jacobian, characteristic_length=characteristic_length
-            )
+        # exact()'s CP, bit for bit, in one compiled call in a worker
+        cp_of = ability.evaluator(model_locked, jacobian=jacobian, characteristic_length=characteristic_length)
 
         refined_q, refined_cp, evaluations = _refine(
             cp_of, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None

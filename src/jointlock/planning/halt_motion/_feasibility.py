@@ -322,6 +322,16 @@ def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarr
     check times where ``phi`` or its derivative vanishes (no bound on ``k``) are left out."""
     n = problem.n_check
     picked = np.unique(np.r_[np.arange(0, n, SCREEN_STRIDE), n - 1])
+    lo, hi = _limits(problem)
+    if use_compiled(picked.size * np.size(halt_times), COMPILED_MIN_BATCH):  # a campaign's workers
+        from ... import _kernels
+
+        out = np.empty(np.size(halt_times), dtype=bool)
+        _kernels.screen_k_bounds(
+            np.asarray(halt_times, dtype=float).reshape(-1), picked, n, problem.q0, problem.dq0, problem.ddq0,
+            problem.qf, lo, hi, SCREEN_RTOL, out,
+        )  # fmt: skip
+        return out
     T = np.asarray(halt_times, dtype=float)[:, None, None]  # (m, 1, 1)
     # the check times exactly as problem.times (np.linspace) makes them: i * (T / (n - 1)), the
     # last one T itself
@@ -338,7 +348,6 @@ def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarr
         (ddq0, 6 * a3 * t, 12 * a4 * t**2, 20 * a5 * t**3),
     )
     shapes = k_shape(t, T)  # phi and its derivatives, every T at once (T broadcasts)
-    lo, hi = _limits(problem)
     k_lo = np.full(T.shape[0], -np.inf)
     k_hi = np.full(T.shape[0], np.inf)
     for kind in range(3):

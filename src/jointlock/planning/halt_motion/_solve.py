@@ -11,6 +11,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._cache import cached_on
 from ..._random import resolve_seed
 from ...errors import InfeasibleError, ScenarioError
 from ...model import FloatArray
@@ -131,6 +132,19 @@ class HaltMotion:
     def trajectory(self, t: ArrayLike | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, dq, ddq (n_t, n) of the optimal halt."""
         return self.problem.trajectory(self.k, t, per_joint=self.per_joint)
+
+    def check_trajectory(self) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """q, dq, ddq (n_check, n) of the optimal halt on the constraint grid
+        (``problem.times(problem.n_check)``), read-only: computed once, as the margins, the
+        clearance, the loads and the summary all look at it."""
+
+        def compute() -> tuple[FloatArray, FloatArray, FloatArray]:
+            sampled = self.trajectory(self.problem.times(self.problem.n_check))
+            for x in sampled:
+                x.setflags(write=False)
+            return sampled
+
+        return cached_on(self, "check_trajectory", compute)
 
 
 def _scan(problem: HaltProblem, lo: float, hi: float, n_scan: int) -> tuple[float, FloatArray, FloatArray]:
