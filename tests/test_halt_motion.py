@@ -748,16 +748,16 @@ def test_the_compiled_mean_torque_equals_numpys(base, about, rng, monkeypatch):
     per_joint = rng.uniform(-2e-4, 2e-4, (5, p.dof))
     for k, pj in ((shared, False), (per_joint, True)):
         reference = global_base_torque(p, k, per_joint=pj)
-        compiled = _compiled_mean_torque(dataclasses.replace(p, compiled=True), k, p.times(), pj)
+        compiled = _compiled_mean_torque(dataclasses.replace(p, compiled=True), k, pj)
         assert compiled is not None
         np.testing.assert_allclose(compiled, reference, rtol=1e-13)
         with monkeypatch.context() as m:
             m.setattr(_objective, "_compiled_mean_torque", lambda *a: None)
             through_rnea = global_base_torque(dataclasses.replace(p, compiled=True), k, per_joint=pj)
         assert np.array_equal(compiled, through_rnea)
-        assert _compiled_mean_torque(p, k, p.times(), pj) is None  # auto mode, few samples: numpy
+        assert _compiled_mean_torque(p, k, pj) is None  # auto mode, few samples: numpy
     huge = np.array([1e300])
-    assert _compiled_mean_torque(dataclasses.replace(p, compiled=True), huge, p.times(), False) is None
+    assert _compiled_mean_torque(dataclasses.replace(p, compiled=True), huge, False) is None
     with pytest.raises(jl.JointlockError, match="overflow"):
         global_base_torque(dataclasses.replace(p, compiled=True), huge)
 
@@ -861,6 +861,51 @@ def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
         assert np.array_equal(nested.relative_violation(grid[10:13]), relative_violation(p, grid[10:13]))
         assert least_violating_k(p) == _reference_least_violating_k(p)
     assert checked >= 3
+
+
+def test_the_compiled_least_violation_scan_is_every_limits_bit_for_bit(rng, monkeypatch):
+    """least_violating_k's scan in the compiled mode "always" (jointlock._kernels.
+    least_violation_scan, the halving with pruning in one call) gives the relative violation of
+    every limit at every check time, bit for bit, on grids of several lengths (stretches of
+    one value, of SCAN_STRETCH and beyond), limits without an angle bound, and a NaN state; and
+    least_violating_k gives the full scan's k."""
+    from jointlock import _kernels
+    from jointlock.planning.halt_motion import relative_violation
+    from jointlock.planning.halt_motion._feasibility import SCAN_STRETCH, _Limits, least_violating_k
+
+    calls = []
+    kernel = _kernels.least_violation_scan
+    monkeypatch.setattr(_kernels, "least_violation_scan", lambda *a: (calls.append(1), kernel(*a))[1])
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    base = _problem()
+    problems = [
+        base,
+        *_varied_problems(rng, 6),
+        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf), T=2.0),
+    ]
+    infeasible = 0
+    for p in problems:
+        limits = _Limits.of(p)
+        for size, stretch in ((801, SCAN_STRETCH), (57, SCAN_STRETCH), (25, SCAN_STRETCH), (40, 1), (1, 3)):
+            span = float(rng.uniform(1e-5, 1e-3))
+            grid = np.linspace(-span, span, size)
+            out = np.full(size, np.nan)
+            kernel(*(getattr(limits.within(grid[0], grid[-1]), f) for f in ("base", "shape", "lo", "hi", "scale")),
+                   grid, stretch, out)  # fmt: skip
+            assert np.array_equal(out, relative_violation(p, grid))
+        lo, hi = shared_k_interval(p)
+        if lo > hi:
+            infeasible += 1
+            with jl.compiled_kernels("always"):
+                assert least_violating_k(p) == _reference_least_violating_k(p)
+    assert infeasible >= 3 and len(calls) == infeasible
+    nan_limits = _Limits.of(base)
+    shape = nan_limits.shape.copy()
+    shape[100] = np.nan
+    out = np.empty(30)
+    grid = np.linspace(-1e-4, 1e-4, 30)
+    kernel(nan_limits.base, shape, nan_limits.lo, nan_limits.hi, nan_limits.scale, grid, 4, out)
+    assert np.isnan(out).all()  # a NaN limit is never pruned: every value is NaN, as numpy's
 
 
 def test_the_compiled_k_intervals_are_numpys_bit_for_bit(rng, monkeypatch):

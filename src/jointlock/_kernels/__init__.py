@@ -62,7 +62,7 @@ from ._arm import (
 )
 from ._common import BLOCK, MAX_SWEEPS, TRIG_LIMIT, sincos
 from ._dynamics import rnea_fixed, rnea_floating
-from ._halt import base_moment_norms, k_intervals, screen_k_bounds
+from ._halt import base_moment_norms, k_intervals, least_violation_scan, screen_k_bounds
 from ._jump import fixed_frame, integrate_steps, rate_law
 from ._svd import singular_values
 
@@ -80,6 +80,7 @@ __all__ = [
     "integrate_steps",
     "jacobian",
     "k_intervals",
+    "least_violation_scan",
     "rate_law",
     "rnea_fixed",
     "rnea_floating",

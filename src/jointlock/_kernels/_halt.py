@@ -20,7 +20,7 @@ import math
 
 import numpy as np
 
-from ._common import _jit, _nan_max, _nan_min
+from ._common import _EPS, _jit, _nan_max, _nan_min
 from ._dynamics import rnea_fixed, rnea_floating
 
 #: Samples per Newton-Euler call: the work arrays of a chunk stay in L2.
@@ -167,3 +167,94 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
                     k_lo = _nan_max(k_lo, _nan_min(b1, b2) - widen)
                     k_hi = _nan_min(k_hi, _nan_max(b1, b2) + widen)
         out[m] = k_lo > k_hi
+
+
+@_jit
+def _within(base, shape, lo, hi, scale, k_lo, k_hi, parent, count, child):
+    """The limits of ``parent[:count]`` that can give the largest excess for some ``k`` in
+    ``[k_lo, k_hi]`` into ``child``; returns how many (the test of
+    ``jointlock.planning.halt_motion._feasibility._Limits.within``, which keeps every limit
+    when a bound is not finite)."""
+    inf = np.inf
+    floor = -inf
+    for c in range(count):
+        i = parent[c]
+        a, b = base[i] + k_lo * shape[i], base[i] + k_hi * shape[i]
+        up = _nan_min((a - hi[i]) / scale[i], (b - hi[i]) / scale[i])
+        down = _nan_min((lo[i] - a) / scale[i], (lo[i] - b) / scale[i])
+        if up != up or down != down:
+            floor = np.nan
+            break
+        floor = max(floor, up, down)
+    if not math.isfinite(floor):
+        for c in range(count):
+            child[c] = parent[c]
+        return count
+    k_big = max(abs(k_lo), abs(k_hi))
+    kept = 0
+    for c in range(count):
+        i = parent[c]
+        a, b = base[i] + k_lo * shape[i], base[i] + k_hi * shape[i]
+        up = _nan_max((a - hi[i]) / scale[i], (b - hi[i]) / scale[i])
+        down = _nan_max((lo[i] - a) / scale[i], (lo[i] - b) / scale[i])
+        lo_f = abs(lo[i]) if math.isfinite(lo[i]) else 0.0
+        hi_f = abs(hi[i]) if math.isfinite(hi[i]) else 0.0
+        terms = abs(base[i]) + k_big * abs(shape[i]) + max(lo_f, hi_f)
+        margin = 1e-6 * (1.0 + abs(floor)) + 64 * _EPS * terms / scale[i]
+        if not (up < floor - margin and down < floor - margin):
+            child[kept] = i
+            kept += 1
+    return kept
+
+
+@_jit
+def least_violation_scan(base, shape, lo, hi, scale, grid, stretch, out):
+    """The largest relative limit excess (0 when within every limit) of the halt at each
+    ``k`` of ``grid`` (m,) [rad/s^6], ``out`` (m,): the scan of
+    :func:`jointlock.planning.halt_motion.least_violating_k`, the same numbers bit for bit.
+
+    The limits (L,) are the flat terms of ``_Limits`` (``traj = base + k shape`` against
+    ``[lo, hi]``, an excess divided by ``scale``).  As the numpy route, the grid is halved
+    down to stretches of at most ``stretch`` values, each half keeping only the limits of its
+    parent that can still be the largest in it (:func:`_within`); a value is
+    ``max(max((traj - hi), (lo - traj)) / scale over the kept limits, 0)``, the numpy route's
+    operations, and a maximum is exact, so which limits are pruned cannot change it.
+    """
+    n_limits, m = base.shape[0], grid.shape[0]
+    depth = 1
+    size = m
+    while size > stretch:
+        size -= size // 2
+        depth += 1
+    kept = np.empty((depth + 1, max(n_limits, 1)), dtype=np.int64)
+    counts = np.zeros(depth + 1, dtype=np.int64)
+    for i in range(n_limits):
+        kept[0, i] = i
+    counts[0] = n_limits
+    # depth-first over the halves: a node's kept limits are in row ``level``, its parent's
+    # (which its sibling still needs) in the row above, untouched by the node's own subtree
+    stack = np.empty((2 * depth + 2, 3), dtype=np.int64)
+    stack[0, 0], stack[0, 1], stack[0, 2] = 0, m, 0
+    top = 1
+    while top > 0:
+        top -= 1
+        start, stop, level = stack[top, 0], stack[top, 1], stack[top, 2]
+        if level > 0:
+            counts[level] = _within(
+                base, shape, lo, hi, scale, grid[start], grid[stop - 1], kept[level - 1], counts[level - 1], kept[level]
+            )
+        if stop - start > stretch:
+            middle = start + (stop - start) // 2
+            stack[top, 0], stack[top, 1], stack[top, 2] = middle, stop, level + 1  # right, after the left
+            stack[top + 1, 0], stack[top + 1, 1], stack[top + 1, 2] = start, middle, level + 1
+            top += 2
+            continue
+        row = kept[level]
+        for g in range(start, stop):
+            k = grid[g]
+            worst = -np.inf
+            for c in range(counts[level]):
+                i = row[c]
+                traj = base[i] + k * shape[i]
+                worst = _nan_max(worst, _nan_max(traj - hi[i], lo[i] - traj) / scale[i])
+            out[g] = _nan_max(worst, 0.0)

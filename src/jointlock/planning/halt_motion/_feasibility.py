@@ -76,17 +76,17 @@ def feasible_k_intervals(problem: HaltProblem) -> FloatArray:
     (n, 2) ``[k_min, k_max]`` per joint [rad/s^6]; ``k_min > k_max`` (or NaN-free
     ``+inf/-inf``) when empty.
     """
-    t = problem.times(problem.n_check)
-    base = np.stack(problem.base_profile(t))  # (3, n_t, n)
+    t, base_parts, shape_parts = problem.profiles(problem.n_check)
+    base = np.stack(base_parts)  # (3, n_t, n)
     lo, hi = _limits(problem)
     sl = _slack(lo, hi)
     if use_compiled(t.size, COMPILED_MIN_BATCH):  # the same numbers, one pass (a campaign's workers)
         from ... import _kernels
 
         out = np.empty((problem.dof, 2))
-        _kernels.k_intervals(base, np.stack(problem.k_shape(t)), lo, hi, lo - sl, hi + sl, out)
+        _kernels.k_intervals(base, np.stack(shape_parts), lo, hi, lo - sl, hi + sl, out)
         return out
-    shape = np.stack(problem.k_shape(t))[:, :, None]  # (3, n_t, 1)
+    shape = np.stack(shape_parts)[:, :, None]  # (3, n_t, 1)
     lo_s, hi_s = (lo - sl)[:, None, :], (hi + sl)[:, None, :]
     nz = np.abs(shape) > 0
     safe = np.where(nz, shape, 1.0)
@@ -172,7 +172,15 @@ def least_violating_k(problem: HaltProblem) -> float:
         halves = part[: part.size // 2], part[part.size // 2 :]
         return np.concatenate([scan(kept.within(float(h[0]), float(h[-1])), h) for h in halves])
 
-    viol = scan(limits, grid)
+    if use_compiled(grid.size * limits.count, COMPILED_MIN_BATCH):  # the same numbers, one call (workers)
+        from ... import _kernels
+
+        viol = np.empty(grid.size)
+        _kernels.least_violation_scan(
+            limits.base, limits.shape, limits.lo, limits.hi, limits.scale, grid, SCAN_STRETCH, viol
+        )
+    else:
+        viol = scan(limits, grid)
     i = int(np.argmin(viol))
     a, b = grid[max(i - 1, 0)], grid[min(i + 1, grid.size - 1)]
     from scipy.optimize import minimize_scalar  # on first use: scipy.optimize takes ~0.5 s to import
@@ -213,10 +221,10 @@ class _Limits:
     @classmethod
     def of(cls, problem: HaltProblem) -> _Limits:
         """Every limit of ``problem`` at every check time (3 x n_check x n)."""
-        t = problem.times(problem.n_check)
+        _, base_parts, shape_parts = problem.profiles(problem.n_check)
         lo, hi = _limits(problem)
-        base = np.stack(problem.base_profile(t))  # (3, n_t, n)
-        shape = np.broadcast_to(np.stack(problem.k_shape(t))[..., None], base.shape)  # (3, n_t, n)
+        base = np.stack(base_parts)  # (3, n_t, n)
+        shape = np.broadcast_to(np.stack(shape_parts)[..., None], base.shape)  # (3, n_t, n)
         scale = np.maximum(np.abs(lo), np.abs(hi))
         scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
         full = np.broadcast_arrays(base, shape, lo[:, None, :], hi[:, None, :], scale)

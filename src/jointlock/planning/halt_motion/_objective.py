@@ -27,7 +27,7 @@ def _simpson_mean(values: FloatArray, T: float) -> FloatArray:
     return values @ w / (3.0 * (n - 1))
 
 
-def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, per_joint: bool) -> FloatArray | None:
+def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, per_joint: bool) -> FloatArray | None:
     """:func:`global_base_torque` of the candidates ``k`` ((m,) shared or (m, n)) by one compiled
     call (:func:`jointlock._kernels.base_moment_norms`: the halts sampled, Newton-Euler and the
     norm, no array of samples) and Simpson's average, where :func:`~jointlock.dynamics.rnea`
@@ -35,6 +35,7 @@ def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, pe
     mode): the same numbers to the bit.  None where the numpy route runs, and where a
     sample's torque is not finite or its system inertia singular (the numpy route says
     which)."""
+    t, base, shape = problem.profiles()  # the objective's grid
     compiled = problem.compiled
     if compiled is None:
         compiled = use_compiled(k.shape[0] * t.size, COMPILED_MIN_BATCH)
@@ -51,7 +52,6 @@ def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, t: FloatArray, pe
     )  # fmt: skip
     point = model.root_body.com if problem.moment_point is None else problem.moment_point
     kk = np.ascontiguousarray(k if per_joint else np.broadcast_to(k[:, None], (k.shape[0], problem.dof)), dtype=float)
-    base, shape = problem.base_profile(t), problem.k_shape(t)
     norms = np.empty((k.shape[0], t.size))
     samples = tuple(kernel_input(x) for x in (*base, *shape))
     rest = (kk, floating, *links[0], links[1], np.zeros(3), np.array(point, dtype=float), norms)
@@ -105,9 +105,9 @@ def global_base_torque(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = 
     out = np.empty(flat.shape[0])
     for start in range(0, flat.shape[0], step):  # chunks of candidates, not samples
         part = flat[start : start + step]
-        fast = _compiled_mean_torque(problem, part, t, per_joint)
+        fast = _compiled_mean_torque(problem, part, per_joint)
         if fast is None:
-            torque = base_torque_history(problem, part, t, per_joint=per_joint)
+            torque = base_torque_history(problem, part, per_joint=per_joint)  # on the cached grid
             fast = _simpson_mean(np.linalg.norm(torque, axis=-1), problem.T)
         out[start : start + step] = fast
     return out.reshape(batch)
@@ -131,7 +131,7 @@ def _per_candidate(problem: HaltProblem, k: ArrayLike, per_joint: bool, reduce) 
     step = max(1, CHUNK_SAMPLES // t.size)
     out = np.empty(flat.shape[0])
     for start in range(0, flat.shape[0], step):
-        q, dq, ddq = problem.trajectory(flat[start : start + step], t, per_joint=per_joint)
+        q, dq, ddq = problem.trajectory(flat[start : start + step], per_joint=per_joint)  # on the cached grid
         out[start : start + step] = reduce(q, dq, ddq, t)
     return out.reshape(batch)
 

@@ -9,6 +9,7 @@ from typing import Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
+from ..._cache import cached_on
 from ...dynamics import BaseMode
 from ...errors import ScenarioError
 from ...model import ArmModel, FloatArray
@@ -201,6 +202,23 @@ class HaltProblem:
         """(n,) uniform times [s] from 0 to T (``n_samples`` points by default)."""
         return np.linspace(0.0, self.T, self.n_samples if n is None else n)
 
+    def profiles(
+        self, n: int | None = None
+    ) -> tuple[FloatArray, tuple[FloatArray, FloatArray, FloatArray], tuple[FloatArray, FloatArray, FloatArray]]:
+        """``(t, base_profile(t), k_shape(t))`` on ``t = times(n)``, read-only, computed once per
+        problem and grid: the optimal ``k``'s scan and bounded search evaluate the objective on
+        the same grid some 30 times, the limits are checked on the same grid by several
+        steps, and each time the halt polynomial's powers cost about as much as the rest."""
+
+        def compute() -> tuple[FloatArray, tuple[FloatArray, ...], tuple[FloatArray, ...]]:
+            t = self.times(n)
+            base, shape = self.base_profile(t), self.k_shape(t)
+            for x in (t, *base, *shape):
+                x.setflags(write=False)
+            return t, base, shape
+
+        return cached_on(self, f"profiles_{self.n_samples if n is None else n}", compute)  # type: ignore[return-value]
+
     def base_profile(self, t: ArrayLike) -> tuple[FloatArray, FloatArray, FloatArray]:
         """The ``k = 0`` (quintic) part: q, dq, ddq each (n_t, n)."""
         coef = halt_coefficients(self.q0, self.dq0, self.ddq0, self.qf, self.T, 0.0)
@@ -228,10 +246,12 @@ class HaltProblem:
         q, dq, ddq
             each (..., n_t, n) [rad, rad/s, rad/s^2].
         """
-        t = self.times() if t is None else np.asarray(t, dtype=float)
         k = _k_array(k, self.dof, per_joint)
-        base = self.base_profile(t)
-        shape = self.k_shape(t)
+        if t is None:
+            t, base, shape = self.profiles()
+        else:
+            t = np.asarray(t, dtype=float)
+            base, shape = self.base_profile(t), self.k_shape(t)
         kk = k[..., None, :]
         return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
 
