@@ -908,6 +908,31 @@ def test_the_compiled_least_violation_scan_is_every_limits_bit_for_bit(rng, monk
     assert np.isnan(out).all()  # a NaN limit is never pruned: every value is NaN, as numpy's
 
 
+def test_the_halt_on_its_cached_grid_is_the_halt_at_those_times_bit_for_bit(rng):
+    """HaltProblem.on_grid (the polynomial and its k part computed once per grid, issue 29)
+    gives trajectory() at the same times, bit for bit, on the whole grid and on any part of it
+    (the clearance screen's strides, a head, a random mask): the halt at a time does not depend
+    on the other times it is evaluated with.  The cached arrays cannot be written."""
+    for p in [_problem(), *_varied_problems(rng, 5)]:
+        k = rng.uniform(-1e-4, 1e-4, 3)
+        t = p.times(p.n_check)
+        masks = [np.zeros(t.size, dtype=bool) for _ in range(4)]
+        masks[0][::16] = True
+        masks[1][::128] = masks[1][-1] = True
+        masks[2][:9] = True
+        masks[3] = rng.random(t.size) < 0.3
+        for n, index, times in [(None, None, p.times()), (p.n_check, None, t)] + [(p.n_check, m, t[m]) for m in masks]:
+            for got, want in zip(p.on_grid(k, n, index), p.trajectory(k, times)):
+                assert np.array_equal(got, want)
+        per = rng.uniform(-1e-4, 1e-4, (2, p.dof))
+        for got, want in zip(p.on_grid(per, p.n_check, per_joint=True), p.trajectory(per, t, per_joint=True)):
+            assert np.array_equal(got, want)
+        grid, base, shape = p.profiles(p.n_check)
+        with pytest.raises(ValueError, match="read-only"):
+            base[0][0, 0] = 1.0
+        assert p.profiles(p.n_check)[1] is base  # once per grid
+
+
 def test_the_compiled_k_intervals_are_numpys_bit_for_bit(rng, monkeypatch):
     """feasible_k_intervals in the compiled mode "always" (jointlock._kernels.k_intervals, one
     pass) gives numpy's intervals bit for bit: varied problems, no angle limits (infinite

@@ -367,15 +367,22 @@ def kernel_mass_program(model: ArmModel) -> tuple[FloatArray, FloatArray, FloatA
 def kernel_link_arrays(model: ArmModel, origin: FloatArray) -> tuple[FloatArray, ...]:
     """The links of :func:`link_constants` (parent of link 1 moved to ``origin`` (3,) [m]) as
     the Newton-Euler kernels (:mod:`jointlock._kernels._dynamics`) take them: ``E`` (n, 3, 3),
-    ``p`` (n, 3) [m], mass (n,) [kg], centre of mass (n, 3) [m], inertia (n, 3, 3) [kg m^2]."""
-    links = link_constants(model, origin)
-    return (
-        np.ascontiguousarray([link.rot for link in links], dtype=float),
-        np.ascontiguousarray([link.pos for link in links], dtype=float),
-        np.array([link.mass for link in links], dtype=float),
-        np.ascontiguousarray([link.com for link in links], dtype=float),
-        np.ascontiguousarray([link.inertia for link in links], dtype=float),
-    )
+    ``p`` (n, 3) [m], mass (n,) [kg], centre of mass (n, 3) [m], inertia (n, 3, 3) [kg m^2].
+    Made once per model and origin and shared (a halt case asks for them ~10 times, 0.3 ms
+    each): writable, as every kernel takes its arrays (:func:`kernel_input`), and never written."""
+    at = np.asarray(origin, dtype=float).reshape(3)
+
+    def compute() -> tuple[FloatArray, ...]:
+        links = link_constants(model, at)
+        return (
+            np.ascontiguousarray([link.rot for link in links], dtype=float),
+            np.ascontiguousarray([link.pos for link in links], dtype=float),
+            np.array([link.mass for link in links], dtype=float),
+            np.ascontiguousarray([link.com for link in links], dtype=float),
+            np.ascontiguousarray([link.inertia for link in links], dtype=float),
+        )
+
+    return cached_on(model, "kernel_link_arrays_" + at.tobytes().hex(), compute)
 
 
 def kernel_root(model: ArmModel) -> FloatArray:

@@ -48,7 +48,7 @@ def actuator_peaks(problem: HaltProblem, k: ArrayLike) -> tuple[FloatArray, Floa
     brake = np.empty((flat.size, n_locked))
     step = max(1, CHUNK_SAMPLES // t.size)
     for start in range(0, flat.size, step):  # chunks of candidates, not of time samples
-        q, dq, ddq = problem.trajectory(flat[start : start + step], t)
+        q, dq, ddq = problem.on_grid(flat[start : start + step], problem.n_check)
         m, b = actuator_torques(problem.model, q, dq, ddq, base=problem.base)
         motor[start : start + step] = np.abs(m).max(axis=-2)
         brake[start : start + step] = np.abs(b).max(axis=-2) if n_locked else b[..., 0, :]
@@ -77,7 +77,7 @@ def torque_feasible_segments(
 def torque_violations(problem: HaltProblem, k: float) -> tuple[Violation, ...]:
     """Every motor or brake torque limit the halt at ``k`` breaks (SI: N m), worst first."""
     t = problem.times(problem.n_check)
-    q, dq, ddq = problem.trajectory(np.asarray(k, dtype=float), t)
+    q, dq, ddq = problem.on_grid(np.asarray(k, dtype=float), problem.n_check)
     motor, brake = actuator_torques(problem.model, q, dq, ddq, base=problem.base)
     tau_max, brake_max = problem.torque_limits()
     out = []

@@ -94,16 +94,17 @@ def _floor(problem: HaltProblem, margin: float, keep_out: Sequence[Shape]) -> Fl
 
 
 def _shortfall_at(
-    problem: HaltProblem, k: FloatArray, t: FloatArray, floor: FloatArray, keep_out: Sequence[Shape]
+    problem: HaltProblem, k: FloatArray, index: np.ndarray, floor: FloatArray, keep_out: Sequence[Shape]
 ) -> FloatArray:
-    """(K,) the largest shortfall [m] of the halts at ``k`` (K,) over the times ``t`` (n_t,)
-    (-inf when there are no times)."""
-    if t.size == 0:
+    """(K,) the largest shortfall [m] of the halts at ``k`` (K,) over the check times
+    ``times(n_check)[index]`` (``index``: a mask of the check grid; -inf when there are none)."""
+    n_t = int(np.count_nonzero(index))
+    if n_t == 0:
         return np.full(k.size, -np.inf)
     out = np.empty(k.size)
-    step = max(1, CHUNK_SAMPLES // t.size)
+    step = max(1, CHUNK_SAMPLES // n_t)
     for start in range(0, k.size, step):
-        q, _, _ = problem.trajectory(k[start : start + step], t)
+        q, _, _ = problem.on_grid(k[start : start + step], problem.n_check, index)
         distance = clearance(problem.model, q, keep_out=keep_out, witness=False).pair_distance  # (K, n_t, P)
         out[start : start + step] = (floor - distance).max(axis=(-2, -1)) if distance.shape[-1] else -np.inf
     return out
@@ -144,7 +145,7 @@ def keeps_clearance(
         level &= ~seen
         alive = screen <= 0.0
         if alive.any() and level.any():
-            screen[alive] = np.maximum(screen[alive], _shortfall_at(problem, k[alive], t[level], floor, keep_out))
+            screen[alive] = np.maximum(screen[alive], _shortfall_at(problem, k[alive], level, floor, keep_out))
         seen |= level
     survivors = np.flatnonzero(screen <= 0.0)
     if any_one:  # the clearest on the screen first
@@ -161,7 +162,7 @@ def _clear_everywhere(
     problem: HaltProblem, k: float, t: FloatArray, floor: FloatArray, keep_out: Sequence[Shape]
 ) -> bool:
     """Whether the halt at ``k`` keeps ``floor`` on every check time ``t`` and between them."""
-    q, dq, ddq = problem.trajectory(k, t)
+    q, dq, ddq = problem.on_grid(k, problem.n_check)
     distance = clearance(problem.model, q, keep_out=keep_out, witness=False).pair_distance
     if distance.shape[-1] and float((floor - distance).max()) > 0.0:
         return False

@@ -110,9 +110,8 @@ def shared_k_interval(problem: HaltProblem) -> tuple[float, float]:
 def relative_violation(problem: HaltProblem, k: ArrayLike, *, per_joint: bool = False) -> FloatArray:
     """Largest limit excess relative to its limit (0 when feasible), for a batch of ``k``:
     (...) [-]; a number per candidate, max over joints, limits and the check grid."""
-    t = problem.times(problem.n_check)
     lo, hi = _limits(problem)
-    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint), axis=-3)  # (..., 3, n_t, n)
+    traj = np.stack(problem.on_grid(k, problem.n_check, per_joint=per_joint), axis=-3)  # (..., 3, n_t, n)
     scale = np.maximum(np.abs(lo), np.abs(hi))
     scale = np.where(np.isfinite(scale), scale, 1.0)[:, None, :]  # no angle limit: never exceeded
     excess = np.maximum(traj - hi[:, None, :], lo[:, None, :] - traj) / scale
@@ -127,7 +126,7 @@ def constraint_violations(
     t = problem.times(problem.n_check)
     lo, hi = _limits(problem)
     sl = _slack(lo, hi)
-    traj = np.stack(problem.trajectory(k, t, per_joint=per_joint))  # (3, n_t, n)
+    traj = np.stack(problem.on_grid(k, problem.n_check, per_joint=per_joint))  # (3, n_t, n)
     over = traj - hi[:, None, :]
     under = lo[:, None, :] - traj
     out = []

@@ -6,7 +6,6 @@ from __future__ import annotations
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._cache import cached_on
 from ..._chain import kernel_input, kernel_link_arrays, kernel_root
 from ...analysis.spacecraft import final_attitude_change_deg
 from ...compiled import use_compiled
@@ -44,12 +43,8 @@ def _compiled_mean_torque(problem: HaltProblem, k: FloatArray, per_joint: bool) 
     from ... import _kernels  # numba on first use
 
     model, floating = problem.model, problem.base == "floating"
-    links = cached_on(
-        model,
-        f"halt_objective_links_{problem.base}",
-        lambda: (kernel_link_arrays(model, model.root_body.com if floating else np.zeros(3)),
-                 kernel_root(model) if floating else np.zeros(13)),
-    )  # fmt: skip
+    links = (kernel_link_arrays(model, model.root_body.com if floating else np.zeros(3)),
+             kernel_root(model) if floating else np.zeros(13))  # fmt: skip
     point = model.root_body.com if problem.moment_point is None else problem.moment_point
     kk = np.ascontiguousarray(k if per_joint else np.broadcast_to(k[:, None], (k.shape[0], problem.dof)), dtype=float)
     norms = np.empty((k.shape[0], t.size))

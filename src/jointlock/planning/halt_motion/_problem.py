@@ -246,12 +246,25 @@ class HaltProblem:
         q, dq, ddq
             each (..., n_t, n) [rad, rad/s, rad/s^2].
         """
-        k = _k_array(k, self.dof, per_joint)
         if t is None:
-            t, base, shape = self.profiles()
-        else:
-            t = np.asarray(t, dtype=float)
-            base, shape = self.base_profile(t), self.k_shape(t)
+            return self.on_grid(k, per_joint=per_joint)
+        k = _k_array(k, self.dof, per_joint)
+        t = np.asarray(t, dtype=float)
+        base, shape = self.base_profile(t), self.k_shape(t)
+        kk = k[..., None, :]
+        return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+
+    def on_grid(
+        self, k: ArrayLike, n: int | None = None, index: np.ndarray | None = None, *, per_joint: bool = False
+    ) -> tuple[FloatArray, FloatArray, FloatArray]:
+        """:meth:`trajectory` on ``times(n)`` (``n_samples`` by default; ``n_check``: the
+        constraint grid), or on the times ``times(n)[index]``, from :meth:`profiles`: the same
+        numbers, as the halt polynomial at a time does not depend on the other times it is
+        evaluated with (``tests/test_halt_motion.py``), without evaluating it again."""
+        k = _k_array(k, self.dof, per_joint)
+        _, base, shape = self.profiles(n)
+        if index is not None:
+            base, shape = tuple(b[index] for b in base), tuple(s[index] for s in shape)
         kk = k[..., None, :]
         return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
 

@@ -22,10 +22,9 @@ def limit_margins(problem: HaltProblem, k: FloatArray) -> FloatArray:
     the problem's constraint grid (negative: broken)."""
     k = np.asarray(k, dtype=float)
     flat = k.reshape(-1)
-    t = problem.times(problem.n_check)
     parts = []
     for start in range(0, flat.size, _CHUNK):
-        _, dq, ddq = problem.trajectory(flat[start : start + _CHUNK], t)
+        _, dq, ddq = problem.on_grid(flat[start : start + _CHUNK], problem.n_check)
         parts.append(
             np.concatenate(
                 [1.0 - np.abs(dq).max(axis=-2) / problem.dq_max, 1.0 - np.abs(ddq).max(axis=-2) / problem.ddq_max],

@@ -139,7 +139,7 @@ class HaltMotion:
         clearance, the loads and the summary all look at it."""
 
         def compute() -> tuple[FloatArray, FloatArray, FloatArray]:
-            sampled = self.trajectory(self.problem.times(self.problem.n_check))
+            sampled = self.problem.on_grid(self.k, self.problem.n_check, per_joint=self.per_joint)
             for x in sampled:
                 x.setflags(write=False)
             return sampled
