@@ -566,3 +566,70 @@ def test_cp_of_configurations_in_one_compiled_call_is_the_indices_route(result, 
             ability.of_configurations(floating4, np.full((2, 5), np.nan), jacobian="spatial")
         with pytest.raises(ConfigurationError):  # weights are checked, not read past their end
             dataclasses.replace(ability, weights=np.ones(2)).of_configurations(floating4, q[0])
+
+
+def test_lbfgsb_in_lockstep_is_minimize_bit_for_bit(rng):
+    """minimize_lockstep (issue 29: the refinement's starts stepped together, their evaluations
+    in one call) ends each start where scipy's minimize(method="L-BFGS-B") ends it, bit for
+    bit: starts converging after different numbers of steps, on a bound, near one, and the
+    evaluation count (minimize's memo: no evaluation at the x just evaluated, as at the start)."""
+    from scipy.optimize import minimize
+
+    from jointlock.planning.halt_config._lockstep import lockstep_available, minimize_lockstep
+
+    if not lockstep_available():
+        pytest.skip("this scipy's L-BFGS-B is not driven in lockstep (the refinement runs minimize per start)")
+    n = 5
+    lo, hi = np.full(n, -2.0), np.array([2.0, 2.0, 0.5, 2.0, 2.0])
+    centre = np.array([0.3, -1.1, 0.9, 0.0, 1.7])  # joint 3's optimum is outside the box
+
+    def fun(x):
+        d = x - centre
+        return float(np.sum(d**2) + 0.1 * np.sum(d**4) + np.sin(3 * x[0])), 2 * d + 0.4 * d**3 + np.r_[3 * np.cos(3 * x[0]), np.zeros(n - 1)]
+
+    counted = {"alone": 0, "together": 0}
+
+    def alone(x):
+        counted["alone"] += 1
+        return fun(x)
+
+    def together(xs):
+        counted["together"] += xs.shape[0]
+        parts = [fun(x) for x in xs]
+        return np.array([f for f, _ in parts]), np.array([g for _, g in parts])
+
+    starts = np.vstack([rng.uniform(-2.0, 2.0, (5, n)), hi, lo + 1e-3])
+    reference = np.array([minimize(alone, s, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi))).x for s in starts])
+    final = minimize_lockstep(together, starts, lo, hi)
+    assert np.array_equal(final, reference) and counted["together"] == counted["alone"]
+    assert not np.array_equal(final[0], starts[0])
+
+
+def test_the_refinement_in_lockstep_is_one_start_at_a_time_bit_for_bit(floating4, fixed4, monkeypatch):
+    """The halt configuration's refinement with its starts in lockstep (a worker: every CP batch
+    compiled) gives the configurations, CP and evaluation count of one minimize per start,
+    on a floating and a fixed base."""
+    from jointlock.planning.halt_config import _search
+    from jointlock.planning.halt_config._lockstep import lockstep_available
+    from jointlock.planning.halt_config._refine import _refine
+
+    if not lockstep_available():
+        pytest.skip("this scipy's L-BFGS-B is not driven in lockstep")
+    seen = []
+
+    def one_at_a_time(*args, lockstep=False, **kwargs):
+        seen.append(lockstep)
+        together = _refine(*args, lockstep=lockstep, **kwargs)
+        alone = _refine(*args, lockstep=False, **kwargs)
+        assert together[2] == alone[2]
+        assert all(np.array_equal(a, b) for a, b in zip(together[0], alone[0])) and together[1] == alone[1]
+        return together
+
+    monkeypatch.setattr(_search, "_refine", one_at_a_time)
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    with jl.compiled_kernels("always"):
+        for model in (floating4, fixed4):
+            optimal_halt_configuration(model, samples=400, rng=3, refine_starts=4)
+    assert seen == [True, True]
+    optimal_halt_configuration(floating4, samples=400, rng=3, refine_starts=2)  # auto: numpy's CP
+    assert seen == [True, True, False]

@@ -9,6 +9,7 @@ from collections.abc import Callable
 import numpy as np
 
 from ...model import FloatArray
+from ._lockstep import lockstep_available, minimize_lockstep
 from ._reachability import HaltReachability
 
 #: Central-difference step of the refinement's gradient [rad]; CP is smooth away from
@@ -23,10 +24,16 @@ def _refine(
     hi: FloatArray,
     reach: HaltReachability | None,
     keeps_clear: Callable[[FloatArray], np.ndarray] | None = None,
+    *,
+    lockstep: bool = False,
 ) -> tuple[list[FloatArray], list[float], int]:
     """Maximise CP from each start (m, n) [rad] inside the box ``[lo, hi]``.
 
-    ``cp_of(qs)`` gives CP (k,) of configurations (k, n) on the frozen scale.
+    ``cp_of(qs)`` gives CP (k,) of configurations (k, n) on the frozen scale.  ``lockstep``:
+    the starts run together, each step's evaluations in one call of ``cp_of``
+    (:func:`~._lockstep.minimize_lockstep`; the same points as one ``minimize`` per start,
+    bit for bit, where ``cp_of`` gives a configuration the CP it gives it alone: the
+    compiled kernel's), where this scipy allows it and the box has no fixed joint.
     A refined point that leaves the reachable set (``reach``) is pulled back along the segment
     from its start (reachable; the set is convex).  With ``keeps_clear`` (configurations
     (k, n) -> (k,) bool, the clearance constraint, whose set is not convex) a refined point is
@@ -45,20 +52,35 @@ def _refine(
     evaluations = 0
     steps = REFINE_FD_STEP * np.vstack([np.zeros(n), np.eye(n), -np.eye(n)])  # (2n+1, n)
 
-    def fun(x: FloatArray) -> tuple[float, FloatArray]:
-        nonlocal evaluations
-        pts = np.clip(x + steps, lo, hi)
-        val = cp_of(pts)
-        evaluations += pts.shape[0]
+    def value_and_gradient(pts: FloatArray, val: FloatArray) -> tuple[float, FloatArray]:
+        """-CP and its central-difference gradient at a point, from its 2n+1 points (the point,
+        then +h and -h along each joint, clipped) and their CP."""
         h = np.diagonal(pts[1 : n + 1]) - np.diagonal(pts[n + 1 :])  # per-joint step
         grad = np.divide(val[1 : n + 1] - val[n + 1 :], h, out=np.zeros(n), where=h > 0)
         return -float(val[0]), -grad
 
+    def fun(x: FloatArray) -> tuple[float, FloatArray]:
+        nonlocal evaluations
+        pts = np.clip(x + steps, lo, hi)
+        evaluations += pts.shape[0]
+        return value_and_gradient(pts, cp_of(pts))
+
+    def evaluate(xs: FloatArray) -> tuple[FloatArray, FloatArray]:  # several points, one call
+        nonlocal evaluations
+        pts = np.clip(xs[:, None, :] + steps, lo, hi)  # (k, 2n+1, n)
+        evaluations += pts.shape[0] * pts.shape[1]
+        val = cp_of(pts.reshape(-1, n)).reshape(pts.shape[:2])
+        parts = [value_and_gradient(p, v) for p, v in zip(pts, val)]
+        return np.array([f for f, _ in parts]), np.array([g for _, g in parts]).reshape(-1, n)
+
+    if lockstep and starts.shape[0] and lockstep_available() and np.all(lo < hi) and np.all(np.isfinite([lo, hi])):
+        finals = list(minimize_lockstep(evaluate, starts, lo, hi))
+    else:
+        finals = [minimize(fun, start, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi))).x for start in starts]
     refined_q: list[FloatArray] = []
     refined_cp: list[float] = []
-    for start in starts:
-        res = minimize(fun, start, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi)))
-        x = np.clip(res.x, lo, hi)
+    for start, final in zip(starts, finals):
+        x = np.clip(final, lo, hi)
         if reach is not None and not reach.contains(x):
             x = _pull_back(reach, start, x)
             evaluations += 1

@@ -242,9 +242,12 @@ def optimal_halt_configuration(
         # exact()'s CP, bit for bit, in one compiled call in a worker
         cp_of = ability.evaluator(model_locked, jacobian=jacobian, characteristic_length=characteristic_length)
 
+        # the starts in lockstep where every batch of CP is the compiled kernel's (a worker),
+        # whose numbers for a configuration do not depend on the batch: the same points
         refined_q, refined_cp, evaluations = _refine(
-            cp_of, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None
-        )
+            cp_of, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None,
+            lockstep=use_compiled(2 * n + 1, COMPILED_MIN_BATCH),
+        )  # fmt: skip
     best = best_sample
     if refined_cp and max(refined_cp) > best_sample.cp:
         j = int(np.argmax(refined_cp))
