@@ -1001,11 +1001,16 @@ def test_the_compiled_screen_of_halt_times_is_numpys(rng, monkeypatch):
         reference = _surely_infeasible(p, times)
         with jl.compiled_kernels("always"):
             compiled = _surely_infeasible(p, times)
+            every = _surely_infeasible(p, times[::25], stride=1)
         assert np.array_equal(compiled, reference)
+        assert np.array_equal(every, _surely_infeasible(p, times[::25], stride=1))  # every check time
+        assert not np.any(compiled[::25] & ~every)  # more check times: at least as many screened out
+        with jl.compiled_kernels("always"):  # minimum_halt_time screens on every check time too
+            assert minimum_halt_time(p) == _reference_minimum_halt_time(p)
         screened += int(compiled.sum())
         feasible = np.array([np.subtract(*shared_k_interval(p.with_time(float(T)))) <= 0 for T in times[::10]])
         assert not np.any(compiled[::10] & feasible)
-    assert len(calls) == len(problems)
+    assert len(calls) > 3 * len(problems)
     assert 0 < screened < len(problems) * times.size
 
 

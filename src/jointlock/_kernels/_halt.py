@@ -119,8 +119,9 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
     operations per sample.
 
     Only a screen: its bounds are the numpy route's up to round-off (powers by multiplication,
-    not numpy's ``pow``), and each is widened by ``rtol`` of the terms it comes from, far above
-    that round-off, so a halt time it calls infeasible is infeasible on the exact check too.
+    not numpy's ``pow``; the widening's division by a multiplication), and each is widened by
+    ``rtol`` of the terms it comes from, far above that round-off, so a halt time it calls
+    infeasible is infeasible on the exact check too.
 
     ``halt_times`` (m,) [s]; ``picked`` (s,) int64 indices of the check times (of
     ``n_check``, spaced as ``np.linspace(0, T, n_check)``); ``q0, dq0, ddq0, qf`` (n,) the
@@ -129,9 +130,19 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
     """
     n = q0.shape[0]
     inf = np.inf
+    coefficients = np.empty((n, 3))
+    ends = np.empty((3, n))
+    for kind in range(3):
+        for j in range(n):
+            ends[kind, j] = max(abs(lo[kind, j]), abs(hi[kind, j]))
     for m in range(halt_times.shape[0]):
         T = halt_times[m]
         T2 = T * T
+        for j in range(n):  # 000 eq. 27 with k = 0 (halt_coefficients)
+            h = qf[j] - q0[j]
+            coefficients[j, 0] = (20.0 * h - T2 * 3.0 * ddq0[j] - T * 12.0 * dq0[j]) / (2.0 * T2 * T)
+            coefficients[j, 1] = (T2 * 3.0 * ddq0[j] + T * 16.0 * dq0[j] - 30.0 * h) / (2.0 * T2 * T2)
+            coefficients[j, 2] = (-ddq0[j] * T2 - 6.0 * dq0[j] * T + 12.0 * h) / (2.0 * T2 * T2 * T)
         k_lo, k_hi = -inf, inf
         for p in range(picked.shape[0]):
             i = picked[p]
@@ -139,12 +150,13 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
             u = t - T
             t2, u2 = t * t, u * u
             shape = (t2 * t * u2 * u, 3.0 * t2 * u2 * (t + u), 6.0 * t * u * (t2 + 3.0 * t * u + u2))
-            for j in range(n):
-                h = qf[j] - q0[j]
-                a3 = (20.0 * h - T2 * 3.0 * ddq0[j] - T * 12.0 * dq0[j]) / (2.0 * T2 * T)
-                a4 = (T2 * 3.0 * ddq0[j] + T * 16.0 * dq0[j] - 30.0 * h) / (2.0 * T2 * T2)
-                a5 = (-ddq0[j] * T2 - 6.0 * dq0[j] * T + 12.0 * h) / (2.0 * T2 * T2 * T)
-                for kind in range(3):
+            for kind in range(3):
+                phi = shape[kind]
+                if not abs(phi) > 0:  # no bound on k here
+                    continue
+                inverse = 1.0 / abs(phi)
+                for j in range(n):
+                    a3, a4, a5 = coefficients[j, 0], coefficients[j, 1], coefficients[j, 2]
                     if kind == 0:
                         terms = (q0[j], dq0[j] * t, ddq0[j] / 2.0 * t2, a3 * t2 * t, a4 * t2 * t2, a5 * t2 * t2 * t)
                     elif kind == 1:
@@ -155,15 +167,10 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
                     for x in terms:
                         base += x
                         size += abs(x)
-                    phi = shape[kind]
-                    if not abs(phi) > 0:
-                        continue
-                    low_limit, high_limit = lo[kind, j], hi[kind, j]
-                    b1, b2 = (low_limit - base) / phi, (high_limit - base) / phi
+                    b1, b2 = (lo[kind, j] - base) / phi, (hi[kind, j] - base) / phi
                     if not math.isfinite(b1 + b2):  # an infinite limit (or NaN): no bound
                         continue
-                    ends = max(abs(low_limit), abs(high_limit))
-                    widen = rtol * (size + ends) / abs(phi)
+                    widen = rtol * (size + ends[kind, j]) * inverse
                     k_lo = _nan_max(k_lo, _nan_min(b1, b2) - widen)
                     k_hi = _nan_min(k_hi, _nan_max(b1, b2) + widen)
         out[m] = k_lo > k_hi

@@ -287,7 +287,14 @@ def minimum_halt_time(
     t_max = max(10 * problem.T, 120.0) if t_max is None else t_max
     grid = np.arange(t_min, t_max + 1e-9, 0.25)
 
+    # in a worker, a halt time the screen on every check time proves infeasible (a tenth of
+    # the exact check's cost, compiled) is not checked exactly: most of the bisection's
+    # infeasible halves and of the scan's halt times the coarse screen let through
+    fine_screen = use_compiled(1, COMPILED_MIN_BATCH)
+
     def ok(T: float) -> bool:
+        if fine_screen and _surely_infeasible(problem, np.array([T]), stride=1)[0]:
+            return False
         lo, hi = shared_k_interval(problem.with_time(T))
         return lo <= hi
 
@@ -317,10 +324,10 @@ SCREEN_STRIDE = 8
 SCREEN_RTOL = 1e-10
 
 
-def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarray:
+def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray, stride: int = SCREEN_STRIDE) -> np.ndarray:
     """(m,) bool: for each halt time (m,) [s], True where no shared ``k`` keeps the angle, rate
-    and acceleration limits even at every :data:`SCREEN_STRIDE`-th check time alone (and False
-    where that is not certain).
+    and acceleration limits even at every ``stride``-th check time alone (and False where that
+    is not certain).
 
     Fewer constraints give each ``k`` interval a superset of the exact one
     (:func:`feasible_k_intervals`), so an empty screened interval means an empty exact one.
@@ -328,7 +335,9 @@ def _surely_infeasible(problem: HaltProblem, halt_times: FloatArray) -> np.ndarr
     round-off, so each bound is widened by :data:`SCREEN_RTOL` of the terms it comes from, and
     check times where ``phi`` or its derivative vanishes (no bound on ``k``) are left out."""
     n = problem.n_check
-    picked = np.unique(np.r_[np.arange(0, n, SCREEN_STRIDE), n - 1])
+    picked = np.arange(0, n, stride)
+    if picked[-1] != n - 1:
+        picked = np.r_[picked, n - 1]  # the last check time always (sorted, unique: as np.unique made them)
     lo, hi = _limits(problem)
     if use_compiled(picked.size * np.size(halt_times), COMPILED_MIN_BATCH):  # a campaign's workers
         from ... import _kernels
