@@ -119,8 +119,9 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
     operations per sample.
 
     Only a screen: its bounds are the numpy route's up to round-off (powers by multiplication,
-    not numpy's ``pow``; the widening's division by a multiplication), and each is widened by
-    ``rtol`` of the terms it comes from, far above that round-off, so a halt time it calls
+    not numpy's ``pow``; a division by ``phi`` as a multiplication by its inverse: within two
+    ulps of the quotient), and each is widened by ``rtol`` of the terms it comes from (at
+    least ``rtol`` of the bound itself), far above that round-off, so a halt time it calls
     infeasible is infeasible on the exact check too.
 
     ``halt_times`` (m,) [s]; ``picked`` (s,) int64 indices of the check times (of
@@ -130,47 +131,52 @@ def screen_k_bounds(halt_times, picked, n_check, q0, dq0, ddq0, qf, lo, hi, rtol
     """
     n = q0.shape[0]
     inf = np.inf
-    coefficients = np.empty((n, 3))
+    # each kind's polynomial in t, k = 0 (000 eq. 27, halt_coefficients): (kind, power, joint)
+    c = np.zeros((3, 6, n))
     ends = np.empty((3, n))
     for kind in range(3):
         for j in range(n):
             ends[kind, j] = max(abs(lo[kind, j]), abs(hi[kind, j]))
+    for j in range(n):
+        c[0, 0, j], c[0, 1, j], c[0, 2, j] = q0[j], dq0[j], ddq0[j] / 2.0
+        c[1, 0, j], c[1, 1, j] = dq0[j], ddq0[j]
+        c[2, 0, j] = ddq0[j]
     for m in range(halt_times.shape[0]):
         T = halt_times[m]
         T2 = T * T
-        for j in range(n):  # 000 eq. 27 with k = 0 (halt_coefficients)
+        for j in range(n):
             h = qf[j] - q0[j]
-            coefficients[j, 0] = (20.0 * h - T2 * 3.0 * ddq0[j] - T * 12.0 * dq0[j]) / (2.0 * T2 * T)
-            coefficients[j, 1] = (T2 * 3.0 * ddq0[j] + T * 16.0 * dq0[j] - 30.0 * h) / (2.0 * T2 * T2)
-            coefficients[j, 2] = (-ddq0[j] * T2 - 6.0 * dq0[j] * T + 12.0 * h) / (2.0 * T2 * T2 * T)
+            a3 = (20.0 * h - T2 * 3.0 * ddq0[j] - T * 12.0 * dq0[j]) / (2.0 * T2 * T)
+            a4 = (T2 * 3.0 * ddq0[j] + T * 16.0 * dq0[j] - 30.0 * h) / (2.0 * T2 * T2)
+            a5 = (-ddq0[j] * T2 - 6.0 * dq0[j] * T + 12.0 * h) / (2.0 * T2 * T2 * T)
+            c[0, 3, j], c[0, 4, j], c[0, 5, j] = a3, a4, a5
+            c[1, 2, j], c[1, 3, j], c[1, 4, j] = 3.0 * a3, 4.0 * a4, 5.0 * a5
+            c[2, 1, j], c[2, 2, j], c[2, 3, j] = 6.0 * a3, 12.0 * a4, 20.0 * a5
         k_lo, k_hi = -inf, inf
         for p in range(picked.shape[0]):
             i = picked[p]
             t = T if i == n_check - 1 else i * (T / (n_check - 1))
             u = t - T
             t2, u2 = t * t, u * u
-            shape = (t2 * t * u2 * u, 3.0 * t2 * u2 * (t + u), 6.0 * t * u * (t2 + 3.0 * t * u + u2))
+            t3, t4 = t2 * t, t2 * t2
+            t5 = t4 * t
+            shape = (t3 * u2 * u, 3.0 * t2 * u2 * (t + u), 6.0 * t * u * (t2 + 3.0 * t * u + u2))
             for kind in range(3):
                 phi = shape[kind]
                 if not abs(phi) > 0:  # no bound on k here
                     continue
-                inverse = 1.0 / abs(phi)
+                inverse = 1.0 / phi
+                magnitude = abs(inverse)
+                ck = c[kind]
                 for j in range(n):
-                    a3, a4, a5 = coefficients[j, 0], coefficients[j, 1], coefficients[j, 2]
-                    if kind == 0:
-                        terms = (q0[j], dq0[j] * t, ddq0[j] / 2.0 * t2, a3 * t2 * t, a4 * t2 * t2, a5 * t2 * t2 * t)
-                    elif kind == 1:
-                        terms = (dq0[j], ddq0[j] * t, 3.0 * a3 * t2, 4.0 * a4 * t2 * t, 5.0 * a5 * t2 * t2, 0.0)
-                    else:
-                        terms = (ddq0[j], 6.0 * a3 * t, 12.0 * a4 * t2, 20.0 * a5 * t2 * t, 0.0, 0.0)
-                    base, size = 0.0, 0.0
-                    for x in terms:
-                        base += x
-                        size += abs(x)
-                    b1, b2 = (lo[kind, j] - base) / phi, (hi[kind, j] - base) / phi
+                    x0, x1, x2 = ck[0, j], ck[1, j] * t, ck[2, j] * t2
+                    x3, x4, x5 = ck[3, j] * t3, ck[4, j] * t4, ck[5, j] * t5
+                    base = x0 + x1 + x2 + x3 + x4 + x5
+                    size = abs(x0) + abs(x1) + abs(x2) + abs(x3) + abs(x4) + abs(x5)
+                    b1, b2 = (lo[kind, j] - base) * inverse, (hi[kind, j] - base) * inverse
                     if not math.isfinite(b1 + b2):  # an infinite limit (or NaN): no bound
                         continue
-                    widen = rtol * (size + ends[kind, j]) * inverse
+                    widen = rtol * (size + ends[kind, j]) * magnitude
                     k_lo = _nan_max(k_lo, _nan_min(b1, b2) - widen)
                     k_hi = _nan_min(k_hi, _nan_max(b1, b2) + widen)
         out[m] = k_lo > k_hi
