@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import pickle
 
 import numpy as np
 import pytest
@@ -931,6 +932,10 @@ def test_the_halt_on_its_cached_grid_is_the_halt_at_those_times_bit_for_bit(rng)
         with pytest.raises(ValueError, match="read-only"):
             base[0][0, 0] = 1.0
         assert p.profiles(p.n_check)[1] is base  # once per grid
+        copied = pickle.loads(pickle.dumps(p))  # the cache is not pickled: computed again, read-only again
+        assert "_jointlock_cache" not in copied.__dict__
+        assert np.array_equal(copied.profiles(p.n_check)[1][0], base[0])
+        assert not copied.profiles(p.n_check)[1][0].flags.writeable
 
 
 def test_the_compiled_k_intervals_are_numpys_bit_for_bit(rng, monkeypatch):

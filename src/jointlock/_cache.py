@@ -18,6 +18,13 @@ T = TypeVar("T")
 _ATTRIBUTE = "_jointlock_cache"
 
 
+def state_without_cache(obj: Any) -> dict[str, Any]:
+    """``obj``'s ``__dict__`` without the cache, for a ``__getstate__``: what is derived is
+    computed again after unpickling or copying, not carried (and stays read-only where the
+    computation made it so)."""
+    return {key: value for key, value in obj.__dict__.items() if key != _ATTRIBUTE}
+
+
 def cached_on(obj: Any, name: str, compute: Callable[[], T]) -> T:
     """``compute()`` the first time ``name`` is asked of ``obj``, its stored value after."""
     store: dict[str, tuple[bool, Any]] | None = obj.__dict__.get(_ATTRIBUTE)

@@ -67,11 +67,15 @@ def minimize_lockstep(
     ``lo < hi``; returns each start's final ``x`` (m, n), ``minimize``'s ``res.x``.
 
     ``evaluate(xs)`` gives ``(f (k,), g (k, n))`` at the points ``xs`` (k, n), each point's
-    numbers independent of the others.
+    numbers independent of the others.  It is called as often as ``minimize`` calls the
+    function where the function is finite (at a NaN ``x``, ``minimize``'s memo misses and it
+    calls the function twice per request; here once, with the same points).
     """
     from scipy.optimize import _lbfgsb
 
     m_starts, n = starts.shape
+    if m_starts == 0:
+        return np.empty((0, n))
     m = MAXCOR
     factr = FTOL / np.finfo(float).eps
     nbd = np.full(n, 2, dtype=np.int32)  # bounded on both sides

@@ -4,12 +4,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, replace
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._cache import cached_on
+from ..._cache import cached_on, state_without_cache
 from ...dynamics import BaseMode
 from ...errors import ScenarioError
 from ...model import ArmModel, FloatArray
@@ -201,6 +201,9 @@ class HaltProblem:
     def times(self, n: int | None = None) -> FloatArray:
         """(n,) uniform times [s] from 0 to T (``n_samples`` points by default)."""
         return np.linspace(0.0, self.T, self.n_samples if n is None else n)
+
+    def __getstate__(self) -> dict[str, Any]:
+        return state_without_cache(self)  # the cached profiles are not pickled
 
     def profiles(
         self, n: int | None = None

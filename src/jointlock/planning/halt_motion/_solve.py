@@ -11,7 +11,7 @@ from typing import Any, Literal
 import numpy as np
 from numpy.typing import ArrayLike
 
-from ..._cache import cached_on
+from ..._cache import cached_on, state_without_cache
 from ..._random import resolve_seed
 from ...errors import InfeasibleError, ScenarioError
 from ...model import FloatArray
@@ -132,6 +132,9 @@ class HaltMotion:
     def trajectory(self, t: ArrayLike | None = None) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, dq, ddq (n_t, n) of the optimal halt."""
         return self.problem.trajectory(self.k, t, per_joint=self.per_joint)
+
+    def __getstate__(self) -> dict[str, Any]:
+        return state_without_cache(self)  # the cached trajectory is not pickled
 
     def check_trajectory(self) -> tuple[FloatArray, FloatArray, FloatArray]:
         """q, dq, ddq (n_check, n) of the optimal halt on the constraint grid
