@@ -864,20 +864,40 @@ def test_least_violating_k_is_the_full_scans_bit_for_bit(rng):
     assert checked >= 3
 
 
+def _edge_problems(rng, count):
+    """000's scenario, ``count`` varied ones, one without angle limits (infinite ends) and one
+    whose start breaks a rate limit (where the k part vanishes, at t = 0)."""
+    base = _problem()
+    return [
+        base,
+        *_varied_problems(rng, count),
+        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf)),
+        dataclasses.replace(base, dq0=base.dq0 + 2.0 * VMAX),
+    ]
+
+
+def _counted_kernel(monkeypatch, name):
+    """``(calls, kernel)``: ``jointlock._kernels.<name>`` made to count its calls in ``calls``,
+    and the compiled mode left to the test (``JOINTLOCK_COMPILED`` unset)."""
+    from jointlock import _kernels
+
+    calls = []
+    kernel = getattr(_kernels, name)
+    monkeypatch.setattr(_kernels, name, lambda *a: (calls.append(1), kernel(*a))[1])
+    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    return calls, kernel
+
+
 def test_the_compiled_least_violation_scan_is_every_limits_bit_for_bit(rng, monkeypatch):
     """least_violating_k's scan in the compiled mode "always" (jointlock._kernels.
     least_violation_scan, the halving with pruning in one call) gives the relative violation of
     every limit at every check time, bit for bit, on grids of several lengths (stretches of
     one value, of SCAN_STRETCH and beyond), limits without an angle bound, and a NaN state; and
     least_violating_k gives the full scan's k."""
-    from jointlock import _kernels
     from jointlock.planning.halt_motion import relative_violation
     from jointlock.planning.halt_motion._feasibility import SCAN_STRETCH, _Limits, least_violating_k
 
-    calls = []
-    kernel = _kernels.least_violation_scan
-    monkeypatch.setattr(_kernels, "least_violation_scan", lambda *a: (calls.append(1), kernel(*a))[1])
-    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
+    calls, kernel = _counted_kernel(monkeypatch, "least_violation_scan")
     base = _problem()
     problems = [
         base,
@@ -943,18 +963,11 @@ def test_the_compiled_k_intervals_are_numpys_bit_for_bit(rng, monkeypatch):
     pass) gives numpy's intervals bit for bit: varied problems, no angle limits (infinite
     ends), a start that breaks a rate limit (where the k part vanishes, at t = 0), an empty
     interval."""
-    from jointlock import _kernels
 
-    calls = []
-    kernel = _kernels.k_intervals
-    monkeypatch.setattr(_kernels, "k_intervals", lambda *a: (calls.append(1), kernel(*a))[1])
-    base = _problem()
+    calls, kernel = _counted_kernel(monkeypatch, "k_intervals")
     problems = [
-        base,
-        *_varied_problems(rng, 6),
-        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf)),
-        dataclasses.replace(base, dq0=base.dq0 + 2.0 * VMAX),
-        dataclasses.replace(base, T=1.0),
+        *_edge_problems(rng, 6),
+        dataclasses.replace(_problem(), T=1.0),
     ]
     monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
     for p in problems:
@@ -986,20 +999,10 @@ def test_the_compiled_screen_of_halt_times_is_numpys(rng, monkeypatch):
     screen_k_bounds): the numpy route's verdicts on every halt time, including limits that are
     infinite, a start outside a limit and halt times whose every check time is decisive; and
     never infeasible where the exact check is feasible."""
-    from jointlock import _kernels
     from jointlock.planning.halt_motion._feasibility import _surely_infeasible
 
-    calls = []
-    kernel = _kernels.screen_k_bounds
-    monkeypatch.setattr(_kernels, "screen_k_bounds", lambda *a: (calls.append(1), kernel(*a))[1])
-    monkeypatch.delenv("JOINTLOCK_COMPILED", raising=False)
-    base = _problem()
-    problems = [
-        base,
-        *_varied_problems(rng, 8),
-        dataclasses.replace(base, q_min=np.full(base.dof, -np.inf), q_max=np.full(base.dof, np.inf)),
-        dataclasses.replace(base, dq0=base.dq0 + 2.0 * VMAX),
-    ]
+    calls, kernel = _counted_kernel(monkeypatch, "screen_k_bounds")
+    problems = _edge_problems(rng, 8)
     times = np.r_[np.linspace(0.05, 30.0, 301), 7.25, 120.0]
     screened = 0
     for p in problems:
