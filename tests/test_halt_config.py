@@ -633,3 +633,12 @@ def test_the_refinement_in_lockstep_is_one_start_at_a_time_bit_for_bit(floating4
     assert seen == [True, True]
     optimal_halt_configuration(floating4, samples=400, rng=3, refine_starts=2)  # auto: numpy's CP
     assert seen == [True, True, False]
+    # where a configuration's CP could depend on its batch (an angle reaching the kernels'
+    # TRIG_LIMIT: the block's sine and cosine are libm's), a fixed joint or no start: minimize
+    from jointlock.planning.halt_config._refine import _lockstep_box
+
+    starts, lo, hi = np.zeros((2, 3)), np.full(3, -np.pi), np.full(3, np.pi)
+    assert _lockstep_box(starts, lo, hi)
+    assert not _lockstep_box(starts, lo, np.r_[np.pi, np.pi, 2e5])
+    assert not _lockstep_box(starts, lo, np.r_[np.pi, np.pi, -np.pi])
+    assert not _lockstep_box(starts[:0], lo, hi)

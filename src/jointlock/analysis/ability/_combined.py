@@ -271,7 +271,10 @@ def _flatten(indices: KinematicIndices) -> KinematicIndices:
 #: block run SIMD lanes (8 doubles with AVX-512, twice 4 with AVX2) and a scalar remainder
 #: about ten times slower per configuration (13 configurations cost 64 us, 16 cost 36 us).
 #: The configurations never mix (each lane's operations are its own, and a converged Jacobi
-#: lane is left exactly as it is), so the padding changes no bit.
+#: lane is left exactly as it is), so the padding changes no bit.  (What a block of 128
+#: decides as a whole -- its Jacobi sweeps; libm's sine and cosine for every lane when one
+#: angle reaches ``TRIG_LIMIT`` -- is unchanged too: the copies are of a row already in the
+#: last block.)
 SIMD_LANES = 8
 
 

@@ -17,7 +17,9 @@ evaluation limits, and its memo that does not evaluate again at the ``x`` last e
 steps every running start to its next request, and evaluates the requests together.  The
 starts do not interact, and each start's ``setulb`` sees the numbers it would see alone, so
 each ends where ``minimize`` ends, bit for bit, when the batched evaluation gives each point
-the value it gives alone (the caller's to ensure; ``tests/test_halt_config.py`` compares).
+the value it gives alone (the caller's to ensure: ``_refine`` runs in lockstep only where the
+compiled CP kernel does, inside a box of angles below its ``TRIG_LIMIT``;
+``tests/test_halt_config.py`` compares).
 
 ``setulb`` is private to scipy: :func:`lockstep_available` accepts only the versions whose
 driver loop this module follows (checked by the tests); elsewhere the caller runs

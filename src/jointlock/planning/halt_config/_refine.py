@@ -75,7 +75,7 @@ def _refine(
         grad = np.divide(val[:, 1 : n + 1] - val[:, n + 1 :], h, out=np.zeros(h.shape), where=h > 0)
         return -val[:, 0], -grad
 
-    if lockstep and starts.shape[0] and lockstep_available() and np.all(lo < hi) and np.all(np.isfinite([lo, hi])):
+    if lockstep and _lockstep_box(starts, lo, hi):
         finals = list(minimize_lockstep(evaluate, starts, lo, hi))
     else:
         finals = [minimize(fun, start, jac=True, method="L-BFGS-B", bounds=list(zip(lo, hi))).x for start in starts]
@@ -91,6 +91,19 @@ def _refine(
         refined_q.append(x)
         refined_cp.append(float(cp_of(x)))
     return refined_q, refined_cp, evaluations
+
+
+def _lockstep_box(starts: FloatArray, lo: FloatArray, hi: FloatArray) -> bool:
+    """Whether the starts can run in lockstep: this scipy allows it, the box is finite with no
+    fixed joint, and every angle in it is below the kernels' ``TRIG_LIMIT`` (beyond, a block
+    of 128 configurations takes libm's sine and cosine for all its lanes when one angle gets
+    there, and a configuration's CP would depend on the batch it is in)."""
+    from ..._kernels import TRIG_LIMIT  # the lockstep runs compiled: numba is loaded
+
+    box = np.array([lo, hi])
+    return bool(
+        starts.shape[0] and lockstep_available() and np.all(lo < hi) and np.all(np.abs(box) < TRIG_LIMIT)
+    )
 
 
 def _pull_back_clear(keeps_clear: Callable[[FloatArray], np.ndarray], start: FloatArray, x: FloatArray) -> FloatArray:
