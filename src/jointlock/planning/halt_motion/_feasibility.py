@@ -287,7 +287,7 @@ def minimum_halt_time(
     t_max = max(10 * problem.T, 120.0) if t_max is None else t_max
     grid = np.arange(t_min, t_max + 1e-9, 0.25)
 
-    # in a worker, a halt time the screen on every check time proves infeasible (a tenth of
+    # in a worker, a halt time the screen on every check time proves infeasible (a fifth of
     # the exact check's cost, compiled) is not checked exactly: most of the bisection's
     # infeasible halves and of the scan's halt times the coarse screen let through
     fine_screen = use_compiled(1, COMPILED_MIN_BATCH)
