@@ -27,7 +27,7 @@ from typing import Any
 
 from .._version import __version__
 from ..compiled import CompiledMode, chosen_compiled_mode, compiled_kernels
-from ..io.files import to_plain
+from ..io.files import json_text
 from ..run import run_scenario
 from ._cases import Case, case_key, case_overrides, resolve_case
 from ._columns import record
@@ -114,10 +114,8 @@ class CaseOutcome:
 
 
 def encode_result(results: Mapping[str, Any]) -> bytes:
-    """``{job: to_dict()}`` as stored in outcomes and the ledger: zlib-compressed compact JSON
-    (:func:`~jointlock.io.files.to_plain`'s data; compact, as json's C encoder writes it: an
-    indented text goes through its Python encoder, 2 ms of a halt case)."""
-    return zlib.compress(json.dumps(to_plain(results), separators=(",", ":"), allow_nan=False).encode(), 6)
+    """``{job: to_dict()}`` as stored in outcomes and the ledger: zlib-compressed compact JSON."""
+    return zlib.compress(json_text(results, compact=True).encode(), 6)
 
 
 def decode_result(blob: bytes) -> dict[str, Any]:

@@ -49,9 +49,12 @@ def to_plain(obj: Any) -> Any:
     return obj
 
 
-def json_text(obj: Any) -> str:
-    """``obj`` as indented JSON text (see :func:`to_plain`), with a final newline."""
-    return json.dumps(to_plain(obj), indent=2, allow_nan=False) + "\n"
+def json_text(obj: Any, *, compact: bool = False) -> str:
+    """``obj`` as indented JSON text (see :func:`to_plain`), with a final newline; ``compact``:
+    no indentation or spaces (json's C encoder: an indented text goes through its Python one,
+    2 ms of a halt case's result)."""
+    layout: dict[str, Any] = {"separators": (",", ":")} if compact else {"indent": 2}
+    return json.dumps(to_plain(obj), allow_nan=False, **layout) + "\n"
 
 
 #: Byte-order marks of the Unicode encodings a text file may use besides UTF-8 (UTF-32's

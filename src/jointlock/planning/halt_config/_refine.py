@@ -52,28 +52,21 @@ def _refine(
     evaluations = 0
     steps = REFINE_FD_STEP * np.vstack([np.zeros(n), np.eye(n), -np.eye(n)])  # (2n+1, n)
 
-    def value_and_gradient(pts: FloatArray, val: FloatArray) -> tuple[float, FloatArray]:
-        """-CP and its central-difference gradient at a point, from its 2n+1 points (the point,
-        then +h and -h along each joint, clipped) and their CP."""
-        h = np.diagonal(pts[1 : n + 1]) - np.diagonal(pts[n + 1 :])  # per-joint step
-        grad = np.divide(val[1 : n + 1] - val[n + 1 :], h, out=np.zeros(n), where=h > 0)
-        return -float(val[0]), -grad
-
-    def fun(x: FloatArray) -> tuple[float, FloatArray]:
-        nonlocal evaluations
-        pts = np.clip(x + steps, lo, hi)
-        evaluations += pts.shape[0]
-        return value_and_gradient(pts, cp_of(pts))
-
-    def evaluate(xs: FloatArray) -> tuple[FloatArray, FloatArray]:  # several points, one call
+    def evaluate(xs: FloatArray) -> tuple[FloatArray, FloatArray]:
+        """-CP (k,) and its central-difference gradient (k, n) at the points ``xs`` (k, n), from
+        each point's 2n+1 points (the point, then +h and -h along each joint, clipped), in one
+        call of ``cp_of``."""
         nonlocal evaluations
         pts = np.clip(xs[:, None, :] + steps, lo, hi)  # (k, 2n+1, n)
         evaluations += pts.shape[0] * pts.shape[1]
         val = cp_of(pts.reshape(-1, n)).reshape(pts.shape[:2])
-        # value_and_gradient of every point at once: the same elementwise operations
         h = np.diagonal(pts[:, 1 : n + 1], axis1=1, axis2=2) - np.diagonal(pts[:, n + 1 :], axis1=1, axis2=2)
         grad = np.divide(val[:, 1 : n + 1] - val[:, n + 1 :], h, out=np.zeros(h.shape), where=h > 0)
         return -val[:, 0], -grad
+
+    def fun(x: FloatArray) -> tuple[float, FloatArray]:  # one point, as minimize asks
+        value, grad = evaluate(x[None])
+        return float(value[0]), grad[0]
 
     if lockstep and _lockstep_box(starts, lo, hi):
         finals = list(minimize_lockstep(evaluate, starts, lo, hi))

@@ -42,11 +42,10 @@ def actuator_peaks(problem: HaltProblem, k: ArrayLike) -> tuple[FloatArray, Floa
     """
     k = np.asarray(k, dtype=float)
     flat = k.reshape(-1)
-    t = problem.times(problem.n_check)
     n_locked = len(problem.model.locked)
     motor = np.empty((flat.size, problem.dof))
     brake = np.empty((flat.size, n_locked))
-    step = max(1, CHUNK_SAMPLES // t.size)
+    step = max(1, CHUNK_SAMPLES // problem.n_check)
     for start in range(0, flat.size, step):  # chunks of candidates, not of time samples
         q, dq, ddq = problem.on_grid(flat[start : start + step], problem.n_check)
         m, b = actuator_torques(problem.model, q, dq, ddq, base=problem.base)

@@ -127,16 +127,16 @@ def keeps_clearance(
     time, the clearest on the screen first, up to the first that keeps it (True); the rest are
     left False."""
     k = np.asarray(k, dtype=float).reshape(-1)
-    t = problem.times(problem.n_check)
+    n_t = problem.n_check
     floor = _floor(problem, margin, keep_out)
     # coarse to fine: a pair closing in on its floor at the failure is caught on the first
     # samples, a halt sweeping through the bus on a few samples; each level looks only at the
     # halts still clear and at times not looked at yet
     screen = np.full(k.size, -np.inf)
-    seen = np.zeros(t.size, dtype=bool)
+    seen = np.zeros(n_t, dtype=bool)
     seen[0] = True  # the floor is the distance at t = 0 where that is smaller
     for stride in SCREEN_LEVELS:
-        level = np.zeros(t.size, dtype=bool)
+        level = np.zeros(n_t, dtype=bool)
         if stride:
             level[::stride] = True
             level[-1] = True
@@ -152,16 +152,14 @@ def keeps_clearance(
         survivors = survivors[np.argsort(screen[survivors], kind="stable")]
     ok = np.zeros(k.size, dtype=bool)
     for i in survivors:
-        ok[i] = _clear_everywhere(problem, float(k[i]), t, floor, keep_out)
+        ok[i] = _clear_everywhere(problem, float(k[i]), floor, keep_out)
         if any_one and ok[i]:
             break
     return ok
 
 
-def _clear_everywhere(
-    problem: HaltProblem, k: float, t: FloatArray, floor: FloatArray, keep_out: Sequence[Shape]
-) -> bool:
-    """Whether the halt at ``k`` keeps ``floor`` on every check time ``t`` and between them."""
+def _clear_everywhere(problem: HaltProblem, k: float, floor: FloatArray, keep_out: Sequence[Shape]) -> bool:
+    """Whether the halt at ``k`` keeps ``floor`` on every check time and between them."""
     q, dq, ddq = problem.on_grid(k, problem.n_check)
     distance = clearance(problem.model, q, keep_out=keep_out, witness=False).pair_distance
     if distance.shape[-1] and float((floor - distance).max()) > 0.0:

@@ -251,11 +251,8 @@ class HaltProblem:
         """
         if t is None:
             return self.on_grid(k, per_joint=per_joint)
-        k = _k_array(k, self.dof, per_joint)
         t = np.asarray(t, dtype=float)
-        base, shape = self.base_profile(t), self.k_shape(t)
-        kk = k[..., None, :]
-        return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+        return _halt(_k_array(k, self.dof, per_joint), self.base_profile(t), self.k_shape(t))
 
     def on_grid(
         self, k: ArrayLike, n: int | None = None, index: np.ndarray | None = None, *, per_joint: bool = False
@@ -264,12 +261,10 @@ class HaltProblem:
         constraint grid), or on the times ``times(n)[index]``, from :meth:`profiles`: the same
         numbers, as the halt polynomial at a time does not depend on the other times it is
         evaluated with (``tests/test_halt_motion.py``), without evaluating it again."""
-        k = _k_array(k, self.dof, per_joint)
         _, base, shape = self.profiles(n)
         if index is not None:
             base, shape = tuple(b[index] for b in base), tuple(s[index] for s in shape)
-        kk = k[..., None, :]
-        return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
+        return _halt(_k_array(k, self.dof, per_joint), base, shape)
 
 
 #: What the halt can minimise over k (:attr:`HaltProblem.objective`).
@@ -278,6 +273,15 @@ HALT_OBJECTIVES = ("mean_torque", "peak_torque", "attitude_change")
 #: Points about which the base torque can be taken (:attr:`HaltProblem.moment_about`).
 MOMENT_POINTS = ("spacecraft_com", "joint1")
 MomentAbout = Literal["spacecraft_com", "joint1"]
+
+
+def _halt(
+    k: FloatArray, base: tuple[FloatArray, ...], shape: tuple[FloatArray, ...]
+) -> tuple[FloatArray, FloatArray, FloatArray]:
+    """q, dq, ddq (..., n_t, n) of the halts ``base + k phi`` (eq. 27): ``k`` (..., n), the
+    ``k = 0`` part (n_t, n) and ``phi`` and its derivatives (n_t,) each."""
+    kk = k[..., None, :]
+    return tuple(b + kk * s[:, None] for b, s in zip(base, shape))  # type: ignore[return-value]
 
 
 def _k_array(k: ArrayLike, n: int, per_joint: bool) -> FloatArray:
