@@ -14,7 +14,7 @@ import pytest
 
 import jointlock as jl
 from jointlock._kernels._distance import pair_distances
-from jointlock.collision import clearance, collision_pairs
+from jointlock.collision import clearance, collision_pairs, margin_floor, smallest_excess
 from jointlock.errors import ConfigurationError, ModelError
 from jointlock.geometry import with_link_capsules
 from jointlock.shapes import Box, Capsule, Sphere
@@ -766,13 +766,10 @@ def ours_offsets(model: jl.ArmModel, keep_out) -> np.ndarray:
     return collision_pairs(model, keep_out).offsets
 
 
-@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda", "ur5"])
-def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
-    """clearance() (frames, placements and distances in one compiled pass) against the scalar
-    kernel on shapes placed by numpy: every pair, the closest one and its witness points, on
-    random configurations (most halt7 ones colliding), with keep-outs (a box, a sphere), and on
-    the UR5, whose joints 2-4 and 6 turn about y (the kernel's z-joint frames differ from the
-    bodies'), with capsules along its links and a box on a moving link."""
+def _kernel_arm(name: str) -> tuple[jl.ArmModel, tuple]:
+    """An arm of the kernels' tests and keep-outs for it: the built-ins, the Panda's collision
+    URDF, and the UR5 (joints 2-4 and 6 turn about y: the kernel's z-joint frames differ from
+    the bodies') with capsules along its links and a box on a moving link."""
     from robot_data import robot_file
 
     if name == "panda":
@@ -794,6 +791,16 @@ def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
     if name == "ur5":
         keep_out = (keep_out[1], Capsule([0.3, 0.3, 0.0], [0.3, 0.3, 0.8], 0.1, name="mast"))
     assert not (collision_pairs(arm, keep_out).pairs[:, 0] == 2).any()
+    return arm, keep_out
+
+
+@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda", "ur5"])
+def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
+    """clearance() (frames, placements and distances in one compiled pass) against the scalar
+    kernel on shapes placed by numpy: every pair, the closest one and its witness points, on
+    random configurations (most halt7 ones colliding), with keep-outs (a box, a sphere), and on
+    the UR5 (:func:`_kernel_arm`)."""
+    arm, keep_out = _kernel_arm(name)
     q = np.random.default_rng(5).uniform(-np.pi, np.pi, (700, arm.dof))  # > one block of 128
     q[0] = 0.0
     for keep in ((), keep_out):
@@ -816,6 +823,53 @@ def test_the_fused_kernel_equals_the_scalar_kernel_on_placed_shapes(name):
         quick = clearance(arm, q, keep_out=keep, witness=False)
         assert np.array_equal(quick.pair_distance, ours.pair_distance) and np.all(np.isnan(quick.witness))
         assert quick.to_dict()["witness_points_m"] is None
+
+
+@pytest.mark.parametrize("name", ["halt7", "canadarm7", "puma6", "panda", "ur5"])
+def test_the_smallest_excess_is_that_of_every_pairs_distance_bit_for_bit(name):
+    """smallest_excess (the jobs' screens: pairs that cannot be the closest, bounded from their
+    shapes' centres, are not computed) against clearance()'s every pair: the smallest
+    ``pair_distance - floor`` and its first pair, bit for bit.
+
+    Floors: 0; a margin (0 for mounted pairs: ``colliding`` is ``excess < 0``); random per-pair
+    ones, negative included; ones larger than the arm (every pair near); and each pair's own
+    distance at one configuration (every excess there exactly 0: a tie of every pair, the
+    first wins).  Configurations: random ones (most halt7 ones colliding), small motions about
+    one (a halt's grid), the zero pose (mounted pairs at their offsets), with and without
+    keep-outs (a box, a sphere, a capsule)."""
+    arm, keep_out = _kernel_arm(name)
+    rng = np.random.default_rng(11)
+    wide = rng.uniform(-np.pi, np.pi, (400, arm.dof))
+    near = wide[:3, None, :] + rng.normal(0.0, 0.02, (3, 150, arm.dof))  # (3, 150, n): a batch shape
+    for keep in ((), keep_out):
+        names = collision_pairs(arm, keep).names
+        mounted = collision_pairs(arm, keep).offsets < 0
+        for q in (wide, near, np.zeros((2, arm.dof))):
+            every = clearance(arm, q, keep_out=keep, witness=False).pair_distance
+            tie = every.reshape(-1, len(names))[0]
+            floors = (
+                np.zeros(len(names)),
+                margin_floor(arm, 0.05, keep),
+                rng.normal(0.0, 0.3, len(names)),
+                np.full(len(names), 50.0),
+                tie,
+            )
+            for floor in floors:
+                excess, pair = smallest_excess(arm, q, floor, keep_out=keep)
+                assert excess.shape == pair.shape == q.shape[:-1]
+                assert np.array_equal(excess, (every - floor).min(axis=-1))
+                assert np.array_equal(pair, (every - floor).argmin(axis=-1))
+            assert np.array_equal(
+                smallest_excess(arm, q, margin_floor(arm, 0.05, keep), keep_out=keep)[0] < 0,
+                clearance(arm, q, keep_out=keep).colliding(0.05),
+            )
+            assert np.array_equal(margin_floor(arm, 0.05, keep), np.where(mounted, 0.0, 0.05))
+            first = q.reshape(-1, arm.dof)[:1]
+            assert smallest_excess(arm, first, tie, keep_out=keep)[1][0] == 0  # every pair tied
+    with pytest.raises(ConfigurationError, match=r"floor must be one finite distance \[m\] per checked pair"):
+        smallest_excess(arm, wide, np.zeros(2))
+    with pytest.raises(ConfigurationError, match="floor must be"):
+        smallest_excess(arm, wide, np.full(len(collision_pairs(arm).names), np.nan))
 
 
 def test_the_singularity_search_may_leave_out_colliding_configurations(tmp_path, capsys):

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 import jointlock as jl
-from jointlock.collision import clearance, collision_pairs
+from jointlock.collision import clearance, collision_pairs, margin_floor, smallest_excess
 from jointlock.errors import ModelError
 from jointlock.geometry import with_root_shapes
 from jointlock.io.urdf_export import write_urdf
@@ -69,6 +69,11 @@ def test_a_box_mesh_gives_the_box_primitives_distances_penetration_included(tmp_
     by_hull = np.isin(ours.closest, hull_pairs)
     gap = np.linalg.norm(ours.witness[by_hull, 1] - ours.witness[by_hull, 0], axis=1)
     assert by_hull.any() and np.allclose(gap, np.abs(ours.distance[by_hull]), atol=1e-9)
+    # the screens' smallest excess with a hull: from every pair's distance, the same bits
+    floor = margin_floor(meshed, 0.05, keep_out)
+    excess, pair = smallest_excess(meshed, q, floor, keep_out=keep_out)
+    assert np.array_equal(excess, (ours.pair_distance - floor).min(axis=1))
+    assert np.array_equal(pair, (ours.pair_distance - floor).argmin(axis=1)) and np.isin(pair, hull_pairs).any()
 
 
 def test_ur5_meshes_equal_coal_hulls_of_pinocchios_meshes():

@@ -321,6 +321,40 @@ def _distances(
     return by_pair.T, lowest, closest, points
 
 
+def _smallest(model: ArmModel, pairs: CollisionPairs, q: FloatArray, floor: FloatArray) -> tuple[FloatArray, np.ndarray]:
+    """(N,) the smallest ``d_p - floor[p]`` over the pairs of configurations q (N, n), and (N,)
+    its pair (the first of equal ones; 0 when there is no pair): that of :func:`_distances`'
+    distances, bit for bit, without computing every pair (:func:`jointlock._kernels._clearance.
+    clearance_smallest`; with a convex hull, from every pair's distance)."""
+    from ._kernels._clearance import clearance_smallest
+
+    count = q.shape[0]
+    if (pairs.pairs[:, 0] == 2).any():  # a convex hull: coal's distance, every pair
+        excess = _distances(model, pairs, q, witness=False)[0] - floor
+        return excess.min(axis=1), excess.argmin(axis=1)
+    smallest = np.full(count, np.inf)
+    closest = np.zeros(count, dtype=np.int64)
+    if pairs.pairs.shape[0] and count:
+        shapes = cached_on(pairs, "kernel_shapes", lambda: _kernel_shapes(model, pairs))
+        clearance_smallest(
+            np.ascontiguousarray(q, dtype=float),
+            shapes.rot,
+            shapes.pos,
+            np.ascontiguousarray(pairs.capsule_body),
+            shapes.capsule_points,
+            np.ascontiguousarray(pairs.capsule_radii),
+            np.ascontiguousarray(pairs.box_body),
+            shapes.box_frames,
+            np.ascontiguousarray(pairs.box_halves),
+            np.ascontiguousarray(pairs.pairs),
+            np.ascontiguousarray(pairs.offsets),
+            np.ascontiguousarray(floor, dtype=float),
+            smallest,
+            closest,
+        )
+    return smallest, closest
+
+
 def _hull_rows(
     model: ArmModel,
     pairs: CollisionPairs,
@@ -524,6 +558,51 @@ def clearance(
 #: recommended halt configuration does not graze the bus; a scenario sets it with
 #: ``limits.clearance_min_m`` (``limits.check_clearance = false``: reported only).
 DEFAULT_CLEARANCE_MIN_M = 0.05
+
+
+def smallest_excess(
+    model: ArmModel, q: ArrayLike, floor: ArrayLike, *, keep_out: Sequence[Shape] = ()
+) -> tuple[FloatArray, np.ndarray]:
+    """How far each configuration keeps its pairs above their floors, without every pair's
+    distance: the jobs' screens.
+
+    Parameters
+    ----------
+    model
+        The arm.
+    q
+        (..., n) joint angles [rad].
+    floor
+        (P,) the distance each checked pair must keep [m] (:func:`margin_floor` for a margin;
+        the pairs are those of :attr:`Clearance.names`).
+    keep_out
+        Keep-out volumes in the root frame.
+
+    Returns
+    -------
+    excess, pair
+        (...,) the smallest ``pair_distance - floor`` over the pairs [m] (negative: a pair comes
+        closer than its floor; +inf without pairs) and (...,) its pair: those of
+        :func:`clearance`'s ``pair_distance``, bit for bit.  Pairs that cannot be the closest
+        (bounded from their shapes' centres) are not computed: a fraction of the time.
+    """
+    q = as_joint_array(model, q)
+    pairs = collision_pairs(model, keep_out)
+    floor = np.asarray(floor, dtype=float)
+    if floor.shape != (len(pairs.names),) or not np.all(np.isfinite(floor)):
+        raise ConfigurationError(
+            f"floor must be one finite distance [m] per checked pair, shape ({len(pairs.names)},); "
+            f"got shape {floor.shape}"
+        )
+    smallest, closest = _smallest(model, pairs, q.reshape(-1, model.dof), floor)
+    return smallest.reshape(q.shape[:-1]), closest.reshape(q.shape[:-1])
+
+
+def margin_floor(model: ArmModel, margin: float, keep_out: Sequence[Shape] = ()) -> FloatArray:
+    """(P,) the floor of each checked pair under a clearance ``margin`` [m]: the margin, 0 for a
+    mounted pair (as :meth:`Clearance.shortfall`)."""
+    margin = check_clearance_m(margin, "margin")
+    return np.where(collision_pairs(model, keep_out).offsets < 0, 0.0, margin)
 
 
 @dataclass(frozen=True, eq=False)

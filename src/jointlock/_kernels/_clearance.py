@@ -43,6 +43,13 @@ from ._distance import _capsule_box, _capsule_capsule
 #: A capsule-box pair whose segment comes this close to the box [m] is computed by the scalar
 #: kernel (touching or overlapping: its penetration depth and witness points).
 NEAR_BOX_M = 1e-6
+#: :func:`clearance_smallest` leaves a pair out only when its lower bound exceeds the least
+#: upper bound by more than this [m]: far above the bounds' and the distances' round-off
+#: (1e-13 m at arm scale), so that the closest pair is never left out.
+BOUND_SLACK_M = 1e-9
+#: Doubles in a SIMD register (AVX-512); :func:`clearance_smallest` computes its pairs in whole
+#: registers.
+LANES = 8
 
 _inline = njit(inline="always", cache=True, error_model="numpy", nogil=True)
 
@@ -146,6 +153,97 @@ def _segment_box_sq(px, py, pz, dx, dy, dz, hx, hy, hz):
     return ex * ex + ey * ey + ez * ez
 
 
+@_inline
+def _place_block(q, s0, nb, rot, pos, cap_body, cap_points, box_body, box_frames, frames, sn, cs, caps, boxes):
+    """The shapes of configurations ``s0 .. s0 + nb`` placed in the root frame: ``caps`` row
+    ``6 c + k`` (capsule ``c``'s end points a, b), ``boxes`` row ``12 k + m`` (box ``k``'s
+    rotation, row-major, then centre), each row a block of :data:`BLOCK` (see
+    :func:`clearance_distances`); ``frames``, ``sn``, ``cs`` are scratch."""
+    n = q.shape[1]
+    n_caps, n_boxes = cap_points.shape[0], box_frames.shape[0]
+    _identity_frames(frames, nb)
+    for body in range(-1, n):
+        if body >= 0:
+            _trig_block(q, s0, nb, body, sn, cs)
+            e = rot[body]
+            p0, p1, p2 = pos[body, 0], pos[body, 1], pos[body, 2]
+            for b in range(nb):
+                _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
+        for c in range(n_caps):
+            if cap_body[c] != body:
+                continue
+            for end in range(2):
+                x, y, z = cap_points[c, 3 * end], cap_points[c, 3 * end + 1], cap_points[c, 3 * end + 2]
+                for r in range(3):
+                    row = caps[6 * c + 3 * end + r]
+                    for b in range(nb):
+                        row[b] = (
+                            frames[3 * r, b] * x + frames[3 * r + 1, b] * y + frames[3 * r + 2, b] * z
+                            + frames[9 + r, b]
+                        )
+        for k in range(n_boxes):
+            if box_body[k] != body:
+                continue
+            f = box_frames[k]
+            for r in range(3):
+                for col in range(3):  # (F R)[r, col]
+                    row = boxes[12 * k + 3 * r + col]
+                    for b in range(nb):
+                        row[b] = (
+                            frames[3 * r, b] * f[col] + frames[3 * r + 1, b] * f[3 + col]
+                            + frames[3 * r + 2, b] * f[6 + col]
+                        )
+                row = boxes[12 * k + 9 + r]
+                for b in range(nb):
+                    row[b] = (
+                        frames[3 * r, b] * f[9] + frames[3 * r + 1, b] * f[10] + frames[3 * r + 2, b] * f[11]
+                        + frames[9 + r, b]
+                    )
+
+
+@_inline
+def _capsule_lane(ca, cb, b, gap):
+    """Signed distance of the capsules ``ca`` and ``cb`` (each its six rows of ``caps``,
+    :func:`_place_block`), configuration ``b`` of the block; ``gap``: both radii plus the
+    pair's offset [m]."""
+    ax, ay, az = ca[0, b], ca[1, b], ca[2, b]
+    bx, by, bz = cb[0, b], cb[1, b], cb[2, b]
+    d2 = _segments_sq(
+        ax, ay, az, ca[3, b] - ax, ca[4, b] - ay, ca[5, b] - az,
+        bx, by, bz, cb[3, b] - bx, cb[4, b] - by, cb[5, b] - bz,
+    )
+    return math.sqrt(d2) - gap
+
+
+@_inline
+def _box_lane(ca, bx, b, hx, hy, hz, gap):
+    """Signed distance of the capsule ``ca`` (its six rows of ``caps``) and the box ``bx`` (its
+    twelve rows of ``boxes``, :func:`_place_block`) of half extents h, configuration ``b`` of
+    the block; ``gap``: the radius plus the pair's offset [m].  NaN when the segment comes
+    within :data:`NEAR_BOX_M` of the box: the scalar kernel's (penetration depth)."""
+    # the segment in the box frame (box axes are the rotation's columns)
+    ox = ca[0, b] - bx[9, b]
+    oy = ca[1, b] - bx[10, b]
+    oz = ca[2, b] - bx[11, b]
+    vx = ca[3, b] - ca[0, b]
+    vy = ca[4, b] - ca[1, b]
+    vz = ca[5, b] - ca[2, b]
+    r00, r01, r02 = bx[0, b], bx[1, b], bx[2, b]
+    r10, r11, r12 = bx[3, b], bx[4, b], bx[5, b]
+    r20, r21, r22 = bx[6, b], bx[7, b], bx[8, b]
+    d2 = _segment_box_sq(
+        r00 * ox + r10 * oy + r20 * oz,
+        r01 * ox + r11 * oy + r21 * oz,
+        r02 * ox + r12 * oy + r22 * oz,
+        r00 * vx + r10 * vy + r20 * vz,
+        r01 * vx + r11 * vy + r21 * vz,
+        r02 * vx + r12 * vy + r22 * vz,
+        hx, hy, hz,
+    )
+    # near or in the box: NaN marks it for the scalar kernel below (q is finite)
+    return math.sqrt(d2) - gap if d2 > NEAR_BOX_M * NEAR_BOX_M else np.nan
+
+
 @_jit
 def clearance_distances(
     q, rot, pos, cap_body, cap_points, radii, box_body, box_frames, halves, pairs, offsets,
@@ -184,9 +282,9 @@ def clearance_distances(
     frames = np.empty((12, BLOCK))
     sn = np.empty(BLOCK)
     cs = np.empty(BLOCK)
-    caps = np.empty(max(n_caps, 1) * 6 * BLOCK)  # row 6 c + k of capsule c, then the block
-    boxes = np.empty(max(n_boxes, 1) * 12 * BLOCK)
-    dist = np.empty(max(n_pairs, 1) * BLOCK)
+    caps = np.empty((max(n_caps, 1) * 6, BLOCK))  # row 6 c + k of capsule c, then the block
+    boxes = np.empty((max(n_boxes, 1) * 12, BLOCK))
+    dist = np.empty((max(n_pairs, 1), BLOCK))
     lowest = np.empty(BLOCK)
     nearest = np.zeros(BLOCK, dtype=np.int64)
     w = np.empty((2, 3))
@@ -195,108 +293,47 @@ def clearance_distances(
     box_world = np.empty(12)
     for s0 in range(0, count, BLOCK):
         nb = min(BLOCK, count - s0)
-        _identity_frames(frames, nb)
-        for body in range(-1, n):
-            if body >= 0:
-                _trig_block(q, s0, nb, body, sn, cs)
-                e = rot[body]
-                p0, p1, p2 = pos[body, 0], pos[body, 1], pos[body, 2]
-                for b in range(nb):
-                    _advance(frames, b, e, p0, p1, p2, cs[b], sn[b])
-            for c in range(n_caps):
-                if cap_body[c] != body:
-                    continue
-                for end in range(2):
-                    x, y, z = cap_points[c, 3 * end], cap_points[c, 3 * end + 1], cap_points[c, 3 * end + 2]
-                    for r in range(3):
-                        row = (6 * c + 3 * end + r) * BLOCK
-                        for b in range(nb):
-                            caps[row + b] = (
-                                frames[3 * r, b] * x + frames[3 * r + 1, b] * y + frames[3 * r + 2, b] * z
-                                + frames[9 + r, b]
-                            )
-            for k in range(n_boxes):
-                if box_body[k] != body:
-                    continue
-                f = box_frames[k]
-                for r in range(3):
-                    for col in range(3):  # (F R)[r, col]
-                        row = (12 * k + 3 * r + col) * BLOCK
-                        for b in range(nb):
-                            boxes[row + b] = (
-                                frames[3 * r, b] * f[col] + frames[3 * r + 1, b] * f[3 + col]
-                                + frames[3 * r + 2, b] * f[6 + col]
-                            )
-                    row = (12 * k + 9 + r) * BLOCK
-                    for b in range(nb):
-                        boxes[row + b] = (
-                            frames[3 * r, b] * f[9] + frames[3 * r + 1, b] * f[10] + frames[3 * r + 2, b] * f[11]
-                            + frames[9 + r, b]
-                        )
+        _place_block(q, s0, nb, rot, pos, cap_body, cap_points, box_body, box_frames, frames, sn, cs, caps, boxes)
         for k in range(n_pairs):
             kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
-            a = 6 * i * BLOCK
-            out = k * BLOCK
+            # each shape's rows as one view: an index b from a range is known not to be
+            # negative, so the loops below load contiguously (an offset plus b would be wrapped
+            # like a negative index, and gathered)
+            ca = caps[6 * i : 6 * i + 6]
+            out = dist[k]
             if kind == 0:
-                o = 6 * j * BLOCK
+                cb = caps[6 * j : 6 * j + 6]
                 gap = radii[i] + radii[j] + offsets[k]
                 for b in range(nb):
-                    ax, ay, az = caps[a + b], caps[a + BLOCK + b], caps[a + 2 * BLOCK + b]
-                    bx, by, bz = caps[o + b], caps[o + BLOCK + b], caps[o + 2 * BLOCK + b]
-                    d2 = _segments_sq(
-                        ax, ay, az,
-                        caps[a + 3 * BLOCK + b] - ax, caps[a + 4 * BLOCK + b] - ay, caps[a + 5 * BLOCK + b] - az,
-                        bx, by, bz,
-                        caps[o + 3 * BLOCK + b] - bx, caps[o + 4 * BLOCK + b] - by, caps[o + 5 * BLOCK + b] - bz,
-                    )
-                    dist[out + b] = math.sqrt(d2) - gap
+                    out[b] = _capsule_lane(ca, cb, b, gap)
             elif kind == 2:  # a convex hull: coal, afterwards (jointlock.collision)
                 for b in range(nb):
-                    dist[out + b] = np.inf
+                    out[b] = np.inf
             else:
-                o = 12 * j * BLOCK
+                bx = boxes[12 * j : 12 * j + 12]
                 hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]
                 gap = radii[i] + offsets[k]
                 for b in range(nb):
-                    # the segment in the box frame (box axes are the rotation's columns)
-                    ox = caps[a + b] - boxes[o + 9 * BLOCK + b]
-                    oy = caps[a + BLOCK + b] - boxes[o + 10 * BLOCK + b]
-                    oz = caps[a + 2 * BLOCK + b] - boxes[o + 11 * BLOCK + b]
-                    vx = caps[a + 3 * BLOCK + b] - caps[a + b]
-                    vy = caps[a + 4 * BLOCK + b] - caps[a + BLOCK + b]
-                    vz = caps[a + 5 * BLOCK + b] - caps[a + 2 * BLOCK + b]
-                    r00, r01, r02 = boxes[o + b], boxes[o + BLOCK + b], boxes[o + 2 * BLOCK + b]
-                    r10, r11, r12 = boxes[o + 3 * BLOCK + b], boxes[o + 4 * BLOCK + b], boxes[o + 5 * BLOCK + b]
-                    r20, r21, r22 = boxes[o + 6 * BLOCK + b], boxes[o + 7 * BLOCK + b], boxes[o + 8 * BLOCK + b]
-                    d2 = _segment_box_sq(
-                        r00 * ox + r10 * oy + r20 * oz,
-                        r01 * ox + r11 * oy + r21 * oz,
-                        r02 * ox + r12 * oy + r22 * oz,
-                        r00 * vx + r10 * vy + r20 * vz,
-                        r01 * vx + r11 * vy + r21 * vz,
-                        r02 * vx + r12 * vy + r22 * vz,
-                        hx, hy, hz,
-                    )
-                    # near or in the box: NaN marks it for the scalar kernel below (q is finite)
-                    dist[out + b] = math.sqrt(d2) - gap if d2 > NEAR_BOX_M * NEAR_BOX_M else np.nan
+                    out[b] = _box_lane(ca, bx, b, hx, hy, hz, gap)
+
         # pairs near or in a box: the scalar kernel (penetration depth)
         for k in range(n_pairs):
             if pairs[k, 0] != 1:
                 continue
             i, j = pairs[k, 1], pairs[k, 2]
             for b in range(nb):
-                if dist[k * BLOCK + b] != dist[k * BLOCK + b]:
+                if dist[k, b] != dist[k, b]:
                     _place(caps, boxes, i, j, b, cap_world, box_world)
-                    dist[k * BLOCK + b] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+                    dist[k, b] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
         # the closest pair: a mounted one only when deeper than at the zero pose
         for b in range(nb):
             lowest[b] = np.inf
             nearest[b] = 0
         for k in range(n_pairs):
             mounted = offsets[k] < 0.0
-            row = k * BLOCK
+            row = dist[k]
             for b in range(nb):
-                value = dist[row + b]
+                value = row[b]
                 out_distance[k, s0 + b] = value
                 rank = np.inf if mounted and value >= 0.0 else value
                 closer = rank < lowest[b]
@@ -305,23 +342,57 @@ def clearance_distances(
         for b in range(nb):
             out_lowest[s0 + b] = lowest[b]
             out_closest[s0 + b] = nearest[b]
-        if not witness:
+        if witness:
+            _witness_block(caps, boxes, radii, halves, pairs, s0, nb, lowest, nearest, cap_world, box_world, w, work, out_witness)
+
+
+@_inline
+def _gather(rows, lanes, m, out):
+    """``out[:, t] = rows[:, lanes[t]]`` for ``t < m``: the configurations a pair is computed
+    for, side by side (so that its loop runs on contiguous lanes)."""
+    for r in range(rows.shape[0]):
+        source, target = rows[r], out[r]
+        for t in range(m):
+            target[t] = source[lanes[t]]
+
+
+@_jit
+def _capsule_lanes(ca, cb, lanes, m, gap, near_a, near_b, values):
+    """``values[t]``: :func:`_capsule_lane` of configuration ``lanes[t]``, ``t < m``."""
+    _gather(ca, lanes, m, near_a)
+    _gather(cb, lanes, m, near_b)
+    for t in range(m):
+        values[t] = _capsule_lane(near_a, near_b, t, gap)
+
+
+@_jit
+def _box_lanes(ca, bx, lanes, m, hx, hy, hz, gap, near_a, near_box, values):
+    """``values[t]``: :func:`_box_lane` of configuration ``lanes[t]``, ``t < m``."""
+    _gather(ca, lanes, m, near_a)
+    _gather(bx, lanes, m, near_box)
+    for t in range(m):
+        values[t] = _box_lane(near_a, near_box, t, hx, hy, hz, gap)
+
+
+@_jit
+def _witness_block(caps, boxes, radii, halves, pairs, s0, nb, lowest, nearest, cap_world, box_world, w, work, out_witness):
+    """The witness points of each configuration's closest pair ``nearest[b]`` (none where
+    ``lowest[b]`` is +inf) into ``out_witness[s0 + b]``, by the scalar kernels."""
+    for b in range(nb):
+        if lowest[b] == np.inf:
             continue
-        for b in range(nb):
-            if lowest[b] == np.inf:
-                continue
-            k = nearest[b]
-            kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
-            _place(caps, boxes, i, j if kind == 1 else 0, b, cap_world, box_world)
-            if kind == 0:
-                for r in range(6):
-                    cap_world[1, r] = caps[(6 * j + r) * BLOCK + b]
-                _capsule_capsule(cap_world[0], radii[i], cap_world[1], radii[j], w)
-            else:
-                _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work)
-            for r in range(2):
-                for col in range(3):
-                    out_witness[s0 + b, r, col] = w[r, col]
+        k = nearest[b]
+        kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+        _place(caps, boxes, i, j if kind == 1 else 0, b, cap_world, box_world)
+        if kind == 0:
+            for r in range(6):
+                cap_world[1, r] = caps[6 * j + r, b]
+            _capsule_capsule(cap_world[0], radii[i], cap_world[1], radii[j], w)
+        else:
+            _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work)
+        for r in range(2):
+            for col in range(3):
+                out_witness[s0 + b, r, col] = w[r, col]
 
 
 @_jit
@@ -329,7 +400,172 @@ def _place(caps, boxes, i, j, b, cap_world, box_world):
     """Capsule ``i`` and box ``j`` of configuration ``b`` of the block, as the scalar kernels
     take them: ``cap_world[0]`` (6,), ``box_world`` (12,)."""
     for r in range(6):
-        cap_world[0, r] = caps[(6 * i + r) * BLOCK + b]
-    if boxes.shape[0] >= 12 * (j + 1) * BLOCK:
+        cap_world[0, r] = caps[6 * i + r, b]
+    if boxes.shape[0] >= 12 * (j + 1):
         for r in range(12):
-            box_world[r] = boxes[(12 * j + r) * BLOCK + b]
+            box_world[r] = boxes[12 * j + r, b]
+
+
+@_jit
+def clearance_smallest(
+    q, rot, pos, cap_body, cap_points, radii, box_body, box_frames, halves, pairs, offsets, floor,
+    out_smallest, out_closest,
+):
+    """The smallest excess of a pair's signed distance over its floor, and its pair, for every
+    configuration, without every pair's distance (the jobs' screens).
+
+    The excess of pair ``k`` is ``d_k - floor[k]``, ``d_k`` the signed distance
+    :func:`clearance_distances` gives it (the same bits: the same lane functions).  Pairs of
+    kind 2 are left out (the caller's).
+
+    Most pairs of a configuration are nowhere near being its closest, and bounds from its
+    shapes' centres say so at a fraction of the cost of its distance.  For a capsule of half
+    length ``l`` and centre ``m``, every point of its segment lies within ``l`` of ``m``:
+
+    * capsule-capsule: with ``e_i`` the distance from ``m_j`` to segment ``i`` and ``e_j`` the
+      other way round, ``min(e_i, e_j) - r_i - r_j`` is at least the signed distance (the
+      centres are points of the segments), and ``max(e_i - l_j, e_j - l_i) - r_i - r_j`` at
+      most;
+    * capsule-box: with ``e`` the distance from ``m`` to the box, ``e - r`` is at least the
+      signed distance, and ``e - l - r`` at most when ``e > l`` (the segment does not reach the
+      box; otherwise nothing is bounded).
+
+    The least of the upper bounds over the pairs bounds the configuration's smallest excess; a
+    pair whose lower bound exceeds it by more than :data:`BOUND_SLACK_M` cannot be the closest
+    and is not computed.  The others are, exactly, in pair order, so that the smallest excess
+    and its pair (the first of equal ones) are those of every pair computed.
+
+    Parameters
+    ----------
+    q, rot, pos, cap_body, cap_points, radii, box_body, box_frames, halves, pairs, offsets
+        As :func:`clearance_distances`.
+    floor
+        (P,) each pair's floor [m].
+    out_smallest, out_closest
+        Written in place: (N,) the smallest excess [m] (+inf when no pair counts); (N,) its
+        pair (0 when none).
+    """
+    count = q.shape[0]
+    n_caps, n_boxes, n_pairs = cap_points.shape[0], box_frames.shape[0], pairs.shape[0]
+    frames = np.empty((12, BLOCK))
+    sn = np.empty(BLOCK)
+    cs = np.empty(BLOCK)
+    caps = np.empty((max(n_caps, 1) * 6, BLOCK))
+    boxes = np.empty((max(n_boxes, 1) * 12, BLOCK))
+    centres = np.empty((max(n_caps, 1) * 3, BLOCK))
+    half_length = np.empty(max(n_caps, 1))
+    inv_length_sq = np.empty(max(n_caps, 1))
+    for c in range(n_caps):
+        dx = cap_points[c, 3] - cap_points[c, 0]
+        dy = cap_points[c, 4] - cap_points[c, 1]
+        dz = cap_points[c, 5] - cap_points[c, 2]
+        half_length[c] = 0.5 * math.sqrt(dx * dx + dy * dy + dz * dz)
+        inv_length_sq[c] = 1.0 / max(dx * dx + dy * dy + dz * dz, 1e-300)
+    lower = np.empty((max(n_pairs, 1), BLOCK))
+    upper = np.empty(BLOCK)
+    lowest = np.empty(BLOCK)
+    nearest = np.zeros(BLOCK, dtype=np.int64)
+    lanes = np.empty(BLOCK, dtype=np.uint64)
+    values = np.empty(BLOCK)
+    near_a = np.empty((6, BLOCK))
+    near_b = np.empty((6, BLOCK))
+    near_box = np.empty((12, BLOCK))
+    w = np.empty((2, 3))
+    work = np.empty(14)
+    cap_world = np.empty((2, 6))
+    box_world = np.empty(12)
+    for s0 in range(0, count, BLOCK):
+        nb = min(BLOCK, count - s0)
+        _place_block(q, s0, nb, rot, pos, cap_body, cap_points, box_body, box_frames, frames, sn, cs, caps, boxes)
+        for c in range(n_caps):
+            for r in range(3):
+                start, end, centre = caps[6 * c + r], caps[6 * c + 3 + r], centres[3 * c + r]
+                for b in range(nb):
+                    centre[b] = 0.5 * (start[b] + end[b])
+        for b in range(nb):
+            upper[b] = np.inf
+            lowest[b] = np.inf
+            nearest[b] = 0
+        # the bounds of every pair, and the least upper bound of each configuration
+        for k in range(n_pairs):
+            kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+            low = lower[k]
+            level = floor[k] + offsets[k]
+            if kind == 2:
+                for b in range(nb):
+                    low[b] = np.inf
+                continue
+            xi, yi, zi = centres[3 * i], centres[3 * i + 1], centres[3 * i + 2]
+            if kind == 0:
+                xj, yj, zj = centres[3 * j], centres[3 * j + 1], centres[3 * j + 2]
+                ca, cb = caps[6 * i : 6 * i + 6], caps[6 * j : 6 * j + 6]
+                gap = radii[i] + radii[j] + level
+                reach_i, reach_j = half_length[i], half_length[j]
+                inv_i, inv_j = inv_length_sq[i], inv_length_sq[j]
+                for b in range(nb):
+                    # each centre against the other segment
+                    to_i = math.sqrt(_point_segment_sq(
+                        xj[b], yj[b], zj[b], ca[0, b], ca[1, b], ca[2, b],
+                        ca[3, b] - ca[0, b], ca[4, b] - ca[1, b], ca[5, b] - ca[2, b], inv_i,
+                    ))
+                    to_j = math.sqrt(_point_segment_sq(
+                        xi[b], yi[b], zi[b], cb[0, b], cb[1, b], cb[2, b],
+                        cb[3, b] - cb[0, b], cb[4, b] - cb[1, b], cb[5, b] - cb[2, b], inv_j,
+                    ))
+                    above = min(to_i, to_j) - gap
+                    low[b] = max(to_i - reach_j, to_j - reach_i) - gap
+                    upper[b] = min(upper[b], above)
+            else:
+                bx = boxes[12 * j : 12 * j + 12]
+                hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]
+                gap = radii[i] + level
+                reach = half_length[i]
+                for b in range(nb):
+                    x, y, z = xi[b] - bx[9, b], yi[b] - bx[10, b], zi[b] - bx[11, b]
+                    ex = _excess(bx[0, b] * x + bx[3, b] * y + bx[6, b] * z, hx)
+                    ey = _excess(bx[1, b] * x + bx[4, b] * y + bx[7, b] * z, hy)
+                    ez = _excess(bx[2, b] * x + bx[5, b] * y + bx[8, b] * z, hz)
+                    e = math.sqrt(ex * ex + ey * ey + ez * ez)
+                    above = e - gap
+                    low[b] = above - reach if e > reach else -np.inf
+                    upper[b] = min(upper[b], above)
+        # the pairs that may be the closest, exactly, in pair order
+        for k in range(n_pairs):
+            kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+            if kind == 2:
+                continue
+            low = lower[k]
+            m = 0
+            for b in range(nb):
+                lanes[m] = b
+                m += 0 if low[b] - BOUND_SLACK_M > upper[b] else 1
+            if m == 0:
+                continue
+            # whole SIMD lanes (copies of the last configuration): a loop's scalar remainder
+            # costs as much as a vector step per configuration
+            padded = min(-(-m // LANES) * LANES, BLOCK)
+            for t in range(m, padded):
+                lanes[t] = lanes[m - 1]
+            ca = caps[6 * i : 6 * i + 6]
+            if kind == 0:
+                cb = caps[6 * j : 6 * j + 6]
+                gap = radii[i] + radii[j] + offsets[k]
+                _capsule_lanes(ca, cb, lanes, padded, gap, near_a, near_b, values)
+            else:
+                bx = boxes[12 * j : 12 * j + 12]
+                hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]
+                gap = radii[i] + offsets[k]
+                _box_lanes(ca, bx, lanes, padded, hx, hy, hz, gap, near_a, near_box, values)
+                for t in range(m):
+                    if values[t] != values[t]:  # near or in the box: the scalar kernel
+                        _place(caps, boxes, i, j, lanes[t], cap_world, box_world)
+                        values[t] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+            for t in range(m):
+                b = lanes[t]
+                value = values[t] - floor[k]
+                closer = value < lowest[b]
+                lowest[b] = value if closer else lowest[b]
+                nearest[b] = k if closer else nearest[b]
+        for b in range(nb):
+            out_smallest[s0 + b] = lowest[b]
+            out_closest[s0 + b] = nearest[b]

@@ -22,7 +22,14 @@ from ...analysis.ability import (
     configuration_indices,
     fit_ability_model,
 )
-from ...collision import check_clearance_m, clearance, collision_pairs, reports_clearance
+from ...collision import (
+    check_clearance_m,
+    clearance,
+    collision_pairs,
+    margin_floor,
+    reports_clearance,
+    smallest_excess,
+)
 from ...compiled import use_compiled
 from ...errors import ConfigurationError, InfeasibleError
 from ...forward import COMPILED_MIN_BATCH
@@ -183,11 +190,14 @@ def optimal_halt_configuration(
     )
     clear = None
     if clearance_min_m is not None and checked:
-        sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin, witness=False)
-        clear = ~sampled.colliding()
+        # Clearance.colliding(margin), without the distances of pairs far from their floor
+        floor = margin_floor(model_locked, margin, keep_out)
+        excess, _ = smallest_excess(model_locked, q, floor, keep_out=keep_out)
+        clear = ~(excess < 0)
         admissible = clear if reachable is None else clear & reachable
         if not admissible.any():
             # the sample that comes nearest to keeping it, and the pair that stops it
+            sampled = clearance(model_locked, q, keep_out=keep_out, margin=margin, witness=False)
             short = sampled.shortfall()
             pool = np.flatnonzero(reachable) if reachable is not None and reachable.any() else np.arange(k)
             near = pool[int(np.argmin(short[pool].max(axis=1)))]
@@ -236,8 +246,8 @@ def optimal_halt_configuration(
     if refine:
         starts = q[order[: min(int(refine_starts), n_ok)]]
 
-        def keeps_clear(qs: FloatArray) -> np.ndarray:
-            return ~clearance(model_locked, qs, keep_out=keep_out, witness=False).colliding(margin)
+        def keeps_clear(qs: FloatArray) -> np.ndarray:  # ~Clearance.colliding(margin)
+            return ~(smallest_excess(model_locked, qs, floor, keep_out=keep_out)[0] < 0)
 
         # exact()'s CP, bit for bit, in one compiled call in a worker
         cp_of = ability.evaluator(model_locked, jacobian=jacobian, characteristic_length=characteristic_length)
