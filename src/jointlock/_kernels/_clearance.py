@@ -467,6 +467,7 @@ def clearance_smallest(
     nearest = np.zeros(BLOCK, dtype=np.int64)
     lanes = np.empty(BLOCK, dtype=np.uint64)
     values = np.empty(BLOCK)
+    dense = np.empty(BLOCK)
     near_a = np.empty((6, BLOCK))
     near_b = np.empty((6, BLOCK))
     near_box = np.empty((12, BLOCK))
@@ -560,11 +561,13 @@ def clearance_smallest(
                     if values[t] != values[t]:  # near or in the box: the scalar kernel
                         _place(caps, boxes, i, j, lanes[t], cap_world, box_world)
                         values[t] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+            for b in range(nb):
+                dense[b] = np.inf
             for t in range(m):
-                b = lanes[t]
-                value = values[t] - floor[k]
-                closer = value < lowest[b]
-                lowest[b] = value if closer else lowest[b]
+                dense[lanes[t]] = values[t] - floor[k]
+            for b in range(nb):  # in SIMD registers: a pair left out is at +inf
+                closer = dense[b] < lowest[b]
+                lowest[b] = dense[b] if closer else lowest[b]
                 nearest[b] = k if closer else nearest[b]
         for b in range(nb):
             out_smallest[s0 + b] = lowest[b]
