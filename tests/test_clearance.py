@@ -866,10 +866,56 @@ def test_the_smallest_excess_is_that_of_every_pairs_distance_bit_for_bit(name):
             assert np.array_equal(margin_floor(arm, 0.05, keep), np.where(mounted, 0.0, 0.05))
             first = q.reshape(-1, arm.dof)[:1]
             assert smallest_excess(arm, first, tie, keep_out=keep)[1][0] == 0  # every pair tied
-    with pytest.raises(ConfigurationError, match=r"floor must be one finite distance \[m\] per checked pair"):
+    with pytest.raises(ConfigurationError, match=r"floor must be one distance \[m\] per checked pair, shape \(\d+,\); got shape \(2,\)"):
         smallest_excess(arm, wide, np.zeros(2))
-    with pytest.raises(ConfigurationError, match="floor must be"):
+    with pytest.raises(ConfigurationError, match=r"floor must be finite \[m\]; got nan \(pair "):
         smallest_excess(arm, wide, np.full(len(collision_pairs(arm).names), np.nan))
+
+
+def test_the_smallest_excess_keeps_the_pairs_a_computed_distance_makes_the_closest():
+    """Where a computed distance errs more than round-off, or round-off grows with the size of
+    the numbers, the pair it makes the closest is still computed (from an independent
+    review): a keep-out rod crossing halt7's longest boom at its centre 1e-7 rad off parallel
+    (the segment distance leaves out the interior point: 5e-9 m too far, against a centre
+    bound that is exact), with a far sphere's floor set 5e-9 m below it; and two spheres tied to
+    half an ulp under floors of 1e5-1e12 m."""
+    arm = jl.load_robot("halt7")
+    q = np.full((1, arm.dof), 0.3)
+    shapes = collision_pairs(arm)
+    state = jl.forward.chain_state(arm, q)
+    lengths = np.linalg.norm(shapes.capsule_points[:, 3:] - shapes.capsule_points[:, :3], axis=1)
+    c = int(np.argmax(np.where(shapes.capsule_body >= 0, lengths, 0.0)))
+    body, points = shapes.capsule_body[c], shapes.capsule_points[c]
+    a, b = (state.rotations[0, body] @ points[s] + state.positions[0, body] for s in (slice(0, 3), slice(3, 6)))
+    centre, along = 0.5 * (a + b), (b - a) / np.linalg.norm(b - a)
+    across = np.cross(along, [1.0, 0.0, 0.0])
+    across /= np.linalg.norm(across)
+    rod = Capsule(tuple(centre - 0.2 * along - 1e-8 * across), tuple(centre + 0.2 * along + 1e-8 * across), 0.02, name="rod")
+    keep = (rod, Sphere(center=(3.0, 3.0, 3.0), radius=0.1, name="ball"))
+    names = collision_pairs(arm, keep).names
+    d = clearance(arm, q, keep_out=keep, witness=False).pair_distance[0]
+    by_rod = min((k for k, name in enumerate(names) if "rod" in name), key=lambda k: d[k])
+    by_ball = names.index(names[by_rod].replace("rod", "ball"))
+    floor = np.full(len(names), -10.0)
+    floor[by_rod] = 0.0
+    floor[by_ball] = d[by_ball] - d[by_rod] + 5e-9
+    excess, pair = smallest_excess(arm, q, floor, keep_out=keep)
+    assert pair[0] == by_ball and excess[0] == (d - floor).min()
+
+    rng = np.random.default_rng(3)
+    for _ in range(20):
+        keep = tuple(Sphere(center=tuple(rng.uniform(-1.5, 1.5, 3)), radius=0.1, name=n) for n in "AB")
+        names = collision_pairs(arm, keep).names
+        q = rng.uniform(-np.pi, np.pi, (1, arm.dof))
+        d = clearance(arm, q, keep_out=keep, witness=False).pair_distance[0]
+        first, second = (min((k for k, name in enumerate(names) if name.endswith(f"- {s}")), key=lambda k: d[k]) for s in "AB")
+        for size in 10.0 ** rng.uniform(5, 12, 4):
+            for step in range(-3, 4):
+                floor = np.full(len(names), size - 1e3)
+                floor[first] = size
+                floor[second] = size + d[second] - d[first] + step * np.spacing(size) * 0.5
+                excess, pair = smallest_excess(arm, q, floor, keep_out=keep)
+                assert excess[0] == (d - floor).min() and pair[0] == (d - floor).argmin()
 
 
 def test_the_singularity_search_may_leave_out_colliding_configurations(tmp_path, capsys):

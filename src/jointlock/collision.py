@@ -589,11 +589,12 @@ def smallest_excess(
     q = as_joint_array(model, q)
     pairs = collision_pairs(model, keep_out)
     floor = np.asarray(floor, dtype=float)
-    if floor.shape != (len(pairs.names),) or not np.all(np.isfinite(floor)):
+    if floor.shape != (len(pairs.names),):
         raise ConfigurationError(
-            f"floor must be one finite distance [m] per checked pair, shape ({len(pairs.names)},); "
-            f"got shape {floor.shape}"
+            f"floor must be one distance [m] per checked pair, shape ({len(pairs.names)},); got shape {floor.shape}"
         )
+    if not np.all(np.isfinite(floor)):
+        raise ConfigurationError(f"floor must be finite [m]; got {floor[~np.isfinite(floor)][0]} (pair {pairs.names[int(np.argmin(np.isfinite(floor)))]})")
     smallest, closest = _smallest(model, pairs, q.reshape(-1, model.dof), floor)
     return smallest.reshape(q.shape[:-1]), closest.reshape(q.shape[:-1])
 

@@ -44,9 +44,17 @@ from ._distance import _capsule_box, _capsule_capsule
 #: kernel (touching or overlapping: its penetration depth and witness points).
 NEAR_BOX_M = 1e-6
 #: :func:`clearance_smallest` leaves a pair out only when its lower bound exceeds the least
-#: upper bound by more than this [m]: far above the bounds' and the distances' round-off
-#: (1e-13 m at arm scale), so that the closest pair is never left out.
+#: upper bound by more than its slack: this [m], plus :data:`PARALLEL_SLACK` of the pair's
+#: longer segment, plus :data:`ROUND_OFF_SLACK` of the coordinates' and the floor's size, so
+#: that the pair a computed distance makes the closest is never left out.
 BOUND_SLACK_M = 1e-9
+#: A capsule pair's computed distance may exceed the true one by up to this share of the
+#: longer segment [-]: :func:`_segments_sq` leaves out the interior critical point of nearly
+#: parallel segments (``sin^2`` of their angle below 1e-14, so by at most 1e-7 of a length).
+PARALLEL_SLACK = 1e-6
+#: The bounds' and the distances' round-off, as a share of the size of the coordinates, the
+#: floors and the offsets [-] (some 450 units in the last place).
+ROUND_OFF_SLACK = 1e-13
 #: Doubles in a SIMD register (AVX-512); :func:`clearance_smallest` computes its pairs in whole
 #: registers.
 LANES = 8
@@ -357,6 +365,33 @@ def _gather(rows, lanes, m, out):
 
 
 @_jit
+def _pair_slack(pos, cap_points, box_frames, halves, pairs, offsets, floor, half_length):
+    """(P,) by how much a pair's lower bound must exceed the least upper bound to be left out
+    [m] (:data:`BOUND_SLACK_M`)."""
+    # every coordinate of a placed shape is at most this far from the origin: the chain's
+    # offsets (its rotations keep lengths) plus the farthest point of any shape
+    extent = 0.0
+    for i in range(pos.shape[0]):
+        extent += math.sqrt(pos[i, 0] ** 2 + pos[i, 1] ** 2 + pos[i, 2] ** 2)
+    farthest = 0.0
+    for c in range(cap_points.shape[0]):
+        for end in range(2):
+            x, y, z = cap_points[c, 3 * end], cap_points[c, 3 * end + 1], cap_points[c, 3 * end + 2]
+            farthest = max(farthest, math.sqrt(x * x + y * y + z * z))
+    for k in range(box_frames.shape[0]):
+        centre = math.sqrt(box_frames[k, 9] ** 2 + box_frames[k, 10] ** 2 + box_frames[k, 11] ** 2)
+        farthest = max(farthest, centre + math.sqrt(halves[k, 0] ** 2 + halves[k, 1] ** 2 + halves[k, 2] ** 2))
+    extent += farthest
+    out = np.empty(pairs.shape[0])
+    for k in range(pairs.shape[0]):
+        kind, i, j = pairs[k, 0], pairs[k, 1], pairs[k, 2]
+        longest = 2.0 * max(half_length[i], half_length[j]) if kind == 0 else 0.0
+        size = extent + abs(floor[k]) + abs(offsets[k])
+        out[k] = BOUND_SLACK_M + PARALLEL_SLACK * longest + ROUND_OFF_SLACK * size
+    return out
+
+
+@_jit
 def _capsule_lanes(ca, cb, lanes, m, gap, near_a, near_b, values):
     """``values[t]``: :func:`_capsule_lane` of configuration ``lanes[t]``, ``t < m``."""
     _gather(ca, lanes, m, near_a)
@@ -431,8 +466,9 @@ def clearance_smallest(
       box; otherwise nothing is bounded).
 
     The least of the upper bounds over the pairs bounds the configuration's smallest excess; a
-    pair whose lower bound exceeds it by more than :data:`BOUND_SLACK_M` cannot be the closest
-    and is not computed.  The others are, exactly, in pair order, so that the smallest excess
+    pair whose lower bound exceeds it by more than its slack (:data:`BOUND_SLACK_M`: the
+    computed distances' own errors, round-off and nearly parallel segments) cannot be the
+    closest and is not computed.  The others are, exactly, in pair order, so that the smallest excess
     and its pair (the first of equal ones) are those of every pair computed.
 
     Parameters
@@ -461,6 +497,7 @@ def clearance_smallest(
         dz = cap_points[c, 5] - cap_points[c, 2]
         half_length[c] = 0.5 * math.sqrt(dx * dx + dy * dy + dz * dz)
         inv_length_sq[c] = 1.0 / max(dx * dx + dy * dy + dz * dz, 1e-300)
+    slack = _pair_slack(pos, cap_points, box_frames, halves, pairs, offsets, floor, half_length)
     lower = np.empty((max(n_pairs, 1), BLOCK))
     upper = np.empty(BLOCK)
     lowest = np.empty(BLOCK)
@@ -539,7 +576,7 @@ def clearance_smallest(
             m = 0
             for b in range(nb):
                 lanes[m] = b
-                m += 0 if low[b] - BOUND_SLACK_M > upper[b] else 1
+                m += 0 if low[b] - slack[k] > upper[b] else 1
             if m == 0:
                 continue
             # whole SIMD lanes (copies of the last configuration): a loop's scalar remainder

@@ -189,11 +189,10 @@ def optimal_halt_configuration(
         model_locked, keep_out
     )
     clear = None
+    keeps_clear: Callable[[FloatArray], np.ndarray] | None = None
     if clearance_min_m is not None and checked:
-        # Clearance.colliding(margin), without the distances of pairs far from their floor
-        floor = margin_floor(model_locked, margin, keep_out)
-        excess, _ = smallest_excess(model_locked, q, floor, keep_out=keep_out)
-        clear = ~(excess < 0)
+        keeps_clear = _clearance_test(model_locked, margin_floor(model_locked, margin, keep_out), keep_out)
+        clear = keeps_clear(q)
         admissible = clear if reachable is None else clear & reachable
         if not admissible.any():
             # the sample that comes nearest to keeping it, and the pair that stops it
@@ -246,16 +245,13 @@ def optimal_halt_configuration(
     if refine:
         starts = q[order[: min(int(refine_starts), n_ok)]]
 
-        def keeps_clear(qs: FloatArray) -> np.ndarray:  # ~Clearance.colliding(margin)
-            return ~(smallest_excess(model_locked, qs, floor, keep_out=keep_out)[0] < 0)
-
         # exact()'s CP, bit for bit, in one compiled call in a worker
         cp_of = ability.evaluator(model_locked, jacobian=jacobian, characteristic_length=characteristic_length)
 
         # the starts in lockstep where every batch of CP is the compiled kernel's (a worker),
         # whose numbers for a configuration do not depend on the batch: the same points
         refined_q, refined_cp, evaluations = _refine(
-            cp_of, starts, lo, hi, exact_reach, keeps_clear if clear is not None else None,
+            cp_of, starts, lo, hi, exact_reach, keeps_clear,
             lockstep=use_compiled(2 * n + 1, COMPILED_MIN_BATCH),
         )  # fmt: skip
     best = best_sample
@@ -337,3 +333,14 @@ def evaluate_cp(result: HaltConfiguration, model_locked: ArmModel, q: ArrayLike)
         model_locked, q, jacobian=result.jacobian, characteristic_length=result.characteristic_length
     )
     return result.ability(ind)
+
+
+def _clearance_test(model: ArmModel, floor: FloatArray, keep_out: Sequence[Shape]) -> Callable[[FloatArray], np.ndarray]:
+    """(K, n) configurations -> (K,) whether each keeps every pair above its floor (P,) [m]:
+    ``~Clearance.colliding(margin)`` for the floors of a margin, without the distances of pairs
+    far from their floor (:func:`jointlock.collision.smallest_excess`)."""
+
+    def keeps_clear(qs: FloatArray) -> np.ndarray:
+        return ~(smallest_excess(model, qs, floor, keep_out=keep_out)[0] < 0)
+
+    return keeps_clear

@@ -105,10 +105,11 @@ def _shortfall_at(
     step = max(1, CHUNK_SAMPLES // n_t)
     for start in range(0, k.size, step):
         q, _, _ = problem.on_grid(k[start : start + step], problem.n_check, index)
-        # max(floor - d) over times and pairs, as -min(d - floor): the same bits (IEEE
-        # subtraction is antisymmetric), without the distances of pairs far from their floor
+        # max(floor - d) over times and pairs as 0 - min(d - floor), without the distances of
+        # pairs far from their floor: the same value (IEEE subtraction is antisymmetric; 0 - x
+        # keeps a zero +0, as floor - d gives it)
         excess, _ = smallest_excess(problem.model, q, floor, keep_out=keep_out)  # (K, n_t)
-        out[start : start + step] = -excess.min(axis=-1)
+        out[start : start + step] = 0.0 - excess.min(axis=-1)
     return out
 
 
