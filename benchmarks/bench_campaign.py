@@ -12,10 +12,13 @@ global torque, the smallest T, the verdicts, ...) moved against the revision bef
 A halt campaign (halt7, 000's strategy: 7 joints x 8 locked angles x 2 halt times = 112 cases)
 and a jump campaign (canadarm7, 001's task: 7 joints x 12 failure times = 84 cases), each run
 serially in-process, on a local process pool of ``W`` workers and on a Dask LocalCluster of
-``W`` workers (default 2).  Printed per engine: wall time, cases/s, speed-up over the serial
-run and parallel efficiency (speed-up / W), and the engine's overhead per case:
-``(wall x W - sum of the cases' own times) / cases`` (scheduling, transfers, resolving, the
-ledger, workers' start-up, idle tails), also as a share of the work.  Then the ledger's write
+``W`` workers (default 2), each twice on the same engine: cold (its workers start in the run:
+imports, numba's load, the models) and warm (the same campaign again, on the started workers:
+what a long campaign sees after its first seconds).  Printed per engine and run: wall time,
+cases/s, speed-up over the serial run of the same kind and parallel efficiency (speed-up / W),
+and the engine's overhead per case: ``(wall x W - sum of the cases' own times) / cases``
+(scheduling, transfers, resolving, the ledger, workers' start-up, idle tails), also as a share
+of the work.  Then the ledger's write
 rate (one transaction per batch of 100 outcomes).  Aim: >= 1.8x serial with 2 workers, overhead
 < 5 % of the work.
 
@@ -63,37 +66,39 @@ def run_engines(name: str, text: str, workers: int, folder: Path) -> None:
     path.write_text(text)
     spec = campaign.load_campaign(path)
     rows = []
-    serial_wall = None
+    serial = {}
     for label in ("serial (in-process)", f"process pool x{workers}", f"dask LocalCluster x{workers}"):
-        out = folder / f"{name}-{label.split()[0]}"
         start_s = 0.0
+        t0 = time.perf_counter()
         if label.startswith("serial"):
             engine, n = campaign.in_process(), 1
         elif label.startswith("process"):
-            engine, n = None, workers  # created (and its workers started) inside the run: start-up counted
+            engine, n = campaign.process_pool(workers), workers  # workers start in the first run
         else:
-            t0 = time.perf_counter()
             engine, n = campaign.dask_cluster("local", workers=workers), workers
             start_s = time.perf_counter() - t0
         try:
-            res = campaign.run_campaign(spec, out, engine=engine, workers=workers, batch_seconds=10.0)
+            # cold: the engine's workers start (imports, numba's load, the models) in this run;
+            # warm: the same campaign again on the same engine, its workers started
+            for run in ("cold", "warm"):
+                out = folder / f"{name}-{label.split()[0]}-{run}"
+                res = campaign.run_campaign(spec, out, engine=engine, workers=workers, batch_seconds=10.0)
+                cases = res.ok + res.failed
+                wall = res.seconds
+                serial.setdefault(run, wall)
+                overhead = (wall * n - res.case_seconds) / cases
+                rows.append(
+                    (f"{label}, {run}", cases, wall, cases / wall, serial[run] / wall, serial[run] / wall / n,
+                     1e3 * overhead, 100 * overhead * cases / res.case_seconds, start_s if run == "cold" else 0.0)
+                )  # fmt: skip
         finally:
-            if engine is not None:
-                engine.close()
-        cases = res.ok + res.failed
-        wall = res.seconds
-        serial_wall = wall if serial_wall is None else serial_wall
-        overhead = (wall * n - res.case_seconds) / cases
-        rows.append(
-            (label, cases, wall, cases / wall, serial_wall / wall, serial_wall / wall / n, 1e3 * overhead,
-             100 * overhead * cases / res.case_seconds, start_s)
-        )  # fmt: skip
-    print(f"\n{name}: {spec.title} ({rows[0][1]} cases, {rows[0][2] / rows[0][1]:.3f} s per case serially)")
-    print(f"{'engine':<26}{'wall [s]':>9}{'cases/s':>9}{'speed-up':>10}{'efficiency':>11}"
+            engine.close()
+    print(f"\n{name}: {spec.title} ({rows[0][1]} cases, {rows[1][2] / rows[1][1]:.3f} s per case serially, warm)")
+    print(f"{'engine':<32}{'wall [s]':>9}{'cases/s':>9}{'speed-up':>10}{'efficiency':>11}"
           f"{'overhead/case':>15}{'of work':>9}{'cluster start':>15}")  # fmt: skip
     for label, _, wall, rate, speedup, eff, over_ms, over_pct, start_s in rows:
         start = f"{start_s:.1f} s" if start_s else "-"
-        print(f"{label:<26}{wall:9.2f}{rate:9.2f}{speedup:9.2f}x{100 * eff:10.0f}%{over_ms:12.1f} ms"
+        print(f"{label:<32}{wall:9.2f}{rate:9.2f}{speedup:9.2f}x{100 * eff:10.0f}%{over_ms:12.1f} ms"
               f"{over_pct:8.1f}%{start:>15}")  # fmt: skip
 
 
