@@ -19,10 +19,11 @@ cases/s, speed-up over the serial run of the same kind and parallel efficiency (
 and the engine's overhead per case: ``(wall x W - sum of the cases' own times) / cases``
 (scheduling, transfers, resolving, the ledger, workers' start-up, idle tails), also as a share
 of the work.  Then the ledger's write
-rate (one transaction per batch of 100 outcomes).  Aim: >= 1.8x serial with 2 workers, overhead
+rate (one transaction per batch of 100 outcomes), and the driver planning 10^5 and 10^6 sampled
+halt cases (``--plan``): wall time and peak RSS, each in a fresh process.  Aim: >= 1.8x serial with 2 workers, overhead
 < 5 % of the work.
 
-    python benchmarks/bench_campaign.py [WORKERS] [--before REV] [--cases N] [--costs-only]
+    python benchmarks/bench_campaign.py [WORKERS] [--before REV] [--cases N] [--costs-only | --engines-only] [--plan N,N]
 """
 
 from __future__ import annotations
@@ -203,6 +204,36 @@ def ledger_rate(folder: Path, n: int = 20000, batch: int = 100) -> None:
     print(f"\nledger: {n} outcomes in batches of {batch}: {n / dt:,.0f} cases/s ({1e6 * dt / n:.0f} us per case)")
 
 
+#: Run in a fresh interpreter: ``jointlock campaign plan`` of a sampled halt campaign of N cases
+#: (no probe), then print its wall seconds and the process's peak RSS [MB].
+_PLAN_SCRIPT = """
+import resource, sys, time
+from jointlock.cli import main
+t0 = time.perf_counter()
+main(["campaign", "plan", sys.argv[1], "--out", sys.argv[2], "--probe", "0", "--json"])
+print(time.perf_counter() - t0, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024)
+"""
+
+
+def driver_memory(folder: Path, sizes: list[int]) -> None:
+    """The coordinator planning N sampled halt cases (joint and lock angle, as issue 29's
+    100,002-case campaign): wall time and peak RSS, each in a fresh process."""
+    print("\ndriver: `jointlock campaign plan` of a sampled halt7 campaign (--probe 0), a fresh process each")
+    for n in sizes:
+        path = folder / f"plan{n}.toml"
+        path.write_text(
+            f'title = "plan {n}"\nscenario = "{ROOT / "examples" / "halt_000.toml"}"\nseed = 0\n[set]\n'
+            '"halt.minimum_T" = true\n"halt_config.samples" = 4000\n"halt_config.reachable" = false\n'
+            f'[sample]\nn = {n}\nranges = {{ "failure.angle_deg" = [-170.0, 170.0], "failure.joint" = [1, 7] }}\n'
+        )
+        out = subprocess.run(
+            [sys.executable, "-c", _PLAN_SCRIPT, str(path), str(folder / f"plan{n}-out")],
+            capture_output=True, text=True, check=True,
+        )  # fmt: skip
+        seconds, rss = (float(x) for x in out.stdout.split()[-2:])
+        print(f"  {n:>9,} planned cases: {seconds:7.1f} s ({1e3 * seconds / n:.2f} ms per case), peak RSS {rss:,.0f} MB")
+
+
 def main(argv: list[str]) -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("workers", nargs="?", type=int, default=2)
@@ -210,6 +241,9 @@ def main(argv: list[str]) -> int:
     parser.add_argument("--cases", type=int, default=15, help="cases of each campaign in the per-case cost")
     parser.add_argument("--costs-only", action="store_true", help="the per-case cost only, no engines")
     parser.add_argument("--engines-only", action="store_true", help="the engines only, no per-case cost")
+    parser.add_argument(
+        "--plan", default="100000,1000000", help="planned cases the driver's memory is measured at (comma-separated; '' none)"
+    )
     args = parser.parse_args(argv[1:])
     print(machine_info())
     if not args.engines_only:
@@ -221,6 +255,7 @@ def main(argv: list[str]) -> int:
         run_engines("halt", HALT, args.workers, folder)
         run_engines("jump", JUMP, args.workers, folder)
         ledger_rate(folder)
+        driver_memory(folder, [int(n) for n in args.plan.split(",") if n.strip()])
     return 0
 
 
