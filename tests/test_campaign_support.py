@@ -106,3 +106,30 @@ def test_progress_off_a_terminal_logs_a_line_now_and_then():
     quiet = io.StringIO()
     Progress(5, "cases", stream=quiet, unit="cases").update(5)  # no log_every_s: silent
     assert quiet.getvalue() == ""
+
+
+def test_a_workers_cases_do_not_import_matplotlib():
+    """A campaign worker's halt and jump cases draw nothing, so they leave matplotlib (0.1 s of
+    every worker's start) unimported: a fresh interpreter runs one case of each example
+    campaign as a worker does."""
+    import subprocess
+    import sys
+
+    script = """
+import sys
+from jointlock import campaign
+from jointlock.campaign._cases import plan_cases
+from jointlock.campaign._columns import check_columns
+for name in sys.argv[1:]:
+    spec = campaign.load_campaign(name)
+    plan = plan_cases(spec)
+    (outcome,) = campaign.run_batch(campaign.make_task(spec, list(plan.cases[:1]), check_columns(spec, plan)))
+    assert outcome.ok, outcome
+print("matplotlib" in sys.modules)
+"""
+    examples = Path(__file__).resolve().parents[1] / "examples" / "campaigns"
+    out = subprocess.run(
+        [sys.executable, "-c", script, str(examples / "halt7.toml"), str(examples / "jump_canadarm7.toml")],
+        capture_output=True, text=True, check=True,
+    )  # fmt: skip
+    assert out.stdout.split()[-1] == "False"
