@@ -730,6 +730,51 @@ def test_the_fused_kernels_primitives_equal_coal():
     assert apart > count / 3
 
 
+def test_the_fused_kernels_depth_near_a_box_is_the_scalar_kernels_bit_for_bit():
+    """Capsule-box pairs whose segment comes within NEAR_BOX_M of the box go to a branch-free
+    copy of the scalar kernel's distance (its pieces between sorted breakpoints, then the
+    penetration depth over the box axes and their cross products): the same bits as
+    ``_distance._capsule_box`` on segments through the box, inside it, touching a face, lying
+    in a face plane, along an edge, parallel to an axis, of zero length, and ending on a face,
+    for boxes turned and not; several blocks of lanes, a partial one included."""
+    from jointlock._kernels._clearance import BLOCK, _near_box_lanes
+    from jointlock._kernels._distance import _capsule_box
+
+    rng = np.random.default_rng(31)
+    halves = np.array([0.5, 0.8, 0.3])
+    for block in range(6):
+        lanes = BLOCK if block < 5 else 37
+        rot = np.eye(3) if block % 2 else _random_rotation(rng)
+        centre = rng.normal(size=3)
+        a = rng.uniform(-1.0, 1.0, (lanes, 3)) * halves * 1.3
+        v = rng.normal(size=(lanes, 3)) * rng.uniform(0.0, 2.0, (lanes, 1))
+        v[::9] = 0.0  # a sphere
+        v[1::9, 1:] = 0.0  # along the box's x axis
+        a[2::9, 2] = halves[2]  # in the plane of the top face
+        v[2::9, 2] = 0.0
+        a[3::9, 1:] = halves[1:]  # along an edge
+        v[3::9, 1:] = 0.0
+        a[4::9] = halves * np.array([1.0, 0.2, -0.4])  # starting on a face
+        a[5::9] = -a[5::9] * 0.1  # from the middle
+        v[6::9] = -2.0 * a[6::9]  # through the centre
+        ends = np.hstack([a, a + v])  # box frame
+        world = np.hstack([ends[:, :3] @ rot.T + centre, ends[:, 3:] @ rot.T + centre])
+        caps = np.zeros((6, BLOCK))
+        caps[:, :lanes] = world.T
+        box = np.zeros((12, BLOCK))
+        box[:9, :lanes] = rot.reshape(9, 1)
+        box[9:, :lanes] = centre.reshape(3, 1)
+        values = np.full(BLOCK, np.nan)
+        _near_box_lanes(
+            caps, box, values, lanes, np.empty(BLOCK, dtype=np.uint64), *halves, 0.1, 0.0,
+            np.empty(BLOCK), np.empty((6, BLOCK)), np.empty((12, BLOCK)),
+        )  # fmt: skip
+        w, work = np.empty((2, 3)), np.empty(14)
+        scalar = [_capsule_box(world[t], 0.1, np.concatenate([rot.ravel(), centre]), halves, w, work) for t in range(lanes)]
+        assert np.array_equal(values[:lanes], scalar)
+        assert np.any(values[:lanes] < -0.1) and np.any(values[:lanes] > 0.0)
+
+
 def _shape_by_shape(model: jl.ArmModel, q: np.ndarray, keep_out=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The scalar kernel on shapes placed by numpy's forward kinematics: the fused kernel's
     reference (its pairs' distances, closest pair and witness points)."""

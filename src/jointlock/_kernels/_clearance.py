@@ -299,6 +299,10 @@ def clearance_distances(
     work = np.empty(14)
     cap_world = np.empty((2, 6))
     box_world = np.empty(12)
+    near_lanes = np.empty(BLOCK, dtype=np.uint64)
+    fixed = np.empty(BLOCK)
+    cap_rows = np.empty((6, BLOCK))
+    box_rows = np.empty((12, BLOCK))
     for s0 in range(0, count, BLOCK):
         nb = min(BLOCK, count - s0)
         _place_block(q, s0, nb, rot, pos, cap_body, cap_points, box_body, box_frames, frames, sn, cs, caps, boxes)
@@ -324,15 +328,15 @@ def clearance_distances(
                 for b in range(nb):
                     out[b] = _box_lane(ca, bx, b, hx, hy, hz, gap)
 
-        # pairs near or in a box: the scalar kernel (penetration depth)
+        # pairs near or in a box: the scalar kernel's distance (penetration depth), in SIMD
         for k in range(n_pairs):
             if pairs[k, 0] != 1:
                 continue
             i, j = pairs[k, 1], pairs[k, 2]
-            for b in range(nb):
-                if dist[k, b] != dist[k, b]:
-                    _place(caps, boxes, i, j, b, cap_world, box_world)
-                    dist[k, b] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+            _near_box_lanes(
+                caps[6 * i : 6 * i + 6], boxes[12 * j : 12 * j + 12], dist[k], nb, near_lanes,
+                halves[j, 0], halves[j, 1], halves[j, 2], radii[i], offsets[k], fixed, cap_rows, box_rows,
+            )  # fmt: skip
         # the closest pair: a mounted one only when deeper than at the zero pose
         for b in range(nb):
             lowest[b] = np.inf
@@ -407,6 +411,148 @@ def _box_lanes(ca, bx, lanes, m, hx, hy, hz, gap, near_a, near_box, values):
     _gather(bx, lanes, m, near_box)
     for t in range(m):
         values[t] = _box_lane(near_a, near_box, t, hx, hy, hz, gap)
+
+
+@_inline
+def _sorted2(a, b):
+    return min(a, b), max(a, b)
+
+
+@_inline
+def _cut_scalar(p, d, h, sign):
+    """A breakpoint of ``_distance._capsule_box`` (the same operations), or 0 where that
+    kernel has none (``d == 0`` or outside (0, 1)): a repeated 0 only adds the piece [0, 0]."""
+    t = (sign * h - p) / d
+    return t if (d != 0.0 and 0.0 < t < 1.0) else 0.0
+
+
+@_inline
+def _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, t0, t1):
+    """The smallest squared distance ``_distance._capsule_box`` finds on the piece [t0, t1] of
+    the segment (its four candidates, the same operations)."""
+    tm = 0.5 * (t0 + t1)
+    qa = 0.0
+    qb = 0.0
+    # a coordinate outside its slab at tm adds its term (adding 0.0 changes no sum here: qa
+    # and qb start at +0.0, and no sum of such terms is -0.0)
+    x = px + tm * dx
+    out = x > hx or x < -hx
+    qa += dx * dx if out else 0.0
+    qb += ((px - hx) if x > hx else (px + hx)) * dx if out else 0.0
+    x = py + tm * dy
+    out = x > hy or x < -hy
+    qa += dy * dy if out else 0.0
+    qb += ((py - hy) if x > hy else (py + hy)) * dy if out else 0.0
+    x = pz + tm * dz
+    out = x > hz or x < -hz
+    qa += dz * dz if out else 0.0
+    qb += ((pz - hz) if x > hz else (pz + hz)) * dz if out else 0.0
+    t = min(max(-qb / qa, t0), t1) if qa > 0.0 else t0
+    best = _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, t0)
+    best = min(best, _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, t))
+    best = min(best, _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, tm))
+    return min(best, _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, t1))
+
+
+@_inline
+def _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, t):
+    ex = _excess(px + t * dx, hx)
+    ey = _excess(py + t * dy, hy)
+    ez = _excess(pz + t * dz, hz)
+    return 0.0 + ex * ex + ey * ey + ez * ez
+
+
+@_inline
+def _facet_depth(ux, uy, uz, hx, hy, hz, dx, dy, dz, mx, my, mz):
+    """How far the segment must move along +-u to leave the box, the smaller of the two
+    (``_distance._capsule_box``'s candidate, the same operations)."""
+    spread = hx * abs(ux) + hy * abs(uy) + hz * abs(uz)
+    spread += 0.5 * abs(ux * dx + uy * dy + uz * dz)
+    along = ux * mx + uy * my + uz * mz
+    return min(spread - 1.0 * along, spread - -1.0 * along)
+
+
+@_inline
+def _cross_depth(ux, uy, uz, dn, hx, hy, hz, dx, dy, dz, mx, my, mz):
+    """:func:`_facet_depth` along the unit ``u / |u|``, +inf where ``_distance._capsule_box``
+    leaves the candidate out (a zero segment, or ``u`` nearly parallel to it)."""
+    un = math.sqrt(ux * ux + uy * uy + uz * uz)
+    depth = _facet_depth(ux / un, uy / un, uz / un, hx, hy, hz, dx, dy, dz, mx, my, mz)
+    return depth if (dn > 0.0 and not un <= 1e-12 * dn) else np.inf
+
+
+@_inline
+def _near_box_distance(ca, bx, t, hx, hy, hz, radius):
+    """The signed distance of ``_distance._capsule_box`` (capsule ``ca``, box ``bx`` of half
+    extents h, configuration ``t`` of the rows) branch-free, bit for bit, for the
+    configurations whose segment comes within :data:`NEAR_BOX_M` of the box: its squared
+    distance over the pieces between the sorted breakpoints (a sorting network instead of an
+    insertion sort: the same pieces, and repeated zeros for missing breakpoints), and where
+    that is 0, the penetration depth over the box's axes and their cross products with the
+    segment."""
+    ox, oy, oz = ca[0, t] - bx[9, t], ca[1, t] - bx[10, t], ca[2, t] - bx[11, t]
+    vx, vy, vz = ca[3, t] - ca[0, t], ca[4, t] - ca[1, t], ca[5, t] - ca[2, t]
+    px = bx[0, t] * ox + bx[3, t] * oy + bx[6, t] * oz
+    py = bx[1, t] * ox + bx[4, t] * oy + bx[7, t] * oz
+    pz = bx[2, t] * ox + bx[5, t] * oy + bx[8, t] * oz
+    dx = bx[0, t] * vx + bx[3, t] * vy + bx[6, t] * vz
+    dy = bx[1, t] * vx + bx[4, t] * vy + bx[7, t] * vz
+    dz = bx[2, t] * vx + bx[5, t] * vy + bx[8, t] * vz
+    c0, c1 = _cut_scalar(px, dx, hx, -1.0), _cut_scalar(px, dx, hx, 1.0)
+    c2, c3 = _cut_scalar(py, dy, hy, -1.0), _cut_scalar(py, dy, hy, 1.0)
+    c4, c5 = _cut_scalar(pz, dz, hz, -1.0), _cut_scalar(pz, dz, hz, 1.0)
+    for _ in range(1):  # a sorting network of the six breakpoints
+        c1, c2 = _sorted2(c1, c2)
+        c4, c5 = _sorted2(c4, c5)
+        c0, c2 = _sorted2(c0, c2)
+        c3, c5 = _sorted2(c3, c5)
+        c0, c1 = _sorted2(c0, c1)
+        c3, c4 = _sorted2(c3, c4)
+        c1, c4 = _sorted2(c1, c4)
+        c0, c3 = _sorted2(c0, c3)
+        c2, c5 = _sorted2(c2, c5)
+        c1, c3 = _sorted2(c1, c3)
+        c2, c4 = _sorted2(c2, c4)
+        c2, c3 = _sorted2(c2, c3)
+    best = _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, 0.0, c0)
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c0, c1))
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c1, c2))
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c2, c3))
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c3, c4))
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c4, c5))
+    best = min(best, _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, c5, 1.0))
+    dn = math.sqrt(dx * dx + dy * dy + dz * dz)
+    mx, my, mz = px + 0.5 * dx, py + 0.5 * dy, pz + 0.5 * dz
+    depth = _facet_depth(1.0, 0.0, 0.0, hx, hy, hz, dx, dy, dz, mx, my, mz)
+    depth = min(depth, _facet_depth(0.0, 1.0, 0.0, hx, hy, hz, dx, dy, dz, mx, my, mz))
+    depth = min(depth, _facet_depth(0.0, 0.0, 1.0, hx, hy, hz, dx, dy, dz, mx, my, mz))
+    depth = min(depth, _cross_depth(0.0, -dz, dy, dn, hx, hy, hz, dx, dy, dz, mx, my, mz))
+    depth = min(depth, _cross_depth(dz, 0.0, -dx, dn, hx, hy, hz, dx, dy, dz, mx, my, mz))
+    depth = min(depth, _cross_depth(-dy, dx, 0.0, dn, hx, hy, hz, dx, dy, dz, mx, my, mz))
+    return math.sqrt(best) - radius if best > 0.0 else -(depth + radius)
+
+
+@_jit
+def _near_box_lanes(near_a, near_box, values, m, lanes, hx, hy, hz, radius, offset, fixed, cap_rows, box_rows):
+    """The lanes ``t < m`` whose ``values[t]`` :func:`_box_lane` left NaN (near or in the box)
+    get :func:`_near_box_distance` minus ``offset``: those of ``_distance._capsule_box`` bit
+    for bit, side by side in whole SIMD registers (``lanes``, ``fixed``, ``cap_rows`` (6,
+    BLOCK), ``box_rows`` (12, BLOCK): scratch)."""
+    count = 0
+    for t in range(m):
+        lanes[count] = t
+        count += 1 if values[t] != values[t] else 0
+    if count == 0:
+        return
+    padded = min(-(-count // LANES) * LANES, BLOCK)
+    for u in range(count, padded):
+        lanes[u] = lanes[count - 1]
+    _gather(near_a, lanes, padded, cap_rows)
+    _gather(near_box, lanes, padded, box_rows)
+    for u in range(padded):
+        fixed[u] = _near_box_distance(cap_rows, box_rows, u, hx, hy, hz, radius) - offset
+    for u in range(count):
+        values[lanes[u]] = fixed[u]
 
 
 @_jit
@@ -505,13 +651,13 @@ def clearance_smallest(
     lanes = np.empty(BLOCK, dtype=np.uint64)
     values = np.empty(BLOCK)
     dense = np.empty(BLOCK)
+    near_lanes = np.empty(BLOCK, dtype=np.uint64)
+    fixed = np.empty(BLOCK)
+    cap_rows = np.empty((6, BLOCK))
+    box_rows = np.empty((12, BLOCK))
     near_a = np.empty((6, BLOCK))
     near_b = np.empty((6, BLOCK))
     near_box = np.empty((12, BLOCK))
-    w = np.empty((2, 3))
-    work = np.empty(14)
-    cap_world = np.empty((2, 6))
-    box_world = np.empty(12)
     for s0 in range(0, count, BLOCK):
         nb = min(BLOCK, count - s0)
         _place_block(q, s0, nb, rot, pos, cap_body, cap_points, box_body, box_frames, frames, sn, cs, caps, boxes)
@@ -594,10 +740,10 @@ def clearance_smallest(
                 hx, hy, hz = halves[j, 0], halves[j, 1], halves[j, 2]
                 gap = radii[i] + offsets[k]
                 _box_lanes(ca, bx, lanes, padded, hx, hy, hz, gap, near_a, near_box, values)
-                for t in range(m):
-                    if values[t] != values[t]:  # near or in the box: the scalar kernel
-                        _place(caps, boxes, i, j, lanes[t], cap_world, box_world)
-                        values[t] = _capsule_box(cap_world[0], radii[i], box_world, halves[j], w, work) - offsets[k]
+                # near or in the box: the scalar kernel's distance, in SIMD
+                _near_box_lanes(
+                    near_a, near_box, values, m, near_lanes, hx, hy, hz, radii[i], offsets[k], fixed, cap_rows, box_rows
+                )
             for b in range(nb):
                 dense[b] = np.inf
             for t in range(m):
