@@ -15,9 +15,17 @@ per shape) and computes each pair's witness points on the way.  Here, for a bloc
    against the other segment and the interior critical point, minus both radii);
    capsule-box from the derivative of the squared distance along the segment (below);
 3. a capsule-box pair whose segment comes within :data:`NEAR_BOX_M` of the box (touching or
-   overlapping: the penetration depth is a different computation) is computed again by the
-   scalar kernel of :mod:`jointlock._kernels._distance`, and the closest pair of each
-   configuration gets its witness points from it (when asked).
+   overlapping: the penetration depth is a different computation) is computed again, those
+   configurations side by side, by a branch-free copy of the scalar kernel's distance
+   (:func:`_near_box_distance`: the same operations, the same bits as
+   ``_distance._capsule_box``), and the closest pair of each configuration gets its witness
+   points from the scalar kernels (when asked);
+4. :func:`clearance_smallest`, the jobs' screens, computes only the pairs that bounds from the
+   shapes' centres leave as possibly the closest.
+
+Indexing.  Each shape's rows are taken as a view (``caps[6 * i : 6 * i + 6]``) and indexed by
+the loop's own index: numba wraps an index that may be negative, and an offset plus the loop
+index made every load of the SIMD loops a gather.
 
 Capsule-box, away from the box.  In the box frame the squared distance from ``p + t d`` to the
 box is ``f(t) = sum_k e_k(t)^2`` with ``e_k`` the excess of coordinate ``k`` over the half
