@@ -735,15 +735,17 @@ def test_the_fused_kernels_depth_near_a_box_is_the_scalar_kernels_bit_for_bit():
     copy of the scalar kernel's distance (its pieces between sorted breakpoints, then the
     penetration depth over the box axes and their cross products): the same bits as
     ``_distance._capsule_box`` on segments through the box, inside it, touching a face, lying
-    in a face plane, along an edge, parallel to an axis, of zero length, and ending on a face,
-    for boxes turned and not; several blocks of lanes, a partial one included."""
+    in a face plane, along an edge, parallel to an axis, of zero length, ending on a face, and
+    grazing a face or a corner within 1e-9 m, for boxes turned and not, with a pair's offset
+    subtracted; several blocks of lanes, a partial one included.  Only the lanes marked NaN
+    (near or in the box) are computed again: the others keep their value."""
     from jointlock._kernels._clearance import BLOCK, _near_box_lanes
     from jointlock._kernels._distance import _capsule_box
 
     rng = np.random.default_rng(31)
     halves = np.array([0.5, 0.8, 0.3])
-    for block in range(6):
-        lanes = BLOCK if block < 5 else 37
+    for block in range(24):
+        lanes = BLOCK if block < 23 else 37
         rot = np.eye(3) if block % 2 else _random_rotation(rng)
         centre = rng.normal(size=3)
         a = rng.uniform(-1.0, 1.0, (lanes, 3)) * halves * 1.3
@@ -757,6 +759,9 @@ def test_the_fused_kernels_depth_near_a_box_is_the_scalar_kernels_bit_for_bit():
         a[4::9] = halves * np.array([1.0, 0.2, -0.4])  # starting on a face
         a[5::9] = -a[5::9] * 0.1  # from the middle
         v[6::9] = -2.0 * a[6::9]  # through the centre
+        a[7::9] = halves * np.sign(rng.normal(size=(len(a[7::9]), 3))) * (1 + 1e-9)  # at a corner
+        a[8::9, 0] = halves[0] + rng.uniform(0, 1e-9, len(a[8::9]))  # grazing the +x face
+        v[8::9, 0] = 0.0
         ends = np.hstack([a, a + v])  # box frame
         world = np.hstack([ends[:, :3] @ rot.T + centre, ends[:, 3:] @ rot.T + centre])
         caps = np.zeros((6, BLOCK))
@@ -765,14 +770,18 @@ def test_the_fused_kernels_depth_near_a_box_is_the_scalar_kernels_bit_for_bit():
         box[:9, :lanes] = rot.reshape(9, 1)
         box[9:, :lanes] = centre.reshape(3, 1)
         values = np.full(BLOCK, np.nan)
+        kept = np.arange(lanes) % 5 == 4  # lanes the fused kernel found apart: left as they are
+        values[:lanes][kept] = 7.0
+        offset = -0.01 if block % 3 else 0.0
         _near_box_lanes(
-            caps, box, values, lanes, np.empty(BLOCK, dtype=np.uint64), *halves, 0.1, 0.0,
+            caps, box, values, lanes, np.empty(BLOCK, dtype=np.uint64), *halves, 0.1, offset,
             np.empty(BLOCK), np.empty((6, BLOCK)), np.empty((12, BLOCK)),
         )  # fmt: skip
         w, work = np.empty((2, 3)), np.empty(14)
-        scalar = [_capsule_box(world[t], 0.1, np.concatenate([rot.ravel(), centre]), halves, w, work) for t in range(lanes)]
-        assert np.array_equal(values[:lanes], scalar)
-        assert np.any(values[:lanes] < -0.1) and np.any(values[:lanes] > 0.0)
+        pose = np.concatenate([rot.ravel(), centre])
+        scalar = np.array([_capsule_box(world[t], 0.1, pose, halves, w, work) for t in range(lanes)]) - offset
+        assert np.array_equal(values[:lanes][~kept], scalar[~kept]) and np.all(values[:lanes][kept] == 7.0)
+        assert np.any(values[:lanes] < -0.1) and np.any(values[:lanes][~kept] > 0.0)
 
 
 def _shape_by_shape(model: jl.ArmModel, q: np.ndarray, keep_out=()) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

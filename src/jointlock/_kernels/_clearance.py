@@ -463,10 +463,17 @@ def _piece_sq(px, py, pz, dx, dy, dz, hx, hy, hz, t0, t1):
 
 
 @_inline
+def _excess_as_scalar(x, h):
+    """``_distance._excess`` as selects (0 for NaN, as there: a candidate whose ``t`` is NaN
+    after an overflow counts as inside)."""
+    return (x - h) if x > h else ((x + h) if x < -h else 0.0)
+
+
+@_inline
 def _box_sq_at(px, py, pz, dx, dy, dz, hx, hy, hz, t):
-    ex = _excess(px + t * dx, hx)
-    ey = _excess(py + t * dy, hy)
-    ez = _excess(pz + t * dz, hz)
+    ex = _excess_as_scalar(px + t * dx, hx)
+    ey = _excess_as_scalar(py + t * dy, hy)
+    ez = _excess_as_scalar(pz + t * dz, hz)
     return 0.0 + ex * ex + ey * ey + ez * ez
 
 
@@ -497,7 +504,8 @@ def _near_box_distance(ca, bx, t, hx, hy, hz, radius):
     distance over the pieces between the sorted breakpoints (a sorting network instead of an
     insertion sort: the same pieces, and repeated zeros for missing breakpoints), and where
     that is 0, the penetration depth over the box's axes and their cross products with the
-    segment."""
+    segment.  Bit for bit while the squares of the coordinates are finite (below 1e154 m: a
+    model's lengths are at most 1e12 m); beyond, the two kernels' overflows differ."""
     ox, oy, oz = ca[0, t] - bx[9, t], ca[1, t] - bx[10, t], ca[2, t] - bx[11, t]
     vx, vy, vz = ca[3, t] - ca[0, t], ca[4, t] - ca[1, t], ca[5, t] - ca[2, t]
     px = bx[0, t] * ox + bx[3, t] * oy + bx[6, t] * oz
