@@ -698,10 +698,10 @@ def test_the_per_joint_solver_searches_within_the_halts_that_keep_the_clearance(
 
 @pytest.mark.oracle
 def test_the_fused_kernels_primitives_equal_coal():
-    """The branch-free distances of the fused kernel (:mod:`jointlock._kernels._clearance`) on
+    """The branch-free distances of the fused kernel (:mod:`jointlock._kernels._lanes`) on
     the random pairs of the scalar kernel's coal test: segment-segment and segment-box, the
     latter where the segment is apart from the box (nearer ones go to the scalar kernel)."""
-    from jointlock._kernels._clearance import NEAR_BOX_M, _segment_box_sq, _segments_sq
+    from jointlock._kernels._lanes import NEAR_BOX_M, _segment_box_sq, _segments_sq
 
     rng = np.random.default_rng(28)
     count = 600
@@ -739,8 +739,9 @@ def test_the_fused_kernels_depth_near_a_box_is_the_scalar_kernels_bit_for_bit():
     grazing a face or a corner within 1e-9 m, for boxes turned and not, with a pair's offset
     subtracted; several blocks of lanes, a partial one included.  Only the lanes marked NaN
     (near or in the box) are computed again: the others keep their value."""
-    from jointlock._kernels._clearance import BLOCK, _near_box_lanes
+    from jointlock._kernels._common import BLOCK
     from jointlock._kernels._distance import _capsule_box
+    from jointlock._kernels._near_box import _near_box_lanes
 
     rng = np.random.default_rng(31)
     halves = np.array([0.5, 0.8, 0.3])

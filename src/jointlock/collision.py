@@ -34,7 +34,7 @@ configuration.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -280,6 +280,25 @@ def reports_clearance(model: ArmModel, keep_out: Sequence[Shape] = ()) -> bool:
     return not model.unread_meshes and bool(collision_pairs(model, keep_out).names)
 
 
+def _kernel_inputs(model: ArmModel, pairs: CollisionPairs, q: FloatArray) -> tuple[np.ndarray, ...]:
+    """The configurations, the chain and the shapes, as both clearance kernels take them first
+    (:func:`jointlock._kernels._clearance.clearance_distances`)."""
+    shapes = cached_on(pairs, "kernel_shapes", lambda: _kernel_shapes(model, pairs))
+    return (
+        np.ascontiguousarray(q, dtype=float),
+        shapes.rot,
+        shapes.pos,
+        np.ascontiguousarray(pairs.capsule_body),
+        shapes.capsule_points,
+        np.ascontiguousarray(pairs.capsule_radii),
+        np.ascontiguousarray(pairs.box_body),
+        shapes.box_frames,
+        np.ascontiguousarray(pairs.box_halves),
+        np.ascontiguousarray(pairs.pairs),
+        np.ascontiguousarray(pairs.offsets),
+    )
+
+
 def _distances(
     model: ArmModel, pairs: CollisionPairs, q: FloatArray, witness: bool = True
 ) -> tuple[FloatArray, FloatArray, np.ndarray, FloatArray]:
@@ -296,19 +315,9 @@ def _distances(
     closest = np.zeros(count, dtype=np.int64)
     points = np.zeros((count, 2, 3)) if witness else np.full((count, 2, 3), np.nan)
     if n_pairs and count:
-        shapes = cached_on(pairs, "kernel_shapes", lambda: _kernel_shapes(model, pairs))
-        clearance_distances(
-            np.ascontiguousarray(q, dtype=float),
-            shapes.rot,
-            shapes.pos,
-            np.ascontiguousarray(pairs.capsule_body),
-            shapes.capsule_points,
-            np.ascontiguousarray(pairs.capsule_radii),
-            np.ascontiguousarray(pairs.box_body),
-            shapes.box_frames,
-            np.ascontiguousarray(pairs.box_halves),
-            np.ascontiguousarray(pairs.pairs),
-            np.ascontiguousarray(pairs.offsets),
+        kernel: Callable[..., None] = clearance_distances  # numba's stubs type no *args
+        kernel(
+            *_kernel_inputs(model, pairs, q),
             witness,
             by_pair,
             lowest,
@@ -324,9 +333,9 @@ def _distances(
 def _smallest(model: ArmModel, pairs: CollisionPairs, q: FloatArray, floor: FloatArray) -> tuple[FloatArray, np.ndarray]:
     """(N,) the smallest ``d_p - floor[p]`` over the pairs of configurations q (N, n), and (N,)
     its pair (the first of equal ones; 0 when there is no pair): that of :func:`_distances`'
-    distances, bit for bit, without computing every pair (:func:`jointlock._kernels._clearance.
+    distances, bit for bit, without computing every pair (:func:`jointlock._kernels._screen.
     clearance_smallest`; with a convex hull, from every pair's distance)."""
-    from ._kernels._clearance import clearance_smallest
+    from ._kernels._screen import clearance_smallest
 
     count = q.shape[0]
     if (pairs.pairs[:, 0] == 2).any():  # a convex hull: coal's distance, every pair
@@ -335,19 +344,9 @@ def _smallest(model: ArmModel, pairs: CollisionPairs, q: FloatArray, floor: Floa
     smallest = np.full(count, np.inf)
     closest = np.zeros(count, dtype=np.int64)
     if pairs.pairs.shape[0] and count:
-        shapes = cached_on(pairs, "kernel_shapes", lambda: _kernel_shapes(model, pairs))
-        clearance_smallest(
-            np.ascontiguousarray(q, dtype=float),
-            shapes.rot,
-            shapes.pos,
-            np.ascontiguousarray(pairs.capsule_body),
-            shapes.capsule_points,
-            np.ascontiguousarray(pairs.capsule_radii),
-            np.ascontiguousarray(pairs.box_body),
-            shapes.box_frames,
-            np.ascontiguousarray(pairs.box_halves),
-            np.ascontiguousarray(pairs.pairs),
-            np.ascontiguousarray(pairs.offsets),
+        kernel: Callable[..., None] = clearance_smallest  # numba's stubs type no *args
+        kernel(
+            *_kernel_inputs(model, pairs, q),
             np.ascontiguousarray(floor, dtype=float),
             smallest,
             closest,
